@@ -1,0 +1,114 @@
+// Integrator base-class helpers (counted evaluations) and the method registry.
+#include "integrators/integrator.hpp"
+
+#include <fmt/format.h>
+
+namespace geomint {
+
+#define GEOMINT_METHOD(name, factory, variants, summary) \
+  std::unique_ptr<Integrator> factory(Params&);
+#include "integrators/registry.def"
+#undef GEOMINT_METHOD
+
+namespace {
+std::vector<std::string> split_variants(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    const auto semicolon = text.find(';', start);
+    out.push_back(text.substr(start, semicolon - start));
+    if (semicolon == std::string::npos) break;
+    start = semicolon + 1;
+  }
+  return out;
+}
+}  // namespace
+
+const std::vector<IntegratorEntry>& integrator_registry() {
+  static const std::vector<IntegratorEntry> entries = {
+#define GEOMINT_METHOD(name, factory, variants, summary) \
+  {#name, summary, &factory, split_variants(variants)},
+#include "integrators/registry.def"
+#undef GEOMINT_METHOD
+  };
+  return entries;
+}
+
+std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {
+  const Spec spec = Spec::parse(spec_text);
+  std::vector<std::string> names;
+  for (const auto& entry : integrator_registry()) {
+    if (entry.name != spec.name) {
+      names.push_back(entry.name);
+      continue;
+    }
+    Params params(spec, fmt::format("method '{}'", spec.name));
+    auto integrator = entry.factory(params);
+    params.finish();
+    integrator->spec_ = params.canonical();
+    return integrator;
+  }
+  throw InputError(
+      fmt::format("unknown method '{}' (valid: {})", spec.name, fmt::join(names, ", ")));
+}
+
+std::vector<std::string> integrator_test_specs() {
+  std::vector<std::string> specs;
+  for (const auto& entry : integrator_registry()) {
+    specs.push_back(entry.name);
+    for (const auto& variant : entry.variants) specs.push_back(entry.name + ":" + variant);
+  }
+  return specs;
+}
+
+std::vector<std::string> flag_names(unsigned flags) {
+  static const std::pair<MethodFlag, const char*> kNames[] = {
+      {kExplicit, "explicit"},       {kImplicit, "implicit"},
+      {kSymplectic, "symplectic"},   {kSymmetric, "symmetric"},
+      {kVariational, "variational"}, {kAdaptive, "adaptive"},
+      {kConstrained, "constrained"}, {kNeedsHessian, "needs_hessian"},
+  };
+  std::vector<std::string> out;
+  for (const auto& [bit, label] : kNames) {
+    if (flags & bit) out.emplace_back(label);
+  }
+  return out;
+}
+
+void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }
+
+StepStatus Integrator::adaptive_step(const Problem&, State&, double) {
+  return StepStatus::failure("not_adaptive", "method has no adaptive_step; use step()");
+}
+
+void Integrator::eval_gradient(const Problem& problem, const Vec& q, Vec& g) {
+  ++counters_.force_evals;
+  problem.gradient(q, g);
+}
+
+double Integrator::eval_potential(const Problem& problem, const Vec& q) {
+  ++counters_.energy_evals;
+  return problem.potential(q);
+}
+
+void Integrator::eval_hessian(const Problem& problem, const Vec& q, SparseMatrix& H) {
+  ++counters_.hessian_evals;
+  problem.hessian(q, H);
+}
+
+void Integrator::eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {
+  problem.force(q, v, t, f);
+}
+
+void Integrator::eval_total_force(const Problem& problem, const Vec& q, const Vec& v, double t,
+                                  Vec& f) {
+  eval_gradient(problem, q, f);
+  f = -f;
+  if (problem.has(kForce)) {
+    Vec extra;
+    problem.force(q, v, t, extra);
+    f += extra;
+  }
+}
+
+}  // namespace geomint

@@ -1,0 +1,106 @@
+// The Integrator interface (DESIGN.md §2): a one-step map on State = (t, q, p) with declared
+// order and properties (flags) that the test suite checks, work counters, and failure statuses.
+// Adaptive library solvers implement advance_to() instead of fixed steps.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+
+enum MethodFlag : unsigned {
+  kExplicit = 1u << 0,
+  kImplicit = 1u << 1,
+  kSymplectic = 1u << 2,   // canonical symplectic one-step map
+  kSymmetric = 1u << 3,    // Φ_{−h} ∘ Φ_h = id
+  kVariational = 1u << 4,  // derived from a discrete Lagrangian: discrete Noether holds
+  kAdaptive = 1u << 5,     // error-controlled; use advance_to()
+  kConstrained = 1u << 6,  // handles holonomic constraints
+  kNeedsHessian = 1u << 7, // needs Problem::hessian
+};
+std::vector<std::string> flag_names(unsigned flags);
+
+struct MethodInfo {
+  std::string name;       // registry name
+  int order = 0;          // classical order of accuracy
+  unsigned flags = 0;
+  std::string reference;  // where the scheme is defined
+};
+
+// Result of one step; a failed step leaves the state unspecified and ends the run.
+struct StepStatus {
+  bool ok = true;
+  std::string reason;   // short CSV code: "nan", "newton_max_iter", "cvode_flag_-4", ...
+  std::string message;  // human-readable detail
+  static StepStatus success() { return {}; }
+  static StepStatus failure(std::string reason, std::string message) {
+    return {false, std::move(reason), std::move(message)};
+  }
+};
+
+struct Counters {
+  long steps = 0;
+  long force_evals = 0;    // gradient (and force) evaluations
+  long energy_evals = 0;   // potential evaluations (line searches)
+  long hessian_evals = 0;
+  long newton_iters = 0;
+  long linear_solves = 0;
+  long rejected = 0;       // rejected steps (adaptive solvers)
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+
+  virtual MethodInfo info() const = 0;
+  // Canonical spec ("newmark:beta=0.25,gamma=0.5"), set by the registry.
+  const std::string& spec() const { return spec_; }
+
+  // Prepares for a run from `state` with nominal step h (h may be negative for reversibility
+  // checks). Resets the counters. Methods with internal variables initialise them here.
+  virtual void reset(const Problem& problem, const State& state, double h);
+  // Advances state by h (fixed-step methods). Must not throw on numerical trouble: returns a
+  // failed status instead. Checks for non-finite results are done by the harness.
+  virtual StepStatus step(const Problem& problem, State& state, double h) = 0;
+  // Adaptive methods (flag kAdaptive): take one internal, error-controlled step without passing
+  // t_stop, so observers see the solver's own step points (never interpolated output). The
+  // harness calls it until state.t == t_stop.
+  virtual StepStatus adaptive_step(const Problem& problem, State& state, double t_stop);
+
+  const Counters& counters() const { return counters_; }
+
+ protected:
+  // Evaluation helpers that keep the counters honest.
+  void eval_gradient(const Problem& problem, const Vec& q, Vec& g);
+  double eval_potential(const Problem& problem, const Vec& q);
+  void eval_hessian(const Problem& problem, const Vec& q, SparseMatrix& H);
+  void eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
+  // −∇V(q) + F(q, v, t): the total generalized force.
+  void eval_total_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
+
+  Counters counters_;
+
+ private:
+  friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
+  std::string spec_;
+};
+
+// Registry (integrators/registry.def). Throws InputError for unknown names/keys/values.
+std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
+
+struct IntegratorEntry {
+  std::string name;
+  std::string summary;
+  std::unique_ptr<Integrator> (*factory)(Params&);
+  std::vector<std::string> variants;  // extra parameter sets the test suite must also cover
+};
+const std::vector<IntegratorEntry>& integrator_registry();
+
+// Default specs to exercise in registry-driven tests and `geomint list`: one per entry, plus
+// extra configurations an entry declares worth testing (e.g. hp with both solvers).
+std::vector<std::string> integrator_test_specs();
+
+}  // namespace geomint

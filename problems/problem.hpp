@@ -1,0 +1,124 @@
+// The Problem interface (DESIGN.md §2): a Lagrangian system L(q, v) = ½ vᵀMv − V(q) with a
+// constant diagonal (lumped) mass matrix, optional non-conservative force, exact solution and
+// momentum maps. Problems declare capabilities; the harness runs only what applies.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "problems/spec.hpp"
+
+namespace geomint {
+
+using Vec = Eigen::VectorXd;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// Canonical state: configuration q and momentum p = M v at time t.
+struct State {
+  double t = 0.0;
+  Vec q;
+  Vec p;
+};
+
+// What a problem offers beyond the required pieces. Instance-level: a pendulum has an exact
+// solution only when it librates, a spring network has angular momentum only when free.
+enum Capability : unsigned {
+  kHessian = 1u << 0,          // hessian(q, H)
+  kForce = 1u << 1,            // force(q, v, t): non-conservative (damping, driving)
+  kExact = 1u << 2,            // exact(t)
+  kLinearMomentum = 1u << 3,   // linear_momentum(q, p) is a conserved quantity
+  kAngularMomentum = 1u << 4,  // angular_momentum(q, p) is a conserved quantity
+  kPeriod = 1u << 5,           // period()
+  kOmegaMax = 1u << 6,         // omega_max(q)
+  kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
+};
+
+// Capability names for `geomint list` and error messages.
+std::vector<std::string> capability_names(unsigned capabilities);
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+
+  // Canonical spec: name plus every parameter, keys sorted.
+  const std::string& spec() const { return spec_; }
+  // Registry name ("pendulum").
+  const std::string& name() const { return name_; }
+  unsigned capabilities() const { return capabilities_; }
+  bool has(Capability c) const { return (capabilities_ & c) != 0; }
+
+  int dof() const { return static_cast<int>(mass_.size()); }
+  virtual State initial_state() const = 0;
+  // Diagonal of the (lumped) mass matrix M, all entries > 0.
+  const Vec& mass() const { return mass_; }
+  const Vec& inverse_mass() const { return inverse_mass_; }
+
+  virtual double potential(const Vec& q) const = 0;
+  // g = ∇V(q); g is resized by the callee.
+  virtual void gradient(const Vec& q, Vec& g) const = 0;
+  // H = ∇²V(q), symmetric, compressed. Only when has(kHessian).
+  virtual void hessian(const Vec& q, SparseMatrix& H) const;
+  // Non-conservative generalized force F(q, v, t) (added to −∇V). Only when has(kForce).
+  virtual void force(const Vec& q, const Vec& v, double t, Vec& f) const;
+  // C = −∂F/∂v (damping matrix, symmetric PSD for dissipative forces). Only when has(kForceJacobian).
+  virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
+  // Exact solution. Only when has(kExact).
+  virtual State exact(double t) const;
+  // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
+  virtual Vec linear_momentum(const Vec& q, const Vec& p) const;
+  // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when has(kAngularMomentum).
+  virtual Vec angular_momentum(const Vec& q, const Vec& p) const;
+  // Period of the exact motion. Only when has(kPeriod).
+  virtual double period() const;
+  // Highest linearised frequency at q (for stability reports). Only when has(kOmegaMax).
+  virtual double omega_max(const Vec& q) const;
+
+  // Total energy H = ½pᵀM⁻¹p + V(q) (the conserved Hamiltonian when there is no force).
+  double energy(const Vec& q, const Vec& p) const;
+  double kinetic(const Vec& p) const;
+
+  // Suggested step and horizon for `geomint run` without --dt/--t-end.
+  double default_dt() const { return default_dt_; }
+  double default_t_end() const { return default_t_end_; }
+
+  // First-order view y = (q, p), y' = (M⁻¹p, −∇V(q) + F(q, M⁻¹p, t)) for ODE solvers.
+  void first_order_rhs(double t, const Vec& y, Vec& ydot) const;
+  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs kHessian; uses kForceJacobian if kForce,
+  // otherwise the force's q/v dependence is differenced numerically).
+  void first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const;
+
+ protected:
+  // Called once by the factory after construction.
+  void set_mass(const Vec& mass);
+  void set_capabilities(unsigned capabilities) { capabilities_ = capabilities; }
+  void set_defaults(double dt, double t_end) {
+    default_dt_ = dt;
+    default_t_end_ = t_end;
+  }
+
+ private:
+  friend std::unique_ptr<Problem> make_problem(const std::string& spec_text);
+  std::string name_;
+  std::string spec_;
+  unsigned capabilities_ = 0;
+  Vec mass_;
+  Vec inverse_mass_;
+  double default_dt_ = 0.01;
+  double default_t_end_ = 10.0;
+};
+
+// Registry (problems/registry.def). Throws InputError for unknown names/keys/values.
+std::unique_ptr<Problem> make_problem(const std::string& spec_text);
+
+struct ProblemEntry {
+  std::string name;
+  std::string summary;
+  std::unique_ptr<Problem> (*factory)(Params&);
+};
+const std::vector<ProblemEntry>& problem_registry();
+
+}  // namespace geomint

@@ -1,0 +1,171 @@
+// Spec string parsing and the validated parameter reader (see spec.hpp).
+#include "problems/spec.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+namespace geomint {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  const auto last = s.find_last_not_of(" \t");
+  return s.substr(first, last - first + 1);
+}
+
+bool valid_identifier(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Spec Spec::parse(const std::string& text) {
+  Spec spec;
+  const auto colon = text.find(':');
+  spec.name = trim(text.substr(0, colon));
+  if (!valid_identifier(spec.name)) {
+    throw InputError(fmt::format("malformed spec '{}': expected NAME or NAME:key=value,...", text));
+  }
+  if (colon == std::string::npos) return spec;
+  std::string rest = text.substr(colon + 1);
+  size_t start = 0;
+  while (start <= rest.size()) {
+    const auto comma = rest.find(',', start);
+    const std::string item =
+        trim(rest.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || !valid_identifier(trim(item.substr(0, eq))) ||
+        trim(item.substr(eq + 1)).empty()) {
+      throw InputError(fmt::format(
+          "malformed spec '{}': item '{}' is not key=value (expected NAME:key=value,...)", text,
+          item));
+    }
+    const std::string key = trim(item.substr(0, eq));
+    if (!spec.values.emplace(key, trim(item.substr(eq + 1))).second) {
+      throw InputError(fmt::format("malformed spec '{}': key '{}' given twice", text, key));
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return spec;
+}
+
+std::string format_number(double value) {
+  // Shortest representation that round-trips.
+  char buffer[64];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+Params::Params(const Spec& spec, std::string context) : spec_(spec), context_(std::move(context)) {}
+
+const std::string* Params::raw(const std::string& key) {
+  auto it = spec_.values.find(key);
+  return it == spec_.values.end() ? nullptr : &it->second;
+}
+
+void Params::record(const std::string& key, const std::string& default_value,
+                    const std::string& help, const std::string& value) {
+  docs_.push_back({key, default_value, help});
+  canonical_values_[key] = value;
+}
+
+double Params::real(const std::string& key, double default_value, const std::string& help,
+                    const std::function<bool(double)>& ok, const std::string& valid) {
+  double value = default_value;
+  if (const std::string* text = raw(key)) {
+    const char* begin = text->c_str();
+    char* end = nullptr;
+    value = std::strtod(begin, &end);
+    if (end == begin || *end != '\0' || !std::isfinite(value)) {
+      throw InputError(fmt::format("{}: parameter {}='{}' is not a finite number", context_, key,
+                                   *text));
+    }
+  }
+  if (ok && !ok(value)) {
+    throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: {})", context_,
+                                 key, format_number(value), valid.empty() ? "see list" : valid));
+  }
+  record(key, format_number(default_value), help, format_number(value));
+  return value;
+}
+
+long Params::integer(const std::string& key, long default_value, const std::string& help,
+                     long min_value, long max_value) {
+  long value = default_value;
+  if (const std::string* text = raw(key)) {
+    const auto result = std::from_chars(text->data(), text->data() + text->size(), value);
+    if (result.ec != std::errc() || result.ptr != text->data() + text->size()) {
+      throw InputError(
+          fmt::format("{}: parameter {}='{}' is not an integer", context_, key, *text));
+    }
+  }
+  if (value < min_value || value > max_value) {
+    throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: {}..{})", context_,
+                                 key, value, min_value, max_value));
+  }
+  record(key, std::to_string(default_value), help, std::to_string(value));
+  return value;
+}
+
+std::string Params::choice(const std::string& key, const std::string& default_value,
+                           const std::vector<std::string>& choices, const std::string& help) {
+  std::string value = default_value;
+  if (const std::string* text = raw(key)) value = *text;
+  bool found = false;
+  for (const auto& c : choices) found = found || c == value;
+  if (!found) {
+    throw InputError(fmt::format("{}: parameter {}='{}' is not allowed (allowed: {})", context_,
+                                 key, value, fmt::join(choices, ", ")));
+  }
+  record(key, default_value, fmt::format("{} ({})", help, fmt::join(choices, "|")), value);
+  return value;
+}
+
+bool Params::flag(const std::string& key, bool default_value, const std::string& help) {
+  bool value = default_value;
+  if (const std::string* text = raw(key)) {
+    if (*text == "true" || *text == "1") {
+      value = true;
+    } else if (*text == "false" || *text == "0") {
+      value = false;
+    } else {
+      throw InputError(fmt::format("{}: parameter {}='{}' is not a boolean (allowed: true, false)",
+                                   context_, key, *text));
+    }
+  }
+  record(key, default_value ? "true" : "false", help, value ? "true" : "false");
+  return value;
+}
+
+void Params::finish() const {
+  for (const auto& [key, value] : spec_.values) {
+    if (canonical_values_.count(key) == 0) {
+      std::vector<std::string> valid;
+      for (const auto& doc : docs_) valid.push_back(doc.key);
+      throw InputError(fmt::format("{}: unknown parameter '{}' (valid: {})", context_, key,
+                                   valid.empty() ? "none" : fmt::format("{}", fmt::join(valid, ", "))));
+    }
+  }
+}
+
+std::string Params::canonical() const {
+  std::string out = spec_.name;
+  char separator = ':';
+  for (const auto& [key, value] : canonical_values_) {
+    out += separator;
+    out += key + "=" + value;
+    separator = ',';
+  }
+  return out;
+}
+
+}  // namespace geomint

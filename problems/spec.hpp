@@ -1,0 +1,79 @@
+// Spec strings "NAME" or "NAME:key=value,key=value" (DESIGN.md §2) and the typed, validated
+// parameter reader that every factory uses; the canonical spec (defaults filled in, keys
+// sorted) is what CSV files record. Bad input throws InputError (the CLI turns it into exit 2).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace geomint {
+
+// Bad user input: unknown name or key, malformed value, out-of-range parameter.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Spec {
+  std::string name;
+  std::map<std::string, std::string> values;  // as written by the user
+
+  // Throws InputError on "", ":", "a:=1", "a:b", duplicate keys.
+  static Spec parse(const std::string& text);
+};
+
+// Documentation of one parameter, collected while a factory reads its parameters.
+struct ParamDoc {
+  std::string key;
+  std::string default_value;
+  std::string help;
+};
+
+// Reads typed parameters from a Spec. Each getter records the key (with its default and help)
+// so that finish() can reject unknown keys by listing the valid ones, and canonical() can
+// print every parameter. `context` ("method 'hp'") prefixes every message.
+class Params {
+ public:
+  Params(const Spec& spec, std::string context);
+
+  // Real parameter; `valid` describes the allowed range for the message ("> 0", "in [0, 1]").
+  double real(const std::string& key, double default_value, const std::string& help,
+              const std::function<bool(double)>& ok = nullptr, const std::string& valid = "");
+  // Integer parameter, bounds inclusive.
+  long integer(const std::string& key, long default_value, const std::string& help, long min_value,
+               long max_value);
+  // One of `choices`.
+  std::string choice(const std::string& key, const std::string& default_value,
+                     const std::vector<std::string>& choices, const std::string& help);
+  bool flag(const std::string& key, bool default_value, const std::string& help);
+
+  // True when the user wrote this key (for parameters whose default depends on others).
+  bool given(const std::string& key) const { return spec_.values.count(key) > 0; }
+
+  // Throws InputError naming any key that no getter read, with the list of valid keys.
+  void finish() const;
+  // "name:key=value,..." with every parameter read, keys sorted; "name" when there are none.
+  std::string canonical() const;
+  const std::vector<ParamDoc>& docs() const { return docs_; }
+  const std::string& name() const { return spec_.name; }
+
+ private:
+  const std::string* raw(const std::string& key);
+  void record(const std::string& key, const std::string& default_value, const std::string& help,
+              const std::string& value);
+
+  Spec spec_;
+  std::string context_;
+  std::vector<ParamDoc> docs_;
+  std::map<std::string, std::string> canonical_values_;
+};
+
+// Formats a double so that it round-trips and stays short for common values ("0.5", "1e-08").
+std::string format_number(double value);
+
+}  // namespace geomint

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages geomint builds with (DESIGN.md §8). Idempotent: installs only
+# what is missing, waits for the dpkg lock, never pulls recommends. As non-root it prints the
+# exact command to run and exits 1.
+set -euo pipefail
+
+PACKAGES=(
+  g++ cmake make pkg-config
+  libeigen3-dev libsundials-dev libgsl-dev libboost-dev
+  gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for pkg in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$pkg")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  [ "${1:-}" = "--quiet" ] || echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+cmd="apt-get update && apt-get install -y --no-install-recommends ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: missing Debian packages: ${missing[*]}" >&2
+  echo "install-deps: run as root:" >&2
+  echo "  sudo sh -c '$cmd'" >&2
+  exit 1
+fi
+
+wait_for_dpkg_lock() {
+  command -v fuser >/dev/null 2>&1 || return 0  # apt itself waits too (Lock::Timeout)
+  local waited=0
+  while fuser /var/lib/dpkg/lock-frontend /var/lib/dpkg/lock >/dev/null 2>&1; do
+    [ $waited -eq 0 ] && echo "install-deps: waiting for the dpkg lock..." >&2
+    sleep 2
+    waited=$((waited + 2))
+    if [ $waited -ge 600 ]; then
+      echo "install-deps: dpkg lock still held after 600 s" >&2
+      exit 1
+    fi
+  done
+}
+
+echo "install-deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+wait_for_dpkg_lock
+apt-get update -q
+wait_for_dpkg_lock
+apt-get install -y -q --no-install-recommends -o DPkg::Lock::Timeout=600 "${missing[@]}"
