@@ -1,2 +1,195 @@
-// geomint command line (placeholder while the harness is written).
-int main() { return 0; }
+// geomint command line (DESIGN.md §4): list, run, order, sweep. Exit codes: 0 ok, 1 a run
+// failed, 2 bad input (the message names the offending option, key or value).
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+
+#include "harness/order.hpp"
+#include "harness/run.hpp"
+#include "harness/scene.hpp"
+
+using namespace geomint;
+
+namespace {
+
+constexpr int kExitFailed = 1;
+constexpr int kExitBadInput = 2;
+
+std::string joined_command_line(int argc, char** argv) {
+  std::string out = "geomint";
+  for (int i = 1; i < argc; ++i) out += std::string(" ") + argv[i];
+  return out;
+}
+
+void print_methods() {
+  fmt::print("{:<22} {:>5}  {:<48} {}\n", "method", "order", "flags", "parameters (default)");
+  for (const auto& entry : integrator_registry()) {
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto integrator = entry.factory(params);
+    const MethodInfo info = integrator->info();
+    std::vector<std::string> parameters;
+    for (const auto& doc : params.docs()) {
+      parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+    }
+    fmt::print("{:<22} {:>5}  {:<48} {}\n", entry.name, info.order,
+               fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
+               fmt::format("{}", fmt::join(parameters, ",")));
+  }
+}
+
+void print_problems() {
+  fmt::print("{:<20} {:>5}  {:<58} {}\n", "problem", "dof", "capabilities (defaults)",
+             "parameters (default)");
+  for (const auto& entry : problem_registry()) {
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto problem = entry.factory(params);
+    std::vector<std::string> parameters;
+    for (const auto& doc : params.docs()) {
+      parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+    }
+    fmt::print("{:<20} {:>5}  {:<58} {}\n", entry.name, problem->dof(),
+               fmt::format("{}", fmt::join(capability_names(problem->capabilities()), ",")),
+               fmt::format("{}", fmt::join(parameters, ",")));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"geomint: verification and benchmark suite for geometric time integrators"};
+  app.require_subcommand(1);
+
+  auto* list = app.add_subcommand("list", "List registered methods and/or problems");
+  std::string list_what = "all";
+  list->add_option("what", list_what, "methods | problems | all")
+      ->check(CLI::IsMember({"methods", "problems", "all"}));
+
+  std::string problem_spec, method_spec, out_path, series_path;
+  double dt = 0, t_end = 0;
+  long every = 1;
+  int timing_repeats = 3;
+  bool series_state = false;
+  auto* run = app.add_subcommand("run", "Run one problem with one method and print a CSV row");
+  run->add_option("--problem", problem_spec, "problem spec, e.g. pendulum:theta0=1.5")->required();
+  run->add_option("--method", method_spec, "method spec, e.g. stormer_verlet")->required();
+  run->add_option("--dt", dt, "step size (> 0); default: the problem's");
+  run->add_option("--t-end", t_end, "horizon (> 0); default: the problem's");
+  run->add_option("--out", out_path, "write the summary CSV here instead of stdout");
+  run->add_option("--series", series_path, "write a time series CSV here");
+  run->add_option("--every", every, "series: every N-th step point (the last is always written)");
+  run->add_flag("--state", series_state, "series: include q and p even for > 64 dof");
+  run->add_option("--timing-repeats", timing_repeats, "timing pass repeats (0 = none)");
+
+  double dt0 = 0;
+  int levels = 6;
+  auto* order = app.add_subcommand("order", "Fit the convergence order over a dt ladder");
+  order->add_option("--problem", problem_spec, "problem spec")->required();
+  order->add_option("--method", method_spec, "method spec")->required();
+  order->add_option("--dt", dt0, "largest step dt0 (ladder dt0*2^-k)")->required();
+  order->add_option("--levels", levels, "number of ladder levels (>= 3)");
+  order->add_option("--t-end", t_end, "horizon")->required();
+  order->add_option("--out", out_path, "write the ladder runs as CSV");
+
+  std::string scene_path, sweep_out;
+  int jobs = 1;
+  bool quick = false;
+  auto* sweep = app.add_subcommand("sweep", "Run a scene file and write its tables");
+  sweep->add_option("scene", scene_path, "results/<scene>/scene.toml")->required();
+  sweep->add_option("--jobs", jobs, "parallel accuracy runs")->check(CLI::Range(1, 256));
+  sweep->add_flag("--quick", quick, "apply the scene's quick_* settings (CI-sized)");
+  sweep->add_option("--out", sweep_out,
+                    "output folder (default: the scene's folder; with --quick: <folder>/quick)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& help) {
+    return app.exit(help);
+  } catch (const CLI::CallForAllHelp& help) {
+    return app.exit(help);
+  } catch (const CLI::ParseError& error) {
+    app.exit(error);
+    return kExitBadInput;
+  }
+
+  const std::string command_line = joined_command_line(argc, argv);
+  try {
+    if (*list) {
+      if (list_what != "problems") print_methods();
+      if (list_what == "all") fmt::print("\n");
+      if (list_what != "methods") print_problems();
+      return 0;
+    }
+    if (*run) {
+      const auto problem = make_problem(problem_spec);
+      RunConfig config;
+      config.dt = run->count("--dt") ? dt : problem->default_dt();
+      config.t_end = run->count("--t-end") ? t_end : problem->default_t_end();
+      config.series_path = series_path;
+      config.series_every = every;
+      config.series_state = series_state;
+      config.timing_repeats = timing_repeats;
+      config.command_line = command_line;
+      const RunResult result = run_one(problem_spec, method_spec, config);
+      const std::vector<Row> rows = {result.row};
+      const std::string csv =
+          to_csv(rows, column_union(rows, standard_columns()), provenance(command_line));
+      if (out_path.empty()) {
+        std::cout << csv;
+      } else {
+        write_file_atomic(out_path, csv);
+      }
+      if (!result.ok) {
+        fmt::print(stderr, "geomint: run failed: {}: {}\n", result.row.at("status"),
+                   result.row.at("message"));
+      }
+      return result.ok ? 0 : kExitFailed;
+    }
+    if (*order) {
+      const OrderStudy study = order_study(problem_spec, method_spec, dt0, levels, t_end);
+      for (const auto& run_result : study.runs) {
+        const auto& row = run_result.row;
+        fmt::print(stderr, "dt={:<12} status={:<8} error_final={}\n", row.at("dt"),
+                   row.at("status"), row.count("error_final") ? row.at("error_final") : "-");
+      }
+      if (!out_path.empty()) {
+        std::vector<Row> rows;
+        for (const auto& run_result : study.runs) rows.push_back(run_result.row);
+        write_file_atomic(out_path, to_csv(rows, column_union(rows, standard_columns()),
+                                           provenance(command_line)));
+      }
+      if (!std::isfinite(study.fit.order)) {
+        fmt::print(stderr, "geomint: no order fit: {}\n", study.fit.note);
+        return kExitFailed;
+      }
+      fmt::print("{:.3f}\n", study.fit.order);
+      fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
+                 study.row.at("declared_order"), study.row.at("points_used"),
+                 study.fit.note.empty() ? "" : "; " + study.fit.note);
+      return 0;
+    }
+    if (*sweep) {
+      const Scene scene = load_scene(scene_path, quick);
+      SweepOptions options;
+      options.jobs = jobs;
+      options.command_line = command_line;
+      const auto folder = std::filesystem::path(scene_path).parent_path();
+      options.out_dir = !sweep_out.empty() ? sweep_out
+                        : quick            ? (folder / "quick").string()
+                                           : folder.string();
+      const int failed = run_sweep(scene, options);
+      fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
+                 scene.title, failed, options.out_dir);
+      return 0;
+    }
+  } catch (const InputError& error) {
+    fmt::print(stderr, "geomint: error: {}\n", error.what());
+    return kExitBadInput;
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "geomint: internal error: {}\n", error.what());
+    return 3;
+  }
+  return 0;
+}

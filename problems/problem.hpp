@@ -77,6 +77,12 @@ class Problem {
   // Highest linearised frequency at q (for stability reports). Only when has(kOmegaMax).
   virtual double omega_max(const Vec& q) const;
 
+  // Extra problem-specific quantities for time series (e.g. the FPU oscillatory energies).
+  virtual std::vector<std::string> series_names() const { return {}; }
+  virtual void series_values(const Vec& q, const Vec& p, std::vector<double>& values) const {
+    (void)q, (void)p, values.clear();
+  }
+
   // Total energy H = ½pᵀM⁻¹p + V(q) (the conserved Hamiltonian when there is no force).
   double energy(const Vec& q, const Vec& p) const;
   double kinetic(const Vec& p) const;

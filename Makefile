@@ -1,0 +1,44 @@
+# Thin wrapper around CMake/CTest (DESIGN.md §1). `make reproduce-figures` and `make test` each
+# work as the very first command on a fresh Debian 12 machine: they install missing packages
+# through scripts/install-deps.sh when run as root, and otherwise stop with the command to run.
+BUILD_DIR ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
+
+.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick bench format clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh --quiet
+
+configure: deps
+	@mkdir -p $(BUILD_DIR) && cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release > $(BUILD_DIR)/configure.log 2>&1 \
+	  || (cat $(BUILD_DIR)/configure.log; exit 1)
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# Fast suites (< 10 minutes on 2 cores); long runs carry the CTest label "slow".
+test: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
+
+test-all: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
+reproduce-figures: build
+	@bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
+
+# CI-sized variant: quick_* settings, output under results/<scene>/quick/ (not committed).
+reproduce-quick: build
+	@QUICK=1 bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
+
+bench: build
+	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
+
+format:
+	@clang-format -i $$(git ls-files '*.cpp' '*.hpp')
+
+clean:
+	@rm -rf $(BUILD_DIR)

@@ -1,0 +1,36 @@
+// Step-point observers that turn a trajectory into the metrics of DESIGN.md §3. Each observer
+// applies only when the problem has what it needs (an invariant, an exact solution), so
+// inapplicable metrics never appear in the output.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  // Called with the initial state; t_end is the horizon (for time windows).
+  virtual void begin(const Problem& problem, const State& state, double t_end) = 0;
+  virtual void observe(const Problem& problem, const State& state) = 0;
+  // Adds this observer's metrics (column name → value).
+  virtual void finish(std::map<std::string, double>& metrics) const = 0;
+};
+
+// The metric observers that apply to `problem`.
+std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem);
+
+// Relative energy error reference: H0 for conservative problems, the exact solution's energy
+// for forced problems that have one; false when neither applies.
+bool has_energy_reference(const Problem& problem);
+
+// Least-squares slope of per-window maxima (window centre time, max value); 0 for < 2 windows.
+double window_maxima_slope(const std::vector<double>& window_time,
+                           const std::vector<double>& window_max);
+
+}  // namespace geomint

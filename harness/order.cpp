@@ -1,0 +1,160 @@
+// Order fit with plateau rejection and the dt-ladder study (see order.hpp).
+#include "harness/order.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace geomint {
+namespace {
+
+double least_squares_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double mean_x = 0, mean_y = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    mean_x += x[i] / n;
+    mean_y += y[i] / n;
+  }
+  double sxy = 0, sxx = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sxy += (x[i] - mean_x) * (y[i] - mean_y);
+    sxx += (x[i] - mean_x) * (x[i] - mean_x);
+  }
+  return sxy / sxx;
+}
+
+double local_slope(const std::vector<double>& dts, const std::vector<double>& errors, int a,
+                   int b) {
+  return std::log(errors[a] / errors[b]) / std::log(dts[a] / dts[b]);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+}  // namespace
+
+OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& errors,
+                   double plateau_floor) {
+  OrderFit fit;
+  fit.order = std::numeric_limits<double>::quiet_NaN();
+  std::vector<int> points;
+  int failed = 0, plateau = 0;
+  for (int i = 0; i < static_cast<int>(dts.size()); ++i) {
+    if (!std::isfinite(errors[i]) || errors[i] <= 0) {
+      ++failed;
+    } else if (errors[i] < plateau_floor) {
+      ++plateau;
+    } else {
+      points.push_back(i);
+    }
+  }
+  // Round-off plateau at small dt: the error stops decreasing (local slope below a third of the
+  // typical one), so drop trailing points until it decreases again.
+  auto slopes_of = [&](const std::vector<int>& idx) {
+    std::vector<double> slopes;
+    for (size_t j = 1; j < idx.size(); ++j) {
+      slopes.push_back(local_slope(dts, errors, idx[j - 1], idx[j]));
+    }
+    return slopes;
+  };
+  while (points.size() > 3) {
+    const auto slopes = slopes_of(points);
+    if (slopes.back() < median(slopes) / 3) {
+      points.pop_back();
+      ++plateau;
+    } else {
+      break;
+    }
+  }
+  // Pre-asymptotic points at large dt: drop leading points whose local slope differs from the
+  // median of the remaining ones by more than 0.25.
+  int preasymptotic = 0;
+  while (points.size() > 3) {
+    const auto slopes = slopes_of(points);
+    const std::vector<double> rest(slopes.begin() + 1, slopes.end());
+    if (std::abs(slopes.front() - median(rest)) > 0.25) {
+      points.erase(points.begin());
+      ++preasymptotic;
+    } else {
+      break;
+    }
+  }
+  std::vector<std::string> notes;
+  if (failed) notes.push_back(fmt::format("{} failed", failed));
+  if (plateau) notes.push_back(fmt::format("{} on round-off plateau", plateau));
+  if (preasymptotic) notes.push_back(fmt::format("{} pre-asymptotic", preasymptotic));
+  if (points.size() < 3) {
+    notes.push_back(fmt::format("only {} usable points (need 3)", points.size()));
+  } else {
+    std::vector<double> log_dt, log_error;
+    for (int i : points) {
+      log_dt.push_back(std::log(dts[i]));
+      log_error.push_back(std::log(errors[i]));
+    }
+    fit.order = least_squares_slope(log_dt, log_error);
+    fit.used = points;
+  }
+  fit.note = fmt::format("{}", fmt::join(notes, "; "));
+  return fit;
+}
+
+OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec,
+                       double dt0, int levels, double t_end) {
+  if (levels < 3) throw InputError(fmt::format("--levels must be >= 3 (got {})", levels));
+  if (!(dt0 > 0)) throw InputError(fmt::format("--dt must be > 0 (got {})", dt0));
+  OrderStudy study;
+  std::vector<double> dts, errors;
+  bool exact = true;
+  for (int k = 0; k < levels; ++k) {
+    RunConfig config;
+    config.dt = dt0 * std::ldexp(1.0, -k);
+    config.t_end = t_end;
+    config.timing_repeats = 0;
+    RunResult result = run_one(problem_spec, method_spec, config);
+    exact = result.metrics.count("error_final") > 0;
+    dts.push_back(config.dt);
+    result.row["order_level"] = std::to_string(k);
+    study.runs.push_back(std::move(result));
+  }
+  for (const auto& run : study.runs) {
+    double error = std::numeric_limits<double>::quiet_NaN();
+    if (run.ok) {
+      if (exact) {
+        error = run.metrics.at("error_final");
+      } else {
+        // No exact solution: compare with the finest level (Richardson-style self-convergence).
+        const State& finest = study.runs.back().final_state;
+        error = std::sqrt((run.final_state.q - finest.q).squaredNorm() +
+                          (run.final_state.p - finest.p).squaredNorm());
+      }
+    }
+    errors.push_back(error);
+  }
+  if (!exact) {
+    // The finest level is the reference, so it has no error of its own.
+    errors.back() = std::numeric_limits<double>::quiet_NaN();
+  }
+  study.fit = fit_order(dts, errors);
+  const auto method = make_integrator(method_spec);
+  Row& row = study.row;
+  row["problem"] = study.runs.front().row.at("problem");
+  row["method"] = study.runs.front().row.at("method");
+  row["t_end"] = format_number(t_end);
+  row["order"] = std::isfinite(study.fit.order) ? fmt::format("{:.3f}", study.fit.order) : "";
+  row["declared_order"] = std::to_string(method->info().order);
+  std::vector<std::string> used;
+  for (int i : study.fit.used) used.push_back(format_number(dts[i]));
+  row["points_used"] = fmt::format("{}", fmt::join(used, " "));
+  row["status"] = std::isfinite(study.fit.order) ? "ok" : "no_fit";
+  std::string note = study.fit.note;
+  if (!exact) note += std::string(note.empty() ? "" : "; ") + "error vs finest level";
+  if (!note.empty()) row["message"] = note;
+  return study;
+}
+
+}  // namespace geomint

@@ -1,0 +1,248 @@
+// The run loop (see run.hpp): metric pass with observers at step points, then a timing pass.
+#include "harness/run.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "harness/observers.hpp"
+
+namespace geomint {
+namespace {
+
+// A conservative run whose relative energy error passes this has blown up; further steps
+// would only overflow. Forced problems use the state size instead.
+constexpr double kDivergedEnergyError = 1e8;
+constexpr double kDivergedStateNorm = 1e100;
+
+bool finite(const State& state) { return state.q.allFinite() && state.p.allFinite(); }
+
+// Time series writer: t, energy, invariants, problem extras, then q and p.
+class SeriesWriter {
+ public:
+  SeriesWriter(const Problem& problem, const RunConfig& config, const std::string& method_spec)
+      : config_(config) {
+    with_state_ = problem.dof() <= 64 || config.series_state;
+    std::vector<std::string> columns = {"t", "energy"};
+    if (problem.has(kLinearMomentum)) {
+      const Vec momentum = problem.linear_momentum(problem.initial_state().q,
+                                                   problem.initial_state().p);
+      for (int i = 0; i < momentum.size(); ++i) columns.push_back(fmt::format("momentum_{}", i));
+    }
+    if (problem.has(kAngularMomentum)) {
+      const State s = problem.initial_state();
+      const Vec angular = problem.angular_momentum(s.q, s.p);
+      for (int i = 0; i < angular.size(); ++i) {
+        columns.push_back(fmt::format("angular_momentum_{}", i));
+      }
+    }
+    for (const auto& name : problem.series_names()) columns.push_back(name);
+    if (with_state_) {
+      for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("q_{}", i));
+      for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("p_{}", i));
+    }
+    for (const auto& [key, value] : provenance(config.command_line)) {
+      text_ += fmt::format("# {}: {}\n", key, value);
+    }
+    text_ += fmt::format("# problem: {}\n# method: {}\n# dt: {}\n", problem.spec(), method_spec,
+                         format_number(config.dt));
+    text_ += fmt::format("{}\n", fmt::join(columns, ","));
+  }
+
+  void observe(const Problem& problem, const State& state, bool last) {
+    if (count_++ % config_.series_every != 0 && !last) return;
+    std::string line = format_number(state.t) + "," +
+                       format_number(problem.energy(state.q, state.p));
+    auto append = [&line](const Vec& values) {
+      for (double v : values) line += "," + format_number(v);
+    };
+    if (problem.has(kLinearMomentum)) append(problem.linear_momentum(state.q, state.p));
+    if (problem.has(kAngularMomentum)) append(problem.angular_momentum(state.q, state.p));
+    problem.series_values(state.q, state.p, extras_);
+    for (double v : extras_) line += "," + format_number(v);
+    if (with_state_) {
+      append(state.q);
+      append(state.p);
+    }
+    text_ += line + "\n";
+  }
+
+  void write() const { write_file_atomic(config_.series_path, text_); }
+
+ private:
+  const RunConfig& config_;
+  bool with_state_ = true;
+  long count_ = 0;
+  std::string text_;
+  std::vector<double> extras_;
+};
+
+struct LoopOutcome {
+  StepStatus status;
+  long steps = 0;
+};
+
+// Advances from the initial state to t_end; `visit(state, last)` sees every step point.
+// Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
+// only when dt does not divide t_end. `checked` = false (timing pass) skips the per-step
+// finiteness and divergence checks, which cost an energy evaluation per step; the metric pass
+// has already established that the run succeeds.
+template <typename Visit>
+LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& state,
+                      const RunConfig& config, bool adaptive, bool checked, Visit&& visit) {
+  LoopOutcome outcome;
+  const double t0 = state.t;
+  const double energy0 = problem.energy(state.q, state.p);
+  const double energy_scale = std::max(std::abs(energy0), 1e-300);
+  const bool conservative = !problem.has(kForce);
+  auto check = [&](const State& s) -> StepStatus {
+    if (!checked) return StepStatus::success();
+    if (!finite(s)) return StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
+    if (conservative) {
+      if (std::abs(problem.energy(s.q, s.p) - energy0) > kDivergedEnergyError * energy_scale) {
+        return StepStatus::failure(
+            "diverged", fmt::format("relative energy error above {:g} at t={:.6g}",
+                                    kDivergedEnergyError, s.t));
+      }
+    } else if (std::max(s.q.lpNorm<Eigen::Infinity>(), s.p.lpNorm<Eigen::Infinity>()) >
+               kDivergedStateNorm) {
+      return StepStatus::failure("diverged", fmt::format("state norm above 1e100 at t={:.6g}", s.t));
+    }
+    return StepStatus::success();
+  };
+  if (adaptive) {
+    const double t_end = t0 + config.t_end;
+    while (state.t < t_end) {
+      StepStatus status = integrator.adaptive_step(problem, state, t_end);
+      if (status.ok) status = check(state);
+      if (!status.ok) {
+        outcome.status = status;
+        return outcome;
+      }
+      ++outcome.steps;
+      visit(state, state.t >= t_end);
+    }
+    return outcome;
+  }
+  const long n = std::max(1L, static_cast<long>(std::ceil(config.t_end / config.dt - 1e-9)));
+  for (long k = 1; k <= n; ++k) {
+    const double t_next = k == n ? t0 + config.t_end : t0 + k * config.dt;
+    const double h = t_next - state.t;
+    StepStatus status = integrator.step(problem, state, h);
+    state.t = t_next;
+    if (status.ok) status = check(state);
+    if (!status.ok) {
+      if (status.message.find("t=") == std::string::npos) {
+        status.message += fmt::format(" (step ending at t={:.6g})", t_next);
+      }
+      outcome.status = status;
+      return outcome;
+    }
+    ++outcome.steps;
+    visit(state, k == n);
+  }
+  return outcome;
+}
+
+void add_counters(Row& row, const Counters& counters) {
+  row["force_evals"] = std::to_string(counters.force_evals);
+  row["energy_evals"] = std::to_string(counters.energy_evals);
+  row["hessian_evals"] = std::to_string(counters.hessian_evals);
+  row["newton_iters"] = std::to_string(counters.newton_iters);
+  row["linear_solves"] = std::to_string(counters.linear_solves);
+  row["rejected"] = std::to_string(counters.rejected);
+}
+
+}  // namespace
+
+void validate_run_config(const RunConfig& config, bool adaptive) {
+  if (!adaptive && !(config.dt > 0 && std::isfinite(config.dt))) {
+    throw InputError(fmt::format("--dt must be a finite number > 0 (got {})", config.dt));
+  }
+  if (!(config.t_end > 0 && std::isfinite(config.t_end))) {
+    throw InputError(fmt::format("--t-end must be a finite number > 0 (got {})", config.t_end));
+  }
+  if (!adaptive && config.t_end / config.dt > 1e10) {
+    throw InputError(fmt::format("--t-end/--dt = {:g} steps is more than the allowed 1e10",
+                                 config.t_end / config.dt));
+  }
+  if (config.series_every < 1) {
+    throw InputError(fmt::format("--every must be >= 1 (got {})", config.series_every));
+  }
+  if (config.timing_repeats < 0) throw InputError("timing repeats must be >= 0");
+}
+
+double time_run(const std::string& problem_spec, const std::string& method_spec,
+                const RunConfig& config, int repeats) {
+  const auto problem = make_problem(problem_spec);
+  std::vector<double> seconds;
+  for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
+    auto integrator = make_integrator(method_spec);
+    const bool adaptive = (integrator->info().flags & kAdaptive) != 0;
+    State state = problem->initial_state();
+    const auto start = std::chrono::steady_clock::now();
+    integrator->reset(*problem, state, config.dt);
+    integrate(*problem, *integrator, state, config, adaptive, false, [](const State&, bool) {});
+    seconds.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::nth_element(seconds.begin(), seconds.begin() + seconds.size() / 2, seconds.end());
+  return seconds[seconds.size() / 2];
+}
+
+RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
+                  const RunConfig& config) {
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method_spec);
+  const MethodInfo info = integrator->info();
+  const bool adaptive = (info.flags & kAdaptive) != 0;
+  validate_run_config(config, adaptive);
+  if ((info.flags & kNeedsHessian) && !problem->has(kHessian)) {
+    throw InputError(fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
+                                 info.name, problem->name()));
+  }
+
+  RunResult result;
+  Row& row = result.row;
+  row["problem"] = problem->spec();
+  row["method"] = integrator->spec();
+  if (!adaptive) row["dt"] = format_number(config.dt);
+  row["t_end"] = format_number(config.t_end);
+
+  auto observers = make_metric_observers(*problem);
+  std::unique_ptr<SeriesWriter> series;
+  if (!config.series_path.empty()) {
+    series = std::make_unique<SeriesWriter>(*problem, config, integrator->spec());
+  }
+  State state = problem->initial_state();
+  for (auto& observer : observers) observer->begin(*problem, state, config.t_end);
+  if (series) series->observe(*problem, state, false);
+  integrator->reset(*problem, state, config.dt);
+  const LoopOutcome outcome =
+      integrate(*problem, *integrator, state, config, adaptive, true, [&](const State& s, bool last) {
+        for (auto& observer : observers) observer->observe(*problem, s);
+        if (series) series->observe(*problem, s, last);
+      });
+  for (const auto& observer : observers) observer->finish(result.metrics);
+  result.ok = outcome.status.ok;
+  result.final_state = state;
+  row["status"] = outcome.status.ok ? "ok" : outcome.status.reason;
+  if (!outcome.status.ok) {
+    row["message"] = outcome.status.message;
+    row["t_reached"] = format_number(state.t);
+  }
+  row["steps"] = std::to_string(outcome.steps);
+  for (const auto& [key, value] : result.metrics) row[key] = format_number(value);
+  add_counters(row, integrator->counters());
+  if (series) series->write();
+
+  if (result.ok && config.timing_repeats > 0) {
+    row["wall_s"] = format_number(time_run(problem_spec, method_spec, config,
+                                           config.timing_repeats));
+  }
+  return result;
+}
+
+}  // namespace geomint

@@ -1,0 +1,416 @@
+// Scene loading (toml++) and the sweep driver (see scene.hpp).
+#include "harness/scene.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <toml++/toml.h>
+
+#include "harness/order.hpp"
+#include "harness/run.hpp"
+
+namespace geomint {
+namespace {
+
+class BlockReader {
+ public:
+  BlockReader(const toml::table& table, std::string where) : table_(table), where_(std::move(where)) {}
+
+  std::string string(const std::string& key, bool required, const std::string& fallback = "") {
+    seen_.insert(key);
+    const toml::node* node = table_.get(key);
+    if (!node) return require(key, required), fallback;
+    if (auto value = node->value<std::string>()) return *value;
+    throw InputError(fmt::format("{}: key '{}' must be a string", where_, key));
+  }
+  double number(const std::string& key, bool required, double fallback = 0) {
+    seen_.insert(key);
+    const toml::node* node = table_.get(key);
+    if (!node) return require(key, required), fallback;
+    if (auto value = node->value<double>()) return *value;
+    throw InputError(fmt::format("{}: key '{}' must be a number", where_, key));
+  }
+  long integer(const std::string& key, bool required, long fallback = 0) {
+    seen_.insert(key);
+    const toml::node* node = table_.get(key);
+    if (!node) return require(key, required), fallback;
+    if (auto value = node->as_integer()) return value->get();
+    throw InputError(fmt::format("{}: key '{}' must be an integer", where_, key));
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    seen_.insert(key);
+    const toml::node* node = table_.get(key);
+    if (!node) return fallback;
+    if (auto value = node->value<bool>()) return *value;
+    throw InputError(fmt::format("{}: key '{}' must be true or false", where_, key));
+  }
+  std::vector<std::string> strings(const std::string& key, bool required) {
+    seen_.insert(key);
+    std::vector<std::string> out;
+    const toml::node* node = table_.get(key);
+    if (!node) return require(key, required), out;
+    const toml::array* array = node->as_array();
+    if (!array) throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
+    for (const auto& item : *array) {
+      auto value = item.value<std::string>();
+      if (!value) throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
+      out.push_back(*value);
+    }
+    if (required && out.empty()) throw InputError(fmt::format("{}: key '{}' is empty", where_, key));
+    return out;
+  }
+  // A number or an array of numbers.
+  std::vector<double> numbers(const std::string& key, bool required) {
+    seen_.insert(key);
+    std::vector<double> out;
+    const toml::node* node = table_.get(key);
+    if (!node) return require(key, required), out;
+    if (auto value = node->value<double>()) return {*value};
+    const toml::array* array = node->as_array();
+    if (!array) throw InputError(fmt::format("{}: key '{}' must be a number or an array of numbers", where_, key));
+    for (const auto& item : *array) {
+      auto value = item.value<double>();
+      if (!value) throw InputError(fmt::format("{}: key '{}' must be an array of numbers", where_, key));
+      out.push_back(*value);
+    }
+    return out;
+  }
+  void known(const std::string& key) { seen_.insert(key); }
+  void finish() const {
+    for (const auto& [key, node] : table_) {
+      if (!seen_.count(std::string(key.str()))) {
+        throw InputError(fmt::format("{}: unknown key '{}' (allowed: {})", where_, key.str(),
+                                     fmt::join(seen_, ", ")));
+      }
+    }
+  }
+
+ private:
+  void require(const std::string& key, bool required) const {
+    if (required) throw InputError(fmt::format("{}: missing required key '{}'", where_, key));
+  }
+  const toml::table& table_;
+  std::string where_;
+  std::set<std::string> seen_;
+};
+
+void check_positive(double value, const std::string& where, const std::string& key) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw InputError(fmt::format("{}: '{}' must be a finite number > 0 (got {})", where, key, value));
+  }
+}
+
+std::vector<const toml::table*> tables_of(const toml::table& root, const std::string& key,
+                                          const std::string& path) {
+  std::vector<const toml::table*> out;
+  const toml::node* node = root.get(key);
+  if (!node) return out;
+  const toml::array* array = node->as_array();
+  if (!array) throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
+  for (const auto& item : *array) {
+    const toml::table* table = item.as_table();
+    if (!table) throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
+    out.push_back(table);
+  }
+  return out;
+}
+
+// Constructs every spec once so that a typo fails before any run starts.
+void validate_specs(const std::vector<std::string>& problems,
+                    const std::vector<std::string>& methods, const std::string& where,
+                    bool* all_adaptive) {
+  try {
+    for (const auto& spec : problems) make_problem(spec);
+    *all_adaptive = true;
+    for (const auto& spec : methods) {
+      *all_adaptive = *all_adaptive && (make_integrator(spec)->info().flags & kAdaptive);
+    }
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{}: {}", where, error.what()));
+  }
+}
+
+}  // namespace
+
+std::string sanitize_for_path(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-';
+    if (keep) {
+      out += c;
+    } else if (out.empty() || out.back() != '_') {
+      out += '_';
+    }
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  return out;
+}
+
+Scene load_scene(const std::string& path, bool quick) {
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& error) {
+    throw InputError(fmt::format("{}:{}:{}: malformed scene file: {}", path,
+                                 error.source().begin.line, error.source().begin.column,
+                                 error.description()));
+  }
+  Scene scene;
+  BlockReader top(root, path);
+  scene.title = top.string("title", true);
+  scene.description = top.string("description", false);
+  scene.table_columns = top.strings("table_columns", false);
+  const auto run_tables = tables_of(root, "runs", path);
+  const auto order_tables = tables_of(root, "orders", path);
+  top.known("runs");
+  top.known("orders");
+  if (run_tables.empty() && order_tables.empty()) {
+    throw InputError(fmt::format("{}: no [[runs]] or [[orders]] block: nothing to run", path));
+  }
+  std::set<std::string> labels;
+  for (size_t i = 0; i < run_tables.size(); ++i) {
+    BlockReader reader(*run_tables[i], fmt::format("{}: [[runs]] #{}", path, i + 1));
+    RunBlock block;
+    block.label = reader.string("label", true);
+    const std::string where = fmt::format("{}: [[runs]] '{}'", path, block.label);
+    block.problems = reader.strings("problems", true);
+    block.methods = reader.strings("methods", true);
+    block.dts = reader.numbers("dt", false);
+    block.t_end = reader.number("t_end", true);
+    block.series_every = reader.integer("series_every", false, 0);
+    block.series_state = reader.boolean("series_state", false);
+    block.timing_repeats = static_cast<int>(reader.integer("timing_repeats", false, 3));
+    const auto quick_dts = reader.numbers("quick_dt", false);
+    const double quick_t_end = reader.number("quick_t_end", false, 0);
+    const auto quick_problems = reader.strings("quick_problems", false);
+    reader.finish();
+    if (quick) {
+      if (!quick_dts.empty()) block.dts = quick_dts;
+      if (quick_t_end > 0) block.t_end = quick_t_end;
+      if (!quick_problems.empty()) block.problems = quick_problems;
+    }
+    bool all_adaptive = false;
+    validate_specs(block.problems, block.methods, where, &all_adaptive);
+    if (block.dts.empty() && !all_adaptive) {
+      throw InputError(fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
+    }
+    for (double dt : block.dts) check_positive(dt, where, "dt");
+    check_positive(block.t_end, where, "t_end");
+    if (block.series_every < 0) throw InputError(fmt::format("{}: 'series_every' must be >= 0", where));
+    if (block.timing_repeats < 0) throw InputError(fmt::format("{}: 'timing_repeats' must be >= 0", where));
+    if (!labels.insert(block.label).second) throw InputError(fmt::format("{}: label used twice", where));
+    scene.runs.push_back(block);
+  }
+  for (size_t i = 0; i < order_tables.size(); ++i) {
+    BlockReader reader(*order_tables[i], fmt::format("{}: [[orders]] #{}", path, i + 1));
+    OrderBlock block;
+    block.label = reader.string("label", true);
+    const std::string where = fmt::format("{}: [[orders]] '{}'", path, block.label);
+    block.problems = reader.strings("problems", true);
+    block.methods = reader.strings("methods", true);
+    block.dt0 = reader.number("dt0", true);
+    block.levels = static_cast<int>(reader.integer("levels", true));
+    block.t_end = reader.number("t_end", true);
+    const long quick_levels = reader.integer("quick_levels", false, 0);
+    const double quick_t_end = reader.number("quick_t_end", false, 0);
+    reader.finish();
+    if (quick && quick_levels > 0) block.levels = static_cast<int>(quick_levels);
+    if (quick && quick_t_end > 0) block.t_end = quick_t_end;
+    bool all_adaptive = false;
+    validate_specs(block.problems, block.methods, where, &all_adaptive);
+    check_positive(block.dt0, where, "dt0");
+    check_positive(block.t_end, where, "t_end");
+    if (block.levels < 3 || block.levels > 30) {
+      throw InputError(fmt::format("{}: 'levels' must be in 3..30 (got {})", where, block.levels));
+    }
+    if (!labels.insert(block.label).second) throw InputError(fmt::format("{}: label used twice", where));
+    scene.orders.push_back(block);
+  }
+  top.finish();
+  return scene;
+}
+
+namespace {
+
+struct Job {
+  std::string label, problem, method;
+  RunConfig config;
+  bool timed = false;
+  Row row;
+  bool ok = true;
+};
+
+class Progress {
+ public:
+  Progress(size_t total, bool enabled) : total_(total), enabled_(enabled && ::isatty(2)) {}
+  void tick() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    if (!enabled_) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double eta = done_ ? elapsed * (total_ - done_) / done_ : 0;
+    std::fprintf(stderr, "\r[sweep] %zu/%zu runs, %.1f s elapsed, ETA %.1f s   ", done_, total_,
+                 elapsed, eta);
+    if (done_ == total_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  size_t total_, done_ = 0;
+  bool enabled_;
+  std::mutex mutex_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// Runs fn(i) for i in [0, n) on `jobs` threads.
+template <typename Fn>
+void parallel_for(size_t n, int jobs, Fn&& fn) {
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < n; i = next++) fn(i);
+  };
+  std::vector<std::thread> threads;
+  for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
+  worker();
+  for (auto& thread : threads) thread.join();
+}
+
+std::string series_name(const RunBlock& block, const std::string& problem,
+                        const std::string& method, double dt) {
+  std::string name = sanitize_for_path(method);
+  if (block.problems.size() > 1) name = sanitize_for_path(problem) + "__" + name;
+  if (block.dts.size() > 1) name += "__dt" + format_number(dt);
+  return name + ".csv";
+}
+
+}  // namespace
+
+int run_sweep(const Scene& scene, const SweepOptions& options) {
+  namespace fs = std::filesystem;
+  std::vector<Job> jobs;
+  for (const auto& block : scene.runs) {
+    const std::vector<double> dts = block.dts.empty() ? std::vector<double>{0.0} : block.dts;
+    for (const auto& problem : block.problems) {
+      for (const auto& method : block.methods) {
+        for (double dt : dts) {
+          Job job{block.label, problem, method, {}, block.timing_repeats > 0, {}, true};
+          job.config.dt = dt;
+          job.config.t_end = block.t_end;
+          job.config.timing_repeats = 0;
+          job.config.command_line = options.command_line;
+          if (block.series_every > 0) {
+            job.config.series_every = block.series_every;
+            job.config.series_state = block.series_state;
+            job.config.series_path = (fs::path(options.out_dir) / "series" / block.label /
+                                      series_name(block, problem, method, dt)).string();
+          }
+          jobs.push_back(std::move(job));
+        }
+      }
+    }
+  }
+  struct OrderJob {
+    std::string label, problem, method;
+    const OrderBlock* block;
+    OrderStudy study;
+  };
+  std::vector<OrderJob> order_jobs;
+  for (const auto& block : scene.orders) {
+    for (const auto& problem : block.problems) {
+      for (const auto& method : block.methods) {
+        order_jobs.push_back({block.label, problem, method, &block, {}});
+      }
+    }
+  }
+  size_t timed = 0;
+  for (const auto& job : jobs) timed += job.timed;
+  Progress progress(jobs.size() + order_jobs.size() + timed, options.progress);
+
+  // Accuracy runs (parallel); specs were validated when the scene was loaded.
+  parallel_for(jobs.size() + order_jobs.size(), options.jobs, [&](size_t i) {
+    if (i < jobs.size()) {
+      Job& job = jobs[i];
+      RunResult result = run_one(job.problem, job.method, job.config);
+      job.row = std::move(result.row);
+      job.ok = result.ok;
+      job.row["label"] = job.label;
+    } else {
+      OrderJob& job = order_jobs[i - jobs.size()];
+      job.study = order_study(job.problem, job.method, job.block->dt0, job.block->levels,
+                              job.block->t_end);
+    }
+    progress.tick();
+  });
+  // Timing runs, one at a time so they do not compete for cores.
+  for (auto& job : jobs) {
+    if (!job.timed) continue;
+    if (job.ok) {
+      const int repeats = [&] {
+        for (const auto& block : scene.runs) {
+          if (block.label == job.label) return block.timing_repeats;
+        }
+        return 3;
+      }();
+      job.row["wall_s"] = format_number(time_run(job.problem, job.method, job.config, repeats));
+    }
+    progress.tick();
+  }
+
+  const auto lines = provenance(options.command_line);
+  int failed = 0;
+  std::vector<Row> summary_rows, order_rows, order_point_rows;
+  for (const auto& job : jobs) {
+    summary_rows.push_back(job.row);
+    failed += !job.ok;
+  }
+  for (auto& job : order_jobs) {
+    Row row = job.study.row;
+    row["label"] = job.label;
+    order_rows.push_back(row);
+    for (auto point : job.study.runs) {
+      point.row["label"] = job.label;
+      order_point_rows.push_back(point.row);
+    }
+  }
+  const fs::path out(options.out_dir);
+  std::vector<std::string> point_columns = standard_columns();
+  point_columns.insert(point_columns.begin() + 1, "order_level");
+  std::string markdown = fmt::format("# {}\n\n", scene.title);
+  if (!scene.description.empty()) markdown += scene.description + "\n\n";
+  if (!summary_rows.empty()) {
+    write_file_atomic((out / "summary.csv").string(),
+                      to_csv(summary_rows, column_union(summary_rows, standard_columns()), lines));
+    auto columns = scene.table_columns.empty()
+                       ? column_union(summary_rows, standard_columns())
+                       : scene.table_columns;
+    markdown += "## Runs (summary.csv)\n\n" + to_markdown(summary_rows, columns) + "\n";
+  }
+  if (!order_rows.empty()) {
+    const std::vector<std::string> order_columns = {"label",          "problem",
+                                                    "method",         "order",
+                                                    "declared_order", "points_used",
+                                                    "status",         "message"};
+    write_file_atomic((out / "order.csv").string(),
+                      to_csv(order_rows, column_union(order_rows, order_columns), lines));
+    write_file_atomic(
+        (out / "order_points.csv").string(),
+        to_csv(order_point_rows, column_union(order_point_rows, point_columns), lines));
+    markdown += "## Fitted convergence orders (order.csv)\n\n" +
+                to_markdown(order_rows, {"problem", "method", "order", "declared_order",
+                                         "points_used", "message"}) +
+                "\n";
+  }
+  markdown += fmt::format("Produced by `{}`.\n", options.command_line);
+  write_file_atomic((out / "table.md").string(), markdown);
+  return failed;
+}
+
+}  // namespace geomint

@@ -1,0 +1,54 @@
+// Scenes (DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs (problems ×
+// methods × dt) and of order studies; `sweep` runs them (accuracy runs in parallel, timing runs
+// one at a time) and writes summary.csv, order.csv, series/ and table.md into the folder.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace geomint {
+
+struct RunBlock {
+  std::string label;
+  std::vector<std::string> problems, methods;
+  std::vector<double> dts;      // empty only when every method is adaptive
+  double t_end = 0;
+  long series_every = 0;        // 0 = no series
+  bool series_state = false;
+  int timing_repeats = 3;       // 0 = no timing pass
+};
+
+struct OrderBlock {
+  std::string label;
+  std::vector<std::string> problems, methods;
+  double dt0 = 0;
+  int levels = 0;
+  double t_end = 0;
+};
+
+struct Scene {
+  std::string title;
+  std::string description;
+  std::vector<std::string> table_columns;  // summary columns for table.md; empty = automatic
+  std::vector<RunBlock> runs;
+  std::vector<OrderBlock> orders;
+};
+
+// Parses and validates a scene file: unknown or missing keys, wrong types, bad specs and bad
+// numbers throw InputError naming the file, block and key. `quick` applies the quick_* keys.
+Scene load_scene(const std::string& path, bool quick);
+
+struct SweepOptions {
+  int jobs = 1;
+  std::string out_dir;          // where outputs go
+  std::string command_line;
+  bool progress = true;         // progress on stderr when it is a terminal
+};
+
+// Runs the scene; returns the number of failed runs (failure rows are results, not errors).
+int run_sweep(const Scene& scene, const SweepOptions& options);
+
+// File-name-safe form of a spec ("hp:alpha=0.5" → "hp_alpha_0.5").
+std::string sanitize_for_path(const std::string& text);
+
+}  // namespace geomint

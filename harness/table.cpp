@@ -1,0 +1,154 @@
+// CSV/Markdown writers and run provenance (see table.hpp).
+#include "harness/table.hpp"
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+#include <gsl/gsl_version.h>
+#include <sundials/sundials_config.h>
+
+#include <Eigen/Core>
+#include <boost/version.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace geomint {
+
+const char* version();
+
+namespace {
+
+std::string cpu_model() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown";
+}
+
+std::string csv_escape(const std::string& value) {
+  if (value.find_first_of(",\"\n") == std::string::npos) return value;
+  std::string out = "\"";
+  for (char c : value) {
+    if (c == '"') out += '"';
+    out += c == '\n' ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+std::string shorten_number(const std::string& text, int digits) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) return text;
+  if (value == std::floor(value) && std::abs(value) < 1e9) return text;
+  return fmt::format("{:.{}g}", value, digits);
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> provenance(const std::string& command_line) {
+  const auto now = std::chrono::system_clock::now();
+  return {
+      {"geomint", fmt::format("{} ({})", version(), GEOMINT_GIT_SHA)},
+      {"compiler", GEOMINT_COMPILER},
+      {"flags", GEOMINT_CXX_FLAGS},
+      {"libraries",
+       fmt::format("Eigen {}.{}.{}, GSL {}, SUNDIALS {}, Boost {}.{}, fmt {}", EIGEN_WORLD_VERSION,
+                   EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, GSL_VERSION, SUNDIALS_VERSION,
+                   BOOST_VERSION / 100000, BOOST_VERSION / 100 % 1000, FMT_VERSION)},
+      {"cpu", cpu_model()},
+      {"date", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(now)))},
+      {"command", command_line},
+  };
+}
+
+const std::vector<std::string>& standard_columns() {
+  static const std::vector<std::string> columns = {
+      "label", "problem", "method", "dt", "tol", "t_end", "status", "message", "t_reached",
+      "steps", "energy_err_max", "energy_err_final", "energy_drift", "momentum_err_max",
+      "angular_momentum_err_max", "constraint_err_max", "constraint_vel_err_max", "error_final",
+      "error_max", "phase_err", "order", "declared_order", "points_used", "force_evals",
+      "energy_evals", "hessian_evals", "newton_iters", "linear_solves", "rejected", "wall_s"};
+  return columns;
+}
+
+std::vector<std::string> column_union(const std::vector<Row>& rows,
+                                      const std::vector<std::string>& preferred) {
+  std::set<std::string> present;
+  for (const auto& row : rows) {
+    for (const auto& [key, value] : row) present.insert(key);
+  }
+  std::vector<std::string> columns;
+  for (const auto& name : preferred) {
+    if (present.erase(name)) columns.push_back(name);
+  }
+  columns.insert(columns.end(), present.begin(), present.end());
+  return columns;
+}
+
+std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
+                   const std::vector<std::pair<std::string, std::string>>& provenance_lines) {
+  std::string out;
+  for (const auto& [key, value] : provenance_lines) out += fmt::format("# {}: {}\n", key, value);
+  out += fmt::format("{}\n", fmt::join(columns, ","));
+  for (const auto& row : rows) {
+    std::string line;
+    for (size_t i = 0; i < columns.size(); ++i) {
+      if (i) line += ',';
+      auto it = row.find(columns[i]);
+      if (it != row.end()) line += csv_escape(it->second);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::string>& columns,
+                        int digits) {
+  std::string out = "| " + fmt::format("{}", fmt::join(columns, " | ")) + " |\n|";
+  for (size_t i = 0; i < columns.size(); ++i) out += "---|";
+  out += "\n";
+  for (const auto& row : rows) {
+    out += "|";
+    for (const auto& column : columns) {
+      auto it = row.find(column);
+      std::string cell = it == row.end() ? "" : shorten_number(it->second, digits);
+      for (auto& c : cell) {
+        if (c == '|') c = '/';
+      }
+      out += " " + cell + " |";
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  const std::filesystem::path target(path);
+  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
+  const std::string temporary = fmt::format("{}.{}.tmp", path, ::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(temporary.c_str());
+      throw std::runtime_error(fmt::format("cannot write '{}'", path));
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    throw std::runtime_error(fmt::format("cannot rename '{}' to '{}'", temporary, path));
+  }
+}
+
+}  // namespace geomint

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Writes results/README.md: every scene with its title, table and figures.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+{
+  echo "# Results"
+  echo
+  echo "Every folder is one scene: \`scene.toml\` (what ran), \`summary.csv\`/\`order.csv\` (the"
+  echo "numbers, with provenance), \`table.md\` and the figures. Regenerate all with"
+  echo "\`make reproduce-figures\`."
+  for toml in "$root"/results/*/scene.toml; do
+    folder=$(dirname "$toml")
+    scene=$(basename "$folder")
+    title=$(sed -n 's/^title *= *"\(.*\)"/\1/p' "$toml" | head -n 1)
+    echo
+    echo "## [$scene]($scene/) — $title"
+    echo
+    echo "Table: [$scene/table.md]($scene/table.md)"
+    for png in "$folder"/*.png; do
+      [ -f "$png" ] || continue
+      echo
+      echo "![$(basename "$png" .png)]($scene/$(basename "$png"))"
+    done
+  done
+} > "$root/results/README.md.tmp"
+mv "$root/results/README.md.tmp" "$root/results/README.md"

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Regenerates results/<scene>/ for each scene named: runs the sweep, then the scene's gnuplot
+# script (scripts/<scene>.gp, run inside the scene folder), then the results/README.md index.
+# QUICK=1 runs the CI-sized variant into results/<scene>/quick/ instead.
+set -euo pipefail
+geomint=$(realpath "$1")
+shift
+root=$(cd "$(dirname "$0")/.." && pwd)
+jobs=$(nproc 2>/dev/null || echo 2)
+start=$(date +%s)
+for scene in "$@"; do
+  folder="$root/results/$scene"
+  echo "== $scene" >&2
+  scene_start=$(date +%s)
+  if [ "${QUICK:-0}" = 1 ]; then
+    (cd "$root" && "$geomint" sweep "results/$scene/scene.toml" --jobs "$jobs" --quick)
+    out="$folder/quick"
+  else
+    (cd "$root" && "$geomint" sweep "results/$scene/scene.toml" --jobs "$jobs")
+    out="$folder"
+  fi
+  if [ -f "$root/scripts/$scene.gp" ]; then
+    (cd "$out" && gnuplot -e "scripts='$root/scripts'" "$root/scripts/$scene.gp")
+  fi
+  echo "== $scene: $(( $(date +%s) - scene_start )) s" >&2
+done
+[ "${QUICK:-0}" = 1 ] || bash "$root/scripts/index-results.sh"
+echo "reproduce: done in $(( $(date +%s) - start )) s" >&2

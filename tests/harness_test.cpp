@@ -1,0 +1,155 @@
+// Harness unit tests: spec parsing, order fit with plateau rejection, drift slope, writers,
+// scene validation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "harness/observers.hpp"
+#include "harness/order.hpp"
+#include "harness/scene.hpp"
+#include "harness/table.hpp"
+
+namespace geomint {
+namespace {
+
+TEST(Spec, ParsesNameAndValues) {
+  const Spec spec = Spec::parse("hp:alpha=0.5, solver=minimize");
+  EXPECT_EQ(spec.name, "hp");
+  EXPECT_EQ(spec.values.at("alpha"), "0.5");
+  EXPECT_EQ(spec.values.at("solver"), "minimize");
+  EXPECT_TRUE(Spec::parse("rk4").values.empty());
+}
+
+TEST(Spec, RejectsMalformedText) {
+  for (const char* text : {"", ":", "a:", "a:=1", "a:b", "a:b=", "a:b=1,b=2", "a b"}) {
+    EXPECT_THROW(Spec::parse(text), InputError) << text;
+  }
+}
+
+TEST(Params, CanonicalFormSortsKeysAndFillsDefaults) {
+  Params params(Spec::parse("m:zeta=2"), "test");
+  params.real("zeta", 1.0, "");
+  params.real("alpha", 0.25, "");
+  params.finish();
+  EXPECT_EQ(params.canonical(), "m:alpha=0.25,zeta=2");
+}
+
+TEST(Params, UnknownKeyListsValidOnes) {
+  Params params(Spec::parse("m:bogus=1"), "method 'm'");
+  params.real("alpha", 0.5, "");
+  try {
+    params.finish();
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("bogus"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("alpha"), std::string::npos);
+  }
+}
+
+// error = C dt^p exactly: the fit recovers p to round-off.
+TEST(OrderFit, RecoversExactPowerLaw) {
+  std::vector<double> dts, errors;
+  for (int k = 0; k < 6; ++k) {
+    dts.push_back(0.1 / (1 << k));
+    errors.push_back(3.0 * std::pow(dts.back(), 2));
+  }
+  const OrderFit fit = fit_order(dts, errors);
+  EXPECT_NEAR(fit.order, 2.0, 1e-12);
+  EXPECT_EQ(fit.used.size(), 6u);
+}
+
+TEST(OrderFit, DropsRoundOffPlateauAndPreAsymptoticPoints) {
+  // Order 4 in the middle, a pre-asymptotic first point, and a plateau at 1e-12.
+  const std::vector<double> dts = {0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625};
+  std::vector<double> errors;
+  for (double dt : dts) errors.push_back(std::max(dt * dt * dt * dt, 2e-12));
+  errors[0] = 5.0;  // pre-asymptotic: far above the power law
+  const OrderFit fit = fit_order(dts, errors);
+  ASSERT_TRUE(std::isfinite(fit.order)) << fit.note;
+  EXPECT_NEAR(fit.order, 4.0, 0.05) << fit.note;
+  EXPECT_EQ(fit.used.front(), 1);
+  EXPECT_LT(fit.used.back(), 7);
+  EXPECT_NE(fit.note.find("plateau"), std::string::npos);
+}
+
+TEST(OrderFit, NeedsThreePoints) {
+  const OrderFit fit = fit_order({0.1, 0.05, 0.025}, {1e-3, NAN, 1e-20});
+  EXPECT_TRUE(std::isnan(fit.order));
+  EXPECT_NE(fit.note.find("need 3"), std::string::npos);
+}
+
+TEST(Drift, SlopeOfWindowMaxima) {
+  EXPECT_NEAR(window_maxima_slope({1, 2, 3, 4}, {2, 4, 6, 8}), 2.0, 1e-14);
+  EXPECT_NEAR(window_maxima_slope({1, 2, 3, 4}, {5, 5, 5, 5}), 0.0, 1e-14);
+}
+
+TEST(Table, CsvHasProvenanceHeaderAndQuotes) {
+  const std::vector<Row> rows = {{{"method", "hp:alpha=0.5,solver=newton"}, {"dt", "0.1"}},
+                                 {{"dt", "0.2"}, {"wall_s", "1"}}};
+  const auto columns = column_union(rows, standard_columns());
+  EXPECT_EQ(columns, (std::vector<std::string>{"method", "dt", "wall_s"}));
+  const std::string csv = to_csv(rows, columns, {{"geomint", "test"}});
+  EXPECT_EQ(csv,
+            "# geomint: test\nmethod,dt,wall_s\n\"hp:alpha=0.5,solver=newton\",0.1,\n,0.2,1\n");
+}
+
+TEST(Table, AtomicWriteLeavesNoTemporaryFile) {
+  const auto dir = std::filesystem::temp_directory_path() / "geomint_atomic_test";
+  std::filesystem::remove_all(dir);
+  write_file_atomic((dir / "a.csv").string(), "x\n");
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    ++files;
+    EXPECT_EQ(entry.path().filename(), "a.csv");
+  }
+  EXPECT_EQ(files, 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Scene, SanitizesSpecsForFileNames) {
+  EXPECT_EQ(sanitize_for_path("hp:alpha=0.5,solver=minimize"), "hp_alpha_0.5_solver_minimize");
+}
+
+std::string write_scene(const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / "geomint_scene_test.toml";
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+void expect_scene_error(const std::string& text, const std::string& needle) {
+  try {
+    load_scene(write_scene(text), false);
+    FAIL() << "no error for: " << text;
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
+  }
+}
+
+TEST(Scene, RejectsBadFiles) {
+  const std::string good_block =
+      "[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\ndt=0.1\nt_end=1.0\n";
+  expect_scene_error("title = \n", "malformed");
+  expect_scene_error(good_block, "title");
+  expect_scene_error("title='x'\n", "nothing to run");
+  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nmethods=['rk4']\ndt=0.1\nt_end=1.0\n",
+                     "problems");
+  expect_scene_error("title='x'\n" + good_block + "colour='red'\n", "colour");
+  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['nope']\n"
+                     "dt=0.1\nt_end=1.0\n",
+                     "nope");
+  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+                     "dt=-0.1\nt_end=1.0\n",
+                     "dt");
+  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+                     "dt='big'\nt_end=1.0\n",
+                     "dt");
+  expect_scene_error("title='x'\n[[orders]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+                     "dt0=0.1\nlevels=2\nt_end=1.0\n",
+                     "levels");
+  EXPECT_NO_THROW(load_scene(write_scene("title='x'\n" + good_block), false));
+}
+
+}  // namespace
+}  // namespace geomint

@@ -1,0 +1,149 @@
+// Registry-driven method checks (DESIGN.md §7): every registered method's declared order and
+// every declared flag is verified, not only declared, so a new method is checked the day it is
+// added. Negative controls make sure the checks can fail.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "harness/order.hpp"
+#include "harness/run.hpp"
+
+namespace geomint {
+namespace {
+
+std::vector<std::string> fixed_step_methods() {
+  std::vector<std::string> out;
+  for (const auto& spec : integrator_test_specs()) {
+    if (!(make_integrator(spec)->info().flags & kAdaptive)) out.push_back(spec);
+  }
+  return out;
+}
+
+std::string test_name(const testing::TestParamInfo<std::string>& info) {
+  std::string name;
+  for (char c : info.param) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return name;
+}
+
+class EveryMethod : public testing::TestWithParam<std::string> {
+ protected:
+  MethodInfo info() const { return make_integrator(GetParam())->info(); }
+};
+
+// Ladders chosen so every method has >= 4 points in its asymptotic range and none reaches the
+// round-off plateau before the fit; the fit drops pre-asymptotic points itself.
+struct Ladder {
+  const char* problem;
+  double dt0;
+  int levels;
+  double t_end;
+};
+constexpr Ladder kPendulumLadder{"pendulum:theta0=1.5", 0.1, 7, 5.0};
+constexpr Ladder kKeplerLadder{"kepler:e=0.6", 0.02, 7, 5.0};
+
+void expect_declared_order(const std::string& method, const Ladder& ladder) {
+  const int declared = make_integrator(method)->info().order;
+  // High orders reach the plateau sooner: start them at a larger dt.
+  const double dt0 = declared >= 4 ? ladder.dt0 * 4 : ladder.dt0;
+  const OrderStudy study = order_study(ladder.problem, method, dt0, ladder.levels, ladder.t_end);
+  ASSERT_TRUE(std::isfinite(study.fit.order)) << method << " on " << ladder.problem << ": "
+                                              << study.fit.note;
+  // ±0.3: the tolerance of DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
+  EXPECT_NEAR(study.fit.order, declared, 0.3)
+      << method << " on " << ladder.problem << " (points " << study.row.at("points_used") << ")";
+}
+
+TEST_P(EveryMethod, DeclaredOrderOnPendulum) { expect_declared_order(GetParam(), kPendulumLadder); }
+TEST_P(EveryMethod, DeclaredOrderOnKepler) { expect_declared_order(GetParam(), kKeplerLadder); }
+
+// Bounded energy error with no drift: over 1e5 steps the least-squares trend of the per-window
+// maxima, times the horizon, must stay below 10% of the maximum error itself. A drifting method
+// (explicit Euler, RK4) has trend × T ≈ err_max.
+bool energy_bounded_without_drift(const std::string& method, double* ratio) {
+  RunConfig config;
+  config.dt = 0.05;
+  config.t_end = 5000.0;  // 1e5 steps
+  config.timing_repeats = 0;
+  const RunResult result = run_one("pendulum:theta0=1.5", method, config);
+  if (!result.ok) {
+    *ratio = INFINITY;
+    return false;
+  }
+  const double drift = result.metrics.at("energy_drift");
+  const double err_max = result.metrics.at("energy_err_max");
+  *ratio = std::abs(drift) * config.t_end / err_max;
+  return *ratio < 0.1 && err_max < 0.1;
+}
+
+TEST_P(EveryMethod, SymplecticMeansBoundedEnergy) {
+  if (!(info().flags & kSymplectic)) GTEST_SKIP() << "not declared symplectic";
+  double ratio = 0;
+  EXPECT_TRUE(energy_bounded_without_drift(GetParam(), &ratio))
+      << GetParam() << ": drift*T/err_max = " << ratio;
+}
+
+TEST(NegativeControl, DriftCheckFailsForRk4AndExplicitEuler) {
+  double ratio = 0;
+  EXPECT_FALSE(energy_bounded_without_drift("rk4", &ratio)) << "rk4 ratio " << ratio;
+  EXPECT_FALSE(energy_bounded_without_drift("explicit_euler", &ratio))
+      << "explicit_euler ratio " << ratio;
+}
+
+// Symmetric: Φ_{−h} ∘ Φ_h = id, checked over 20 steps forward and back.
+double reversibility_defect(const std::string& method, const std::string& problem_spec, double h) {
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method);
+  const State start = problem->initial_state();
+  State state = start;
+  integrator->reset(*problem, state, h);
+  for (int k = 0; k < 20; ++k) {
+    if (!integrator->step(*problem, state, h).ok) return INFINITY;
+  }
+  integrator->reset(*problem, state, -h);
+  for (int k = 0; k < 20; ++k) {
+    if (!integrator->step(*problem, state, -h).ok) return INFINITY;
+  }
+  const double scale = std::sqrt(start.q.squaredNorm() + start.p.squaredNorm());
+  return std::sqrt((state.q - start.q).squaredNorm() + (state.p - start.p).squaredNorm()) / scale;
+}
+
+TEST_P(EveryMethod, SymmetricMeansReversible) {
+  if (!(info().flags & kSymmetric)) GTEST_SKIP() << "not declared symmetric";
+  // 40 steps of round-off at ~1e-16 each, with implicit solves at 1e-12 relative tolerance.
+  EXPECT_LT(reversibility_defect(GetParam(), "pendulum:theta0=1.5", 0.1), 1e-11);
+  EXPECT_LT(reversibility_defect(GetParam(), "kepler:e=0.6", 0.01), 1e-11);
+}
+
+TEST(NegativeControl, ReversibilityCheckFailsForNonSymmetricMethods) {
+  EXPECT_GT(reversibility_defect("symplectic_euler_a", "pendulum:theta0=1.5", 0.1), 1e-6);
+  EXPECT_GT(reversibility_defect("rk4", "pendulum:theta0=1.5", 0.1), 1e-9);
+}
+
+// Central force: a variational/symplectic method with a rotation-invariant discrete Lagrangian
+// keeps q × p exactly, so only round-off remains: ≤ 1e-13 relative over 1e5 steps.
+TEST_P(EveryMethod, SymplecticKeepsKeplerAngularMomentum) {
+  if (!(info().flags & kSymplectic)) GTEST_SKIP() << "not declared symplectic";
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 1000.0;  // 1e5 steps
+  config.timing_repeats = 0;
+  const RunResult result = run_one("kepler:e=0.6", GetParam(), config);
+  ASSERT_TRUE(result.ok) << result.row.at("message");
+  const double angular0 = std::sqrt(1 - 0.6 * 0.6);
+  EXPECT_LT(result.metrics.at("angular_momentum_err_max") / angular0, 1e-13);
+}
+
+TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 1000.0;
+  config.timing_repeats = 0;
+  const RunResult result = run_one("kepler:e=0.6", "rk4", config);
+  EXPECT_GT(result.metrics.at("angular_momentum_err_max"), 1e-10);
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, EveryMethod, testing::ValuesIn(fixed_step_methods()),
+                         test_name);
+
+}  // namespace
+}  // namespace geomint
