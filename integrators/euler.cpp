@@ -1,0 +1,185 @@
+// Explicit (forward) and implicit (backward) Euler on M q̈ = −∇V(q) + F(q, q̇, t): the
+// first-order, non-symplectic references of PAPER.md §7 (Hairer, Nørsett & Wanner, "Solving ODEs
+// I", §I.7; Hairer & Wanner, "Solving ODEs II", §IV.3).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+#include "integrators/newton.hpp"
+
+namespace geomint {
+namespace {
+
+class ExplicitEuler final : public Integrator {
+ public:
+  MethodInfo info() const override {
+    return {"explicit_euler", 1, kExplicit,
+            "forward Euler, Hairer-Norsett-Wanner Solving ODEs I §I.7; PAPER.md §7"};
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    const Vec velocity = problem.inverse_mass().cwiseProduct(state.p);
+    eval_total_force(problem, state.q, velocity, state.t, force_);
+    state.q += h * velocity;
+    state.p += h * force_;
+    state.t += h;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  Vec force_;
+};
+
+// Backward Euler for the unknown end velocity v⁺:
+//   R(v⁺) = M v⁺ − p − h F_total(q + h v⁺, v⁺, t + h) = 0,  q⁺ = q + h v⁺,  p⁺ = M v⁺,
+// solved by Newton with ∂R/∂v⁺ = M + h²∇²V(q⁺) − h d/dv⁺[F(q + h v⁺, v⁺, t + h)].
+// The non-conservative part of that Jacobian:
+//  - kForceJacobian: + h C(q⁺, v⁺) with C = −∂F/∂v; the h²∂F/∂q term is left out because
+//    problems do not provide it. Only the Newton matrix is approximate (convergence may become
+//    linear for position-dependent forces); the residual, hence the solution, is exact.
+//  - kForce without kForceJacobian: the whole v⁺-derivative of F(q + h v⁺, v⁺, t + h) by central
+//    differences, one column per unknown (2·dof force evaluations per Jacobian, dense): meant
+//    for the small forced test problems; large forced problems should provide force_jacobian_v.
+class ImplicitEuler final : public Integrator {
+ public:
+  ImplicitEuler(double tolerance, int max_iterations) {
+    newton_.options().tolerance = tolerance;
+    newton_.options().max_iterations = max_iterations;
+  }
+
+  MethodInfo info() const override {
+    return {"implicit_euler", 1, kImplicit | kNeedsHessian,
+            "backward Euler, Hairer-Wanner Solving ODEs II §IV.3; PAPER.md §7"};
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    newton_.forget_pattern();
+    end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
+    damping_symmetric_.reset();
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    const Vec& mass = problem.mass();
+    const double t_next = state.t + h;
+    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
+      mass_diagonal_ = mass;
+      mass_matrix_ = SparseMatrix(mass.asDiagonal());
+    }
+
+    // Scale of the balanced terms for the relative residual test: ‖p‖ + h‖F‖ at the start of
+    // the step. ‖F‖ at the end of the previous step is reused when the state was not changed
+    // in between, which saves one force evaluation per step.
+    if (!(std::isfinite(end_force_norm_) && end_q_.size() == state.q.size() && end_q_ == state.q)) {
+      eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
+                       force_);
+      end_force_norm_ = force_.norm();
+    }
+    const double residual_scale = state.p.norm() + std::abs(h) * end_force_norm_;
+
+    double latest_force_norm = 0.0;
+    NewtonSystem system;
+    system.residual = [&](const Vec& v, Vec& residual) {
+      q_next_ = state.q + h * v;
+      eval_total_force(problem, q_next_, v, t_next, force_);
+      latest_force_norm = force_.norm();
+      residual = mass.cwiseProduct(v) - state.p - h * force_;
+    };
+    system.jacobian = [&](const Vec& v, SparseMatrix& jacobian) {
+      q_next_ = state.q + h * v;
+      eval_hessian(problem, q_next_, hessian_);
+      jacobian = (h * h) * hessian_ + mass_matrix_;
+      if (problem.has(kForce)) add_force_jacobian(problem, state.q, v, t_next, h, jacobian);
+    };
+    if (problem.has(kForceJacobian) && !damping_symmetric_.has_value()) {
+      // Decided once per run: C is symmetric for dissipative forces, not for gyroscopic ones.
+      problem.force_jacobian_v(state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
+                               damping_);
+      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
+    }
+    system.symmetric = !problem.has(kForce) || (problem.has(kForceJacobian) && *damping_symmetric_);
+
+    Vec velocity = problem.inverse_mass().cwiseProduct(state.p);
+    const NewtonResult result = newton_.solve(system, velocity, residual_scale);
+    counters_.newton_iters += result.iterations;
+    counters_.linear_solves += result.linear_solves;
+    if (!result.converged) {
+      end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
+      return StepStatus::failure(result.reason, describe(result));
+    }
+
+    // The last residual evaluation was at the accepted velocity, so its force is F at the new
+    // state: reuse it for the next step's residual scale.
+    state.q = state.q + h * velocity;
+    state.p = mass.cwiseProduct(velocity);
+    state.t = t_next;
+    end_q_ = state.q;
+    end_force_norm_ = latest_force_norm;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  void add_force_jacobian(const Problem& problem, const Vec& q_start, const Vec& v, double t_next,
+                          double h, SparseMatrix& jacobian) {
+    if (problem.has(kForceJacobian)) {
+      problem.force_jacobian_v(q_next_, v, t_next, damping_);
+      jacobian += h * damping_;
+      return;
+    }
+    const int n = problem.dof();
+    // Central differences with the step that balances truncation (δ²) and round-off (ε/δ).
+    const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
+    std::vector<Eigen::Triplet<double>> triplets;
+    Vec v_shift = v, force_plus, force_minus;
+    for (int j = 0; j < n; ++j) {
+      const double delta = relative_step * std::max(1.0, std::abs(v[j]));
+      v_shift[j] = v[j] + delta;
+      q_shift_ = q_start + h * v_shift;
+      eval_force(problem, q_shift_, v_shift, t_next, force_plus);
+      v_shift[j] = v[j] - delta;
+      q_shift_ = q_start + h * v_shift;
+      eval_force(problem, q_shift_, v_shift, t_next, force_minus);
+      v_shift[j] = v[j];
+      for (int i = 0; i < n; ++i) {
+        const double derivative = (force_plus[i] - force_minus[i]) / (2 * delta);
+        if (derivative != 0.0) triplets.emplace_back(i, j, -h * derivative);
+      }
+    }
+    // eval_force does not count; these are real force evaluations, so count them here.
+    counters_.force_evals += 2L * n;
+    SparseMatrix force_part(n, n);
+    force_part.setFromTriplets(triplets.begin(), triplets.end());
+    jacobian += force_part;
+  }
+
+  NewtonSolver newton_;
+  Vec mass_diagonal_;
+  SparseMatrix mass_matrix_, hessian_, damping_;
+  std::optional<bool> damping_symmetric_;  // C = Cᵀ, decided on the first step of a run
+  Vec force_, q_next_, q_shift_;
+  Vec end_q_;
+  double end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_explicit_euler(Params&) {
+  return std::make_unique<ExplicitEuler>();
+}
+
+std::unique_ptr<Integrator> make_implicit_euler(Params& params) {
+  const double tolerance = params.real(
+      "tol", 1e-12, "Newton relative residual tolerance (scale ‖p‖ + h‖F‖)",
+      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
+  const long max_iterations =
+      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  return std::make_unique<ImplicitEuler>(tolerance, static_cast<int>(max_iterations));
+}
+
+}  // namespace geomint

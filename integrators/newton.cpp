@@ -1,0 +1,195 @@
+// Damped sparse Newton solver (see newton.hpp); line search after Nocedal & Wright, "Numerical
+// Optimization", 2nd ed., Algorithm 3.1 (backtracking Armijo) and §11.1 (merit ½‖R‖²).
+#include "integrators/newton.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace geomint {
+
+struct NewtonSolver::Factorisation {
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  Eigen::SparseLU<SparseMatrix> lu;
+  SparseMatrix jacobian;
+  // Pattern of the matrix last passed to analyzePattern, and which factorisation it was for.
+  bool has_pattern = false;
+  bool pattern_symmetric = false;
+  Eigen::Index rows = 0;
+  std::vector<SparseMatrix::StorageIndex> outer;
+  std::vector<SparseMatrix::StorageIndex> inner;
+
+  bool same_pattern(const SparseMatrix& J, bool symmetric) const {
+    if (!has_pattern || symmetric != pattern_symmetric || J.rows() != rows) return false;
+    const auto* J_outer = J.outerIndexPtr();
+    const auto* J_inner = J.innerIndexPtr();
+    return std::equal(outer.begin(), outer.end(), J_outer, J_outer + J.outerSize() + 1) &&
+           std::equal(inner.begin(), inner.end(), J_inner, J_inner + J.nonZeros());
+  }
+
+  void remember_pattern(const SparseMatrix& J, bool symmetric) {
+    has_pattern = true;
+    pattern_symmetric = symmetric;
+    rows = J.rows();
+    outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
+    inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
+  }
+
+  // Factorises `jacobian`; false when the factorisation hit a zero pivot.
+  bool factorise(bool symmetric, bool reuse_symbolic, int& analyses) {
+    jacobian.makeCompressed();
+    const bool analyse = !reuse_symbolic || !same_pattern(jacobian, symmetric);
+    if (symmetric) {
+      if (analyse) ldlt.analyzePattern(jacobian);
+      ldlt.factorize(jacobian);
+      if (analyse) {
+        ++analyses;
+        remember_pattern(jacobian, symmetric);
+      }
+      return ldlt.info() == Eigen::Success;
+    }
+    if (analyse) lu.analyzePattern(jacobian);
+    lu.factorize(jacobian);
+    if (analyse) {
+      ++analyses;
+      remember_pattern(jacobian, symmetric);
+    }
+    return lu.info() == Eigen::Success;
+  }
+
+  void solve(bool symmetric, const Vec& rhs, Vec& out) {
+    out = symmetric ? Vec(ldlt.solve(rhs)) : Vec(lu.solve(rhs));
+  }
+};
+
+NewtonSolver::NewtonSolver(NewtonOptions options)
+    : options_(options), factorisation_(std::make_unique<Factorisation>()) {}
+NewtonSolver::~NewtonSolver() = default;
+NewtonSolver::NewtonSolver(NewtonSolver&&) noexcept = default;
+NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
+
+void NewtonSolver::forget_pattern() { factorisation_->has_pattern = false; }
+
+namespace {
+
+bool all_finite(const Vec& v) { return v.allFinite(); }
+
+bool all_finite(const SparseMatrix& J) {
+  const double* values = J.valuePtr();
+  return std::all_of(values, values + J.nonZeros(), [](double a) { return std::isfinite(a); });
+}
+
+}  // namespace
+
+std::string describe(const NewtonResult& result) {
+  if (result.converged) {
+    return fmt::format("Newton converged in {} iterations: residual {:.3g} <= {:.3g}",
+                       result.iterations, result.residual_norm, result.threshold);
+  }
+  return fmt::format("Newton stopped after {} iterations: residual {:.3g} > {:.3g} ({})",
+                     result.iterations, result.residual_norm, result.threshold, result.reason);
+}
+
+NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
+  NewtonResult result;
+  result.threshold = options_.tolerance * std::max(1.0, residual_scale);
+  Factorisation& f = *factorisation_;
+
+  Vec residual;
+  auto evaluate = [&](const Vec& at, Vec& r) {
+    ++result.residual_evals;
+    system.residual(at, r);
+    if (r.size() != at.size()) {
+      throw std::logic_error(
+          fmt::format("Newton residual has size {} for {} unknowns", r.size(), at.size()));
+    }
+  };
+  // Merit of a finite residual: the objective when the system has one, else ½‖R‖².
+  auto merit_of = [&](const Vec& at, const Vec& r) {
+    return system.objective ? system.objective(at) : 0.5 * r.squaredNorm();
+  };
+  auto fail = [&](const char* reason) {
+    result.reason = reason;
+    return result;
+  };
+
+  evaluate(x, residual);
+  result.residual_norm = residual.norm();
+  if (options_.record_history) result.residual_history.push_back(result.residual_norm);
+  if (!all_finite(residual)) return fail("nan");
+  double merit = merit_of(x, residual);
+  if (!std::isfinite(merit)) return fail("nan");
+
+  Vec direction, trial, trial_residual;
+  while (true) {
+    if (result.residual_norm <= result.threshold) {
+      result.converged = true;
+      return result;
+    }
+    if (result.iterations >= options_.max_iterations) return fail("newton_max_iter");
+
+    system.jacobian(x, f.jacobian);
+    if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
+      throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
+                                         f.jacobian.rows(), f.jacobian.cols(), x.size()));
+    }
+    if (!all_finite(f.jacobian)) return fail("nan");
+    ++result.linear_solves;
+    if (!f.factorise(system.symmetric, options_.reuse_symbolic, result.symbolic_analyses)) {
+      return fail("linear_solve_failed");
+    }
+    f.solve(system.symmetric, -residual, direction);
+    // A nearly singular matrix factorises without a zero pivot but yields inf/NaN here.
+    if (!all_finite(direction)) return fail("linear_solve_failed");
+    ++result.iterations;
+
+    // Directional derivative of the merit along the step. For ½‖R‖² it is Rᵀ J d = −‖R‖² for
+    // the exact Newton step, whatever J is, so the step is always a descent direction.
+    const double slope = system.objective ? residual.dot(direction) : -residual.squaredNorm();
+    if (system.objective && options_.line_search && !(slope < 0.0)) return fail("not_descent");
+
+    double step = 1.0;
+    bool accepted = false;
+    bool any_finite = false;
+    double trial_merit = 0.0;
+    for (int backtrack = 0; backtrack <= options_.max_backtracks; ++backtrack, step *= 0.5) {
+      trial = x + step * direction;
+      evaluate(trial, trial_residual);
+      if (!all_finite(trial_residual)) {
+        if (!options_.line_search) break;
+        continue;  // the step left the domain of R (e.g. an inverted element): shorten it
+      }
+      trial_merit = merit_of(trial, trial_residual);
+      if (!std::isfinite(trial_merit)) {
+        if (!options_.line_search) break;
+        continue;
+      }
+      any_finite = true;
+      if (!options_.line_search || trial_merit <= merit + options_.armijo * step * slope) {
+        accepted = true;
+        break;
+      }
+      // Close to the root an objective's decrease (~‖R‖²) drops below its round-off
+      // (~ε|E|) long before ‖R‖ reaches the tolerance; the residual still measures progress.
+      if (system.objective && trial_residual.norm() < result.residual_norm &&
+          trial_merit <= merit + 16 * std::numeric_limits<double>::epsilon() * std::abs(merit)) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) return fail(any_finite ? "line_search_failed" : "nan");
+
+    x.swap(trial);
+    residual.swap(trial_residual);
+    merit = trial_merit;
+    result.residual_norm = residual.norm();
+    if (options_.record_history) result.residual_history.push_back(result.residual_norm);
+  }
+}
+
+}  // namespace geomint

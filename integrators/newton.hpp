@@ -1,0 +1,91 @@
+// Sparse Newton solver shared by the implicit methods (implicit Euler, Newmark, discrete-Lagrangian
+// VIs, the Hamilton–Pontryagin minimiser of PAPER.md §4, Gauss collocation): damped Newton with
+// Armijo backtracking (Nocedal & Wright, "Numerical Optimization", 2nd ed., §3.1 and §11.1).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+
+struct NewtonOptions {
+  // Converged when ‖R(x)‖₂ ≤ tolerance · max(1, residual_scale), where residual_scale (passed to
+  // solve()) is the size of the terms that R balances, e.g. ‖p_k‖ + h‖∇V‖ for a momentum
+  // residual: the test is then relative to the physics, not to an arbitrary initial guess.
+  double tolerance = 1e-12;
+  int max_iterations = 50;  // Newton updates (Jacobian factorisations) allowed per solve
+  // Backtracking on the merit function (½‖R‖², or the system's objective when it has one).
+  bool line_search = true;
+  int max_backtracks = 30;  // halvings of the step before the line search gives up
+  double armijo = 1e-4;     // sufficient-decrease constant c₁
+  // Keep the symbolic factorisation (fill-reducing ordering, elimination tree) while the
+  // Jacobian's sparsity pattern stays the same; only the numeric factorisation is redone.
+  bool reuse_symbolic = true;
+  // Store ‖R‖ after every iteration in NewtonResult::residual_history (tests, diagnostics).
+  bool record_history = false;
+};
+
+// The nonlinear system R(x) = 0 to solve.
+struct NewtonSystem {
+  // R(x); must resize `residual`. Non-finite entries make the solve fail with reason "nan"
+  // (or, inside a line search, shorten the step).
+  std::function<void(const Vec& x, Vec& residual)> residual;
+  // J = ∂R/∂x, compressed. It may be reused between calls with the same pattern.
+  std::function<void(const Vec& x, SparseMatrix& jacobian)> jacobian;
+  // Declares J symmetric: factorised with SimplicialLDLT (reads the lower triangle only),
+  // otherwise with SparseLU.
+  bool symmetric = false;
+  // Optional scalar E(x) with ∇E = R (minimisation form, PAPER.md §4). When present the line
+  // search enforces Armijo decrease of E instead of ½‖R‖², so the iteration is a globalised
+  // minimisation; a Newton direction that is not a descent direction of E (J not positive
+  // definite) fails with reason "not_descent" — the caller owns the SPD safeguard.
+  std::function<double(const Vec& x)> objective;
+};
+
+struct NewtonResult {
+  bool converged = false;
+  // "" when converged; otherwise "newton_max_iter", "nan", "linear_solve_failed",
+  // "line_search_failed" (no acceptable step length: R is at its round-off floor or x is near
+  // a stationary point of the merit function that is not a root), "not_descent".
+  std::string reason;
+  int iterations = 0;         // Newton updates taken
+  int linear_solves = 0;      // factorise + solve pairs
+  int residual_evals = 0;     // including line-search trials
+  int symbolic_analyses = 0;  // analyzePattern calls (0 when the cached pattern was reused)
+  double residual_norm = 0.0;
+  double threshold = 0.0;                // tolerance · max(1, residual_scale)
+  std::vector<double> residual_history;  // ‖R‖ at x₀, x₁, … when options.record_history
+};
+
+// One line for StepStatus messages: "Newton stopped after 3 iterations: residual 1.2e-05 >
+// 1e-12 (newton_max_iter)".
+std::string describe(const NewtonResult& result);
+
+class NewtonSolver {
+ public:
+  explicit NewtonSolver(NewtonOptions options = {});
+  ~NewtonSolver();
+  NewtonSolver(NewtonSolver&&) noexcept;
+  NewtonSolver& operator=(NewtonSolver&&) noexcept;
+
+  // Solves system.R(x) = 0 starting from x (overwritten by the last accepted iterate, also on
+  // failure). Never throws on numerical trouble; the result says what happened.
+  NewtonResult solve(const NewtonSystem& system, Vec& x, double residual_scale);
+
+  // Drops the cached symbolic factorisation (e.g. on Integrator::reset()).
+  void forget_pattern();
+
+  const NewtonOptions& options() const { return options_; }
+  NewtonOptions& options() { return options_; }
+
+ private:
+  struct Factorisation;
+  NewtonOptions options_;
+  std::unique_ptr<Factorisation> factorisation_;
+};
+
+}  // namespace geomint

@@ -1,0 +1,44 @@
+// Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
+// F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
+// Not symplectic: the negative control of PAPER.md §7.
+#include "integrators/integrator.hpp"
+
+namespace geomint {
+namespace {
+
+class Rk4 final : public Integrator {
+ public:
+  MethodInfo info() const override {
+    return {"rk4", 4, kExplicit, "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    const double t = state.t;
+    const Vec& q = state.q;
+    const Vec& p = state.p;
+    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i.
+    rhs(problem, t, q, p, dq_[0], dp_[0]);
+    rhs(problem, t + h / 2, q + (h / 2) * dq_[0], p + (h / 2) * dp_[0], dq_[1], dp_[1]);
+    rhs(problem, t + h / 2, q + (h / 2) * dq_[1], p + (h / 2) * dp_[1], dq_[2], dp_[2]);
+    rhs(problem, t + h, q + h * dq_[2], p + h * dp_[2], dq_[3], dp_[3]);
+    state.q += (h / 6) * (dq_[0] + 2 * dq_[1] + 2 * dq_[2] + dq_[3]);
+    state.p += (h / 6) * (dp_[0] + 2 * dp_[1] + 2 * dp_[2] + dp_[3]);
+    state.t = t + h;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
+    dq = problem.inverse_mass().cwiseProduct(p);
+    eval_total_force(problem, q, dq, t, dp);
+  }
+
+  Vec dq_[4], dp_[4];
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_rk4(Params&) { return std::make_unique<Rk4>(); }
+
+}  // namespace geomint

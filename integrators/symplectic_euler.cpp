@@ -1,0 +1,67 @@
+// Symplectic Euler, kick first (L_d = h L(q_k, v)) and drift first (L_d = h L(q_{k+1}, v)):
+// PAPER.md §1 table; Hairer, Lubich & Wanner, GNI §VI.3, Theorem 3.3 and its adjoint. Forces enter
+// as discrete Lagrange–d'Alembert impulses h·F (PAPER.md §2).
+#include "integrators/integrator.hpp"
+
+namespace geomint {
+namespace {
+
+// Kick then drift: p⁺ = p + h[−∇V(q) + F(q, v, t)], q⁺ = q + h M⁻¹p⁺. The force takes the
+// velocity at the start of the step, v = M⁻¹p: the step velocity M⁻¹p⁺ would make a
+// velocity-dependent force implicit, and the method is first order either way.
+class SymplecticEulerA final : public Integrator {
+ public:
+  MethodInfo info() const override {
+    return {"symplectic_euler_a", 1, kExplicit | kSymplectic | kVariational,
+            "symplectic Euler (kick first), GNI §VI.3 Thm 3.3; PAPER.md §1"};
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
+                     force_);
+    state.p += h * force_;
+    state.q += h * problem.inverse_mass().cwiseProduct(state.p);
+    state.t += h;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  Vec force_;
+};
+
+// Drift then kick: q⁺ = q + h M⁻¹p, p⁺ = p + h[−∇V(q⁺) + F(q⁺, v, t + h)]. The force takes the
+// drift velocity v = M⁻¹p = (q⁺ − q)/h, the discrete velocity of the step, so the impulse is
+// the Lagrange–d'Alembert F_d⁺ = h F(q_{k+1}, v_{k,k+1}) and the scheme stays explicit.
+class SymplecticEulerB final : public Integrator {
+ public:
+  MethodInfo info() const override {
+    return {"symplectic_euler_b", 1, kExplicit | kSymplectic | kVariational,
+            "symplectic Euler (drift first), adjoint of GNI §VI.3 Thm 3.3; PAPER.md §1"};
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    state.q += h * velocity_;
+    state.t += h;
+    eval_total_force(problem, state.q, velocity_, state.t, force_);
+    state.p += h * force_;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  Vec velocity_, force_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_symplectic_euler_a(Params&) {
+  return std::make_unique<SymplecticEulerA>();
+}
+
+std::unique_ptr<Integrator> make_symplectic_euler_b(Params&) {
+  return std::make_unique<SymplecticEulerB>();
+}
+
+}  // namespace geomint
