@@ -111,8 +111,8 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
         std::make_unique<MomentumObserver>(&Problem::linear_momentum, "momentum_err_max"));
   }
   if (problem.has(kAngularMomentum)) {
-    observers.push_back(std::make_unique<MomentumObserver>(&Problem::angular_momentum,
-                                                           "angular_momentum_err_max"));
+    observers.push_back(
+        std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
   }
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
   return observers;

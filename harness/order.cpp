@@ -103,8 +103,8 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
   return fit;
 }
 
-OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec,
-                       double dt0, int levels, double t_end) {
+OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
+                       int levels, double t_end) {
   if (levels < 3) throw InputError(fmt::format("--levels must be >= 3 (got {})", levels));
   if (!(dt0 > 0)) throw InputError(fmt::format("--dt must be > 0 (got {})", dt0));
   OrderStudy study;

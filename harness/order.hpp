@@ -11,9 +11,9 @@
 namespace geomint {
 
 struct OrderFit {
-  double order = 0.0;           // NaN when fewer than 3 usable points
-  std::vector<int> used;        // indices into the ladder that entered the fit
-  std::string note;             // why points were dropped, or why there is no fit
+  double order = 0.0;     // NaN when fewer than 3 usable points
+  std::vector<int> used;  // indices into the ladder that entered the fit
+  std::string note;       // why points were dropped, or why there is no fit
 };
 
 // `errors[i]` at step `dts[i]` (dts decreasing); failed points have a non-finite error.
@@ -29,7 +29,7 @@ struct OrderStudy {
 
 // Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing, and fits error_final (or, for
 // problems without an exact solution, the difference to the finest level — noted in the row).
-OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec,
-                       double dt0, int levels, double t_end);
+OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
+                       int levels, double t_end);
 
 }  // namespace geomint

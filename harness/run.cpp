@@ -27,8 +27,8 @@ class SeriesWriter {
     with_state_ = problem.dof() <= 64 || config.series_state;
     std::vector<std::string> columns = {"t", "energy"};
     if (problem.has(kLinearMomentum)) {
-      const Vec momentum = problem.linear_momentum(problem.initial_state().q,
-                                                   problem.initial_state().p);
+      const Vec momentum =
+          problem.linear_momentum(problem.initial_state().q, problem.initial_state().p);
       for (int i = 0; i < momentum.size(); ++i) columns.push_back(fmt::format("momentum_{}", i));
     }
     if (problem.has(kAngularMomentum)) {
@@ -53,8 +53,8 @@ class SeriesWriter {
 
   void observe(const Problem& problem, const State& state, bool last) {
     if (count_++ % config_.series_every != 0 && !last) return;
-    std::string line = format_number(state.t) + "," +
-                       format_number(problem.energy(state.q, state.p));
+    std::string line =
+        format_number(state.t) + "," + format_number(problem.energy(state.q, state.p));
     auto append = [&line](const Vec& values) {
       for (double v : values) line += "," + format_number(v);
     };
@@ -103,12 +103,13 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
     if (conservative) {
       if (std::abs(problem.energy(s.q, s.p) - energy0) > kDivergedEnergyError * energy_scale) {
         return StepStatus::failure(
-            "diverged", fmt::format("relative energy error above {:g} at t={:.6g}",
-                                    kDivergedEnergyError, s.t));
+            "diverged",
+            fmt::format("relative energy error above {:g} at t={:.6g}", kDivergedEnergyError, s.t));
       }
     } else if (std::max(s.q.lpNorm<Eigen::Infinity>(), s.p.lpNorm<Eigen::Infinity>()) >
                kDivergedStateNorm) {
-      return StepStatus::failure("diverged", fmt::format("state norm above 1e100 at t={:.6g}", s.t));
+      return StepStatus::failure("diverged",
+                                 fmt::format("state norm above 1e100 at t={:.6g}", s.t));
     }
     return StepStatus::success();
   };
@@ -220,11 +221,12 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   for (auto& observer : observers) observer->begin(*problem, state, config.t_end);
   if (series) series->observe(*problem, state, false);
   integrator->reset(*problem, state, config.dt);
-  const LoopOutcome outcome =
-      integrate(*problem, *integrator, state, config, adaptive, true, [&](const State& s, bool last) {
-        for (auto& observer : observers) observer->observe(*problem, s);
-        if (series) series->observe(*problem, s, last);
-      });
+  const LoopOutcome outcome = integrate(*problem, *integrator, state, config, adaptive, true,
+                                        [&](const State& s, bool last) {
+                                          for (auto& observer : observers)
+                                            observer->observe(*problem, s);
+                                          if (series) series->observe(*problem, s, last);
+                                        });
   for (const auto& observer : observers) observer->finish(result.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
@@ -239,8 +241,8 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (series) series->write();
 
   if (result.ok && config.timing_repeats > 0) {
-    row["wall_s"] = format_number(time_run(problem_spec, method_spec, config,
-                                           config.timing_repeats));
+    row["wall_s"] =
+        format_number(time_run(problem_spec, method_spec, config, config.timing_repeats));
   }
   return result;
 }

@@ -12,17 +12,17 @@
 namespace geomint {
 
 struct RunConfig {
-  double dt = 0.0;              // fixed step (> 0); adaptive methods ignore it
-  double t_end = 0.0;           // horizon (> 0)
-  std::string series_path;      // time series CSV, empty = none
-  long series_every = 1;        // write every N-th step point (the last point always)
-  bool series_state = false;    // force q, p columns for problems with > 64 dof
-  int timing_repeats = 3;       // separate timed runs without observers; 0 = no wall_s
-  std::string command_line;     // for the series provenance
+  double dt = 0.0;            // fixed step (> 0); adaptive methods ignore it
+  double t_end = 0.0;         // horizon (> 0)
+  std::string series_path;    // time series CSV, empty = none
+  long series_every = 1;      // write every N-th step point (the last point always)
+  bool series_state = false;  // force q, p columns for problems with > 64 dof
+  int timing_repeats = 3;     // separate timed runs without observers; 0 = no wall_s
+  std::string command_line;   // for the series provenance
 };
 
 struct RunResult {
-  Row row;                      // CSV row: identifiers, status, metrics, counters, wall_s
+  Row row;  // CSV row: identifiers, status, metrics, counters, wall_s
   bool ok = true;
   State final_state;
   std::map<std::string, double> metrics;  // numeric metrics by column name

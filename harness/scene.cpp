@@ -2,6 +2,7 @@
 #include "harness/scene.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -12,7 +13,6 @@
 #include <mutex>
 #include <set>
 #include <thread>
-#include <toml++/toml.h>
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
@@ -22,7 +22,8 @@ namespace {
 
 class BlockReader {
  public:
-  BlockReader(const toml::table& table, std::string where) : table_(table), where_(std::move(where)) {}
+  BlockReader(const toml::table& table, std::string where)
+      : table_(table), where_(std::move(where)) {}
 
   std::string string(const std::string& key, bool required, const std::string& fallback = "") {
     seen_.insert(key);
@@ -58,13 +59,16 @@ class BlockReader {
     const toml::node* node = table_.get(key);
     if (!node) return require(key, required), out;
     const toml::array* array = node->as_array();
-    if (!array) throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
+    if (!array)
+      throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
     for (const auto& item : *array) {
       auto value = item.value<std::string>();
-      if (!value) throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
+      if (!value)
+        throw InputError(fmt::format("{}: key '{}' must be an array of strings", where_, key));
       out.push_back(*value);
     }
-    if (required && out.empty()) throw InputError(fmt::format("{}: key '{}' is empty", where_, key));
+    if (required && out.empty())
+      throw InputError(fmt::format("{}: key '{}' is empty", where_, key));
     return out;
   }
   // A number or an array of numbers.
@@ -75,10 +79,13 @@ class BlockReader {
     if (!node) return require(key, required), out;
     if (auto value = node->value<double>()) return {*value};
     const toml::array* array = node->as_array();
-    if (!array) throw InputError(fmt::format("{}: key '{}' must be a number or an array of numbers", where_, key));
+    if (!array)
+      throw InputError(
+          fmt::format("{}: key '{}' must be a number or an array of numbers", where_, key));
     for (const auto& item : *array) {
       auto value = item.value<double>();
-      if (!value) throw InputError(fmt::format("{}: key '{}' must be an array of numbers", where_, key));
+      if (!value)
+        throw InputError(fmt::format("{}: key '{}' must be an array of numbers", where_, key));
       out.push_back(*value);
     }
     return out;
@@ -104,7 +111,8 @@ class BlockReader {
 
 void check_positive(double value, const std::string& where, const std::string& key) {
   if (!(value > 0) || !std::isfinite(value)) {
-    throw InputError(fmt::format("{}: '{}' must be a finite number > 0 (got {})", where, key, value));
+    throw InputError(
+        fmt::format("{}: '{}' must be a finite number > 0 (got {})", where, key, value));
   }
 }
 
@@ -114,10 +122,12 @@ std::vector<const toml::table*> tables_of(const toml::table& root, const std::st
   const toml::node* node = root.get(key);
   if (!node) return out;
   const toml::array* array = node->as_array();
-  if (!array) throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
+  if (!array)
+    throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
   for (const auto& item : *array) {
     const toml::table* table = item.as_table();
-    if (!table) throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
+    if (!table)
+      throw InputError(fmt::format("{}: '{}' must be an array of tables ([[{}]])", path, key, key));
     out.push_back(table);
   }
   return out;
@@ -200,13 +210,17 @@ Scene load_scene(const std::string& path, bool quick) {
     bool all_adaptive = false;
     validate_specs(block.problems, block.methods, where, &all_adaptive);
     if (block.dts.empty() && !all_adaptive) {
-      throw InputError(fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
+      throw InputError(
+          fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
     }
     for (double dt : block.dts) check_positive(dt, where, "dt");
     check_positive(block.t_end, where, "t_end");
-    if (block.series_every < 0) throw InputError(fmt::format("{}: 'series_every' must be >= 0", where));
-    if (block.timing_repeats < 0) throw InputError(fmt::format("{}: 'timing_repeats' must be >= 0", where));
-    if (!labels.insert(block.label).second) throw InputError(fmt::format("{}: label used twice", where));
+    if (block.series_every < 0)
+      throw InputError(fmt::format("{}: 'series_every' must be >= 0", where));
+    if (block.timing_repeats < 0)
+      throw InputError(fmt::format("{}: 'timing_repeats' must be >= 0", where));
+    if (!labels.insert(block.label).second)
+      throw InputError(fmt::format("{}: label used twice", where));
     scene.runs.push_back(block);
   }
   for (size_t i = 0; i < order_tables.size(); ++i) {
@@ -231,7 +245,8 @@ Scene load_scene(const std::string& path, bool quick) {
     if (block.levels < 3 || block.levels > 30) {
       throw InputError(fmt::format("{}: 'levels' must be in 3..30 (got {})", where, block.levels));
     }
-    if (!labels.insert(block.label).second) throw InputError(fmt::format("{}: label used twice", where));
+    if (!labels.insert(block.label).second)
+      throw InputError(fmt::format("{}: label used twice", where));
     scene.orders.push_back(block);
   }
   top.finish();
@@ -310,7 +325,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
             job.config.series_every = block.series_every;
             job.config.series_state = block.series_state;
             job.config.series_path = (fs::path(options.out_dir) / "series" / block.label /
-                                      series_name(block, problem, method, dt)).string();
+                                      series_name(block, problem, method, dt))
+                                         .string();
           }
           jobs.push_back(std::move(job));
         }
@@ -344,8 +360,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       job.row["label"] = job.label;
     } else {
       OrderJob& job = order_jobs[i - jobs.size()];
-      job.study = order_study(job.problem, job.method, job.block->dt0, job.block->levels,
-                              job.block->t_end);
+      job.study =
+          order_study(job.problem, job.method, job.block->dt0, job.block->levels, job.block->t_end);
     }
     progress.tick();
   });
@@ -388,16 +404,14 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   if (!summary_rows.empty()) {
     write_file_atomic((out / "summary.csv").string(),
                       to_csv(summary_rows, column_union(summary_rows, standard_columns()), lines));
-    auto columns = scene.table_columns.empty()
-                       ? column_union(summary_rows, standard_columns())
-                       : scene.table_columns;
+    auto columns = scene.table_columns.empty() ? column_union(summary_rows, standard_columns())
+                                               : scene.table_columns;
     markdown += "## Runs (summary.csv)\n\n" + to_markdown(summary_rows, columns) + "\n";
   }
   if (!order_rows.empty()) {
-    const std::vector<std::string> order_columns = {"label",          "problem",
-                                                    "method",         "order",
-                                                    "declared_order", "points_used",
-                                                    "status",         "message"};
+    const std::vector<std::string> order_columns = {"label",  "problem",        "method",
+                                                    "order",  "declared_order", "points_used",
+                                                    "status", "message"};
     write_file_atomic((out / "order.csv").string(),
                       to_csv(order_rows, column_union(order_rows, order_columns), lines));
     write_file_atomic(

@@ -11,11 +11,11 @@ namespace geomint {
 struct RunBlock {
   std::string label;
   std::vector<std::string> problems, methods;
-  std::vector<double> dts;      // empty only when every method is adaptive
+  std::vector<double> dts;  // empty only when every method is adaptive
   double t_end = 0;
-  long series_every = 0;        // 0 = no series
+  long series_every = 0;  // 0 = no series
   bool series_state = false;
-  int timing_repeats = 3;       // 0 = no timing pass
+  int timing_repeats = 3;  // 0 = no timing pass
 };
 
 struct OrderBlock {
@@ -40,9 +40,9 @@ Scene load_scene(const std::string& path, bool quick);
 
 struct SweepOptions {
   int jobs = 1;
-  std::string out_dir;          // where outputs go
+  std::string out_dir;  // where outputs go
   std::string command_line;
-  bool progress = true;         // progress on stderr when it is a terminal
+  bool progress = true;  // progress on stderr when it is a terminal
 };
 
 // Runs the scene; returns the number of failed runs (failure rows are results, not errors).

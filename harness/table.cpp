@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gsl/gsl_version.h>
 #include <sundials/sundials_config.h>
+#include <unistd.h>
 
 #include <Eigen/Core>
 #include <boost/version.hpp>
@@ -15,7 +16,6 @@
 #include <fstream>
 #include <set>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace geomint {
 
@@ -66,18 +66,43 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
                    EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, GSL_VERSION, SUNDIALS_VERSION,
                    BOOST_VERSION / 100000, BOOST_VERSION / 100 % 1000, FMT_VERSION)},
       {"cpu", cpu_model()},
-      {"date", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::chrono::system_clock::to_time_t(now)))},
+      {"date", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}",
+                           fmt::gmtime(std::chrono::system_clock::to_time_t(now)))},
       {"command", command_line},
   };
 }
 
 const std::vector<std::string>& standard_columns() {
-  static const std::vector<std::string> columns = {
-      "label", "problem", "method", "dt", "tol", "t_end", "status", "message", "t_reached",
-      "steps", "energy_err_max", "energy_err_final", "energy_drift", "momentum_err_max",
-      "angular_momentum_err_max", "constraint_err_max", "constraint_vel_err_max", "error_final",
-      "error_max", "phase_err", "order", "declared_order", "points_used", "force_evals",
-      "energy_evals", "hessian_evals", "newton_iters", "linear_solves", "rejected", "wall_s"};
+  static const std::vector<std::string> columns = {"label",
+                                                   "problem",
+                                                   "method",
+                                                   "dt",
+                                                   "tol",
+                                                   "t_end",
+                                                   "status",
+                                                   "message",
+                                                   "t_reached",
+                                                   "steps",
+                                                   "energy_err_max",
+                                                   "energy_err_final",
+                                                   "energy_drift",
+                                                   "momentum_err_max",
+                                                   "angular_momentum_err_max",
+                                                   "constraint_err_max",
+                                                   "constraint_vel_err_max",
+                                                   "error_final",
+                                                   "error_max",
+                                                   "phase_err",
+                                                   "order",
+                                                   "declared_order",
+                                                   "points_used",
+                                                   "force_evals",
+                                                   "energy_evals",
+                                                   "hessian_evals",
+                                                   "newton_iters",
+                                                   "linear_solves",
+                                                   "rejected",
+                                                   "wall_s"};
   return columns;
 }
 

@@ -63,9 +63,8 @@ std::vector<std::string> integrator_test_specs() {
 
 std::vector<std::string> flag_names(unsigned flags) {
   static const std::pair<MethodFlag, const char*> kNames[] = {
-      {kExplicit, "explicit"},       {kImplicit, "implicit"},
-      {kSymplectic, "symplectic"},   {kSymmetric, "symmetric"},
-      {kVariational, "variational"}, {kAdaptive, "adaptive"},
+      {kExplicit, "explicit"},       {kImplicit, "implicit"},          {kSymplectic, "symplectic"},
+      {kSymmetric, "symmetric"},     {kVariational, "variational"},    {kAdaptive, "adaptive"},
       {kConstrained, "constrained"}, {kNeedsHessian, "needs_hessian"},
   };
   std::vector<std::string> out;

@@ -14,18 +14,18 @@ namespace geomint {
 enum MethodFlag : unsigned {
   kExplicit = 1u << 0,
   kImplicit = 1u << 1,
-  kSymplectic = 1u << 2,   // canonical symplectic one-step map
-  kSymmetric = 1u << 3,    // Φ_{−h} ∘ Φ_h = id
-  kVariational = 1u << 4,  // derived from a discrete Lagrangian: discrete Noether holds
-  kAdaptive = 1u << 5,     // error-controlled; use advance_to()
-  kConstrained = 1u << 6,  // handles holonomic constraints
-  kNeedsHessian = 1u << 7, // needs Problem::hessian
+  kSymplectic = 1u << 2,    // canonical symplectic one-step map
+  kSymmetric = 1u << 3,     // Φ_{−h} ∘ Φ_h = id
+  kVariational = 1u << 4,   // derived from a discrete Lagrangian: discrete Noether holds
+  kAdaptive = 1u << 5,      // error-controlled; use advance_to()
+  kConstrained = 1u << 6,   // handles holonomic constraints
+  kNeedsHessian = 1u << 7,  // needs Problem::hessian
 };
 std::vector<std::string> flag_names(unsigned flags);
 
 struct MethodInfo {
-  std::string name;       // registry name
-  int order = 0;          // classical order of accuracy
+  std::string name;  // registry name
+  int order = 0;     // classical order of accuracy
   unsigned flags = 0;
   std::string reference;  // where the scheme is defined
 };
@@ -43,12 +43,12 @@ struct StepStatus {
 
 struct Counters {
   long steps = 0;
-  long force_evals = 0;    // gradient (and force) evaluations
-  long energy_evals = 0;   // potential evaluations (line searches)
+  long force_evals = 0;   // gradient (and force) evaluations
+  long energy_evals = 0;  // potential evaluations (line searches)
   long hessian_evals = 0;
   long newton_iters = 0;
   long linear_solves = 0;
-  long rejected = 0;       // rejected steps (adaptive solvers)
+  long rejected = 0;  // rejected steps (adaptive solvers)
 };
 
 class Integrator {

@@ -62,6 +62,9 @@ struct NewtonSolver::Factorisation {
     return lu.info() == Eigen::Success;
   }
 
+  // Every pivot of the last LDLT factorisation is positive: the matrix is positive definite.
+  bool positive_pivots() const { return (ldlt.vectorD().array() > 0.0).all(); }
+
   void solve(bool symmetric, const Vec& rhs, Vec& out) {
     out = symmetric ? Vec(ldlt.solve(rhs)) : Vec(lu.solve(rhs));
   }
@@ -85,6 +88,31 @@ bool all_finite(const SparseMatrix& J) {
 }
 
 }  // namespace
+
+SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, Vec& f)>& f,
+                                         const Vec& x) {
+  const Eigen::Index n = x.size();
+  const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
+  std::vector<Eigen::Triplet<double>> triplets;
+  Vec shifted = x, plus, minus;
+  Eigen::Index rows = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double delta = relative_step * std::max(1.0, std::abs(x[j]));
+    shifted[j] = x[j] + delta;
+    f(shifted, plus);
+    shifted[j] = x[j] - delta;
+    f(shifted, minus);
+    shifted[j] = x[j];
+    rows = plus.size();
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const double derivative = (plus[i] - minus[i]) / (2 * delta);
+      if (derivative != 0.0) triplets.emplace_back(i, j, derivative);
+    }
+  }
+  SparseMatrix out(n == 0 ? 0 : rows, n);
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
+}
 
 std::string describe(const NewtonResult& result) {
   if (result.converged) {
@@ -125,10 +153,30 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   double merit = merit_of(x, residual);
   if (!std::isfinite(merit)) return fail("nan");
 
+  const bool safeguard = system.symmetric && system.objective && system.spd_shift.size() > 0;
+  if (safeguard && (system.spd_shift.rows() != x.size() || system.spd_shift.cols() != x.size())) {
+    throw std::logic_error(fmt::format("Newton SPD shift is {}x{} for {} unknowns",
+                                       system.spd_shift.rows(), system.spd_shift.cols(), x.size()));
+  }
+
   Vec direction, trial, trial_residual;
   while (true) {
     if (result.residual_norm <= result.threshold) {
       result.converged = true;
+      if (options_.polish && result.iterations > 0) {
+        f.solve(system.symmetric, -residual, direction);
+        if (all_finite(direction)) {
+          trial = x + direction;
+          evaluate(trial, trial_residual);
+          const double polished_norm = trial_residual.norm();
+          if (all_finite(trial_residual) && polished_norm < result.residual_norm) {
+            x.swap(trial);
+            result.residual_norm = polished_norm;
+            result.polished = true;
+            if (options_.record_history) result.residual_history.push_back(polished_norm);
+          }
+        }
+      }
       return result;
     }
     if (result.iterations >= options_.max_iterations) return fail("newton_max_iter");
@@ -140,7 +188,29 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     }
     if (!all_finite(f.jacobian)) return fail("nan");
     ++result.linear_solves;
-    if (!f.factorise(system.symmetric, options_.reuse_symbolic, result.symbolic_analyses)) {
+    const bool factorised =
+        f.factorise(system.symmetric, options_.reuse_symbolic, result.symbolic_analyses);
+    if (safeguard && !(factorised && f.positive_pivots())) {
+      // J is not positive definite (or singular): shift it towards S until it is. J + μS has the
+      // pattern of J when S's pattern is contained in it (M diagonal, J with a full diagonal), so
+      // the symbolic factorisation is reused.
+      ++result.shifted_iterations;
+      const SparseMatrix unshifted = f.jacobian;
+      // Start one growth step below the last successful shift of this solve: consecutive
+      // iterates usually need a similar μ, and the schedule then costs one or two factorisations.
+      double mu =
+          std::max(options_.spd_shift_initial, result.last_shift / options_.spd_shift_growth);
+      bool positive = false;
+      for (int attempt = 0; attempt < options_.max_spd_shifts && !positive;
+           ++attempt, mu *= options_.spd_shift_growth) {
+        f.jacobian = unshifted + mu * system.spd_shift;
+        ++result.shift_factorisations;
+        positive = f.factorise(true, options_.reuse_symbolic, result.symbolic_analyses) &&
+                   f.positive_pivots();
+        if (positive) result.last_shift = mu;
+      }
+      if (!positive) return fail("linear_solve_failed");
+    } else if (!factorised) {
       return fail("linear_solve_failed");
     }
     f.solve(system.symmetric, -residual, direction);
@@ -159,6 +229,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     double trial_merit = 0.0;
     for (int backtrack = 0; backtrack <= options_.max_backtracks; ++backtrack, step *= 0.5) {
       trial = x + step * direction;
+      if (trial == x) break;  // the step is below x's resolution: no progress is possible
       evaluate(trial, trial_residual);
       if (!all_finite(trial_residual)) {
         if (!options_.line_search) break;
@@ -176,8 +247,9 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       }
       // Close to the root an objective's decrease (~‖R‖²) drops below its round-off
       // (~ε|E|) long before ‖R‖ reaches the tolerance; the residual still measures progress.
+      const double merit_size = std::max(std::abs(merit), system.objective_scale);
       if (system.objective && trial_residual.norm() < result.residual_norm &&
-          trial_merit <= merit + 16 * std::numeric_limits<double>::epsilon() * std::abs(merit)) {
+          trial_merit <= merit + 16 * std::numeric_limits<double>::epsilon() * merit_size) {
         accepted = true;
         break;
       }

@@ -27,6 +27,18 @@ struct NewtonOptions {
   bool reuse_symbolic = true;
   // Store ‖R‖ after every iteration in NewtonResult::residual_history (tests, diagnostics).
   bool record_history = false;
+  // After convergence, one more simplified-Newton correction with the last factorisation (no new
+  // Jacobian, one back-substitution and one residual evaluation), kept only if it lowers ‖R‖.
+  // Quadratic convergence makes it take ‖R‖ from just below the tolerance to its round-off floor,
+  // which invariants that are exact only for the exact solve (angular momentum of a variational
+  // integrator, PAPER.md §4) need over 10⁵ steps; the tolerance alone allows a 1e-12 error a step.
+  bool polish = false;
+  // Schedule of the SPD safeguard (NewtonSystem::spd_shift): μ = spd_shift_initial (or the last
+  // successful μ of the solve / spd_shift_growth, if larger), ·spd_shift_growth, … at most
+  // max_spd_shifts times per iteration.
+  double spd_shift_initial = 1e-3;
+  double spd_shift_growth = 10.0;
+  int max_spd_shifts = 40;
 };
 
 // The nonlinear system R(x) = 0 to solve.
@@ -42,8 +54,20 @@ struct NewtonSystem {
   // Optional scalar E(x) with ∇E = R (minimisation form, PAPER.md §4). When present the line
   // search enforces Armijo decrease of E instead of ½‖R‖², so the iteration is a globalised
   // minimisation; a Newton direction that is not a descent direction of E (J not positive
-  // definite) fails with reason "not_descent" — the caller owns the SPD safeguard.
+  // definite) fails with reason "not_descent" unless the SPD safeguard below is enabled.
   std::function<double(const Vec& x)> objective;
+  // Size of the terms the objective sums (e.g. |½xᵀMx| + |pᵀx| + |V|): E's round-off is about
+  // ε·objective_scale even where E itself is near zero by cancellation. The line search treats
+  // changes of E below that level as noise (see solve()). 0: use |E|.
+  double objective_scale = 0.0;
+  // Optional SPD safeguard for the minimisation form (read only when `symmetric` and `objective`
+  // are set; pass an SPD matrix, e.g. the mass matrix M). When the LDLT factor of J has a
+  // non-positive pivot in D — by Sylvester's law of inertia exactly when J is not positive
+  // definite, so the Newton step need not descend E — J + μS is factorised instead, with μ growing
+  // geometrically (NewtonOptions) until every pivot is positive. The shifted step is a descent
+  // direction of E, so the line search can always make progress; near a strict minimiser J is
+  // positive definite again and the iteration is plain Newton. Empty (default): no safeguard.
+  SparseMatrix spd_shift;
 };
 
 struct NewtonResult {
@@ -52,10 +76,14 @@ struct NewtonResult {
   // "line_search_failed" (no acceptable step length: R is at its round-off floor or x is near
   // a stationary point of the merit function that is not a root), "not_descent".
   std::string reason;
-  int iterations = 0;         // Newton updates taken
-  int linear_solves = 0;      // factorise + solve pairs
-  int residual_evals = 0;     // including line-search trials
-  int symbolic_analyses = 0;  // analyzePattern calls (0 when the cached pattern was reused)
+  int iterations = 0;            // Newton updates taken
+  int linear_solves = 0;         // factorise + solve pairs
+  int residual_evals = 0;        // including line-search trials
+  int symbolic_analyses = 0;     // analyzePattern calls (0 when the cached pattern was reused)
+  int shifted_iterations = 0;    // iterations whose Jacobian needed the SPD shift
+  int shift_factorisations = 0;  // extra numeric factorisations spent on the shift
+  double last_shift = 0.0;       // μ of the last shifted iteration
+  bool polished = false;         // the polishing correction was taken (NewtonOptions::polish)
   double residual_norm = 0.0;
   double threshold = 0.0;                // tolerance · max(1, residual_scale)
   std::vector<double> residual_history;  // ‖R‖ at x₀, x₁, … when options.record_history
@@ -64,6 +92,12 @@ struct NewtonResult {
 // One line for StepStatus messages: "Newton stopped after 3 iterations: residual 1.2e-05 >
 // 1e-12 (newton_max_iter)".
 std::string describe(const NewtonResult& result);
+
+// ∂f/∂x at x by central differences, one column per unknown, with the step δ_j =
+// ε^(1/3)·max(1, |x_j|) that balances truncation (δ²) and round-off (ε/δ). Dense columns and
+// 2·dim(x) evaluations of f: for Jacobian pieces a problem does not provide, on small systems.
+SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, Vec& f)>& f,
+                                         const Vec& x);
 
 class NewtonSolver {
  public:

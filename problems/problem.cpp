@@ -77,9 +77,7 @@ void Problem::set_mass(const Vec& mass) {
   inverse_mass_ = mass.cwiseInverse();
 }
 
-double Problem::kinetic(const Vec& p) const {
-  return 0.5 * p.dot(inverse_mass_.cwiseProduct(p));
-}
+double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass_.cwiseProduct(p)); }
 
 double Problem::energy(const Vec& q, const Vec& p) const { return kinetic(p) + potential(q); }
 

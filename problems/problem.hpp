@@ -64,13 +64,15 @@ class Problem {
   virtual void hessian(const Vec& q, SparseMatrix& H) const;
   // Non-conservative generalized force F(q, v, t) (added to −∇V). Only when has(kForce).
   virtual void force(const Vec& q, const Vec& v, double t, Vec& f) const;
-  // C = −∂F/∂v (damping matrix, symmetric PSD for dissipative forces). Only when has(kForceJacobian).
+  // C = −∂F/∂v (damping matrix, symmetric PSD for dissipative forces). Only when
+  // has(kForceJacobian).
   virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
   // Exact solution. Only when has(kExact).
   virtual State exact(double t) const;
   // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
   virtual Vec linear_momentum(const Vec& q, const Vec& p) const;
-  // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when has(kAngularMomentum).
+  // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when
+  // has(kAngularMomentum).
   virtual Vec angular_momentum(const Vec& q, const Vec& p) const;
   // Period of the exact motion. Only when has(kPeriod).
   virtual double period() const;

@@ -86,13 +86,13 @@ double Params::real(const std::string& key, double default_value, const std::str
     char* end = nullptr;
     value = std::strtod(begin, &end);
     if (end == begin || *end != '\0' || !std::isfinite(value)) {
-      throw InputError(fmt::format("{}: parameter {}='{}' is not a finite number", context_, key,
-                                   *text));
+      throw InputError(
+          fmt::format("{}: parameter {}='{}' is not a finite number", context_, key, *text));
     }
   }
   if (ok && !ok(value)) {
-    throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: {})", context_,
-                                 key, format_number(value), valid.empty() ? "see list" : valid));
+    throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: {})", context_, key,
+                                 format_number(value), valid.empty() ? "see list" : valid));
   }
   record(key, format_number(default_value), help, format_number(value));
   return value;
@@ -151,8 +151,9 @@ void Params::finish() const {
     if (canonical_values_.count(key) == 0) {
       std::vector<std::string> valid;
       for (const auto& doc : docs_) valid.push_back(doc.key);
-      throw InputError(fmt::format("{}: unknown parameter '{}' (valid: {})", context_, key,
-                                   valid.empty() ? "none" : fmt::format("{}", fmt::join(valid, ", "))));
+      throw InputError(
+          fmt::format("{}: unknown parameter '{}' (valid: {})", context_, key,
+                      valid.empty() ? "none" : fmt::format("{}", fmt::join(valid, ", "))));
     }
   }
 }

@@ -13,10 +13,11 @@ do for [format in "png pdf"] {
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     set key outside right
     ref = (label eq "pendulum") ? 0.1 : 0.02
+    set xrange [ref/600:ref*1.5]
     plot for [i=1:words(methods)] "order_points.csv" using "dt":(select(label, word(methods,i))) \
            with linespoints ls i pt 7 title word(methods,i), \
-         [ref/300:ref] 1e-1*(x/ref) with lines dt 2 lc rgb "black" title "slope 1", \
-         [ref/300:ref] 1e-3*(x/ref)**2 with lines dt 3 lc rgb "black" title "slope 2", \
-         [ref/300:ref] 1e-5*(x/ref)**4 with lines dt 4 lc rgb "black" title "slope 4"
+         1e-1*(x/ref) with lines dt 2 lc rgb "black" title "slope 1", \
+         1e-3*(x/ref)**2 with lines dt 3 lc rgb "black" title "slope 2", \
+         1e-5*(x/ref)**4 with lines dt 4 lc rgb "black" title "slope 4"
   }
 }

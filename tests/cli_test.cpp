@@ -94,8 +94,10 @@ TEST(Cli, BadSceneExitsTwoAndWritesNothing) {
 
 TEST(Cli, RunWritesOneRowWithProvenance) {
   const fs::path out = scratch("run.csv");
-  const Outcome outcome = geomint("run --problem harmonic --method stormer_verlet --dt 0.1 "
-                                  "--t-end 1 --timing-repeats 1 --out " + out.string());
+  const Outcome outcome = geomint(
+      "run --problem harmonic --method stormer_verlet --dt 0.1 "
+      "--t-end 1 --timing-repeats 1 --out " +
+      out.string());
   ASSERT_EQ(outcome.exit_code, 0) << outcome.output;
   std::ifstream in(out);
   std::string line, header;
@@ -119,8 +121,10 @@ TEST(Cli, RunWritesOneRowWithProvenance) {
 
 TEST(Cli, SeriesHasStateColumnsAndEndsAtTEnd) {
   const fs::path series = scratch("series.csv");
-  const Outcome outcome = geomint("run --problem kepler --method rk4 --dt 0.1 --t-end 1.05 "
-                                  "--timing-repeats 0 --series " + series.string() + " --every 3");
+  const Outcome outcome = geomint(
+      "run --problem kepler --method rk4 --dt 0.1 --t-end 1.05 "
+      "--timing-repeats 0 --series " +
+      series.string() + " --every 3");
   ASSERT_EQ(outcome.exit_code, 0) << outcome.output;
   std::ifstream in(series);
   std::string line, header, last;
@@ -138,8 +142,9 @@ TEST(Cli, SeriesHasStateColumnsAndEndsAtTEnd) {
 
 TEST(Cli, FailedRunIsARowWithExitOne) {
   // Explicit Euler on a stiff harmonic oscillator at hω = 10 blows up.
-  const Outcome outcome = geomint("run --problem harmonic:omega=100 --method explicit_euler "
-                                  "--dt 0.1 --t-end 100 --timing-repeats 0");
+  const Outcome outcome = geomint(
+      "run --problem harmonic:omega=100 --method explicit_euler "
+      "--dt 0.1 --t-end 100 --timing-repeats 0");
   EXPECT_EQ(outcome.exit_code, 1) << outcome.output;
   EXPECT_NE(outcome.output.find(",diverged,"), std::string::npos) << outcome.output;
 }

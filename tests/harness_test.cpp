@@ -136,18 +136,22 @@ TEST(Scene, RejectsBadFiles) {
   expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nmethods=['rk4']\ndt=0.1\nt_end=1.0\n",
                      "problems");
   expect_scene_error("title='x'\n" + good_block + "colour='red'\n", "colour");
-  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['nope']\n"
-                     "dt=0.1\nt_end=1.0\n",
-                     "nope");
-  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
-                     "dt=-0.1\nt_end=1.0\n",
-                     "dt");
-  expect_scene_error("title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
-                     "dt='big'\nt_end=1.0\n",
-                     "dt");
-  expect_scene_error("title='x'\n[[orders]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
-                     "dt0=0.1\nlevels=2\nt_end=1.0\n",
-                     "levels");
+  expect_scene_error(
+      "title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['nope']\n"
+      "dt=0.1\nt_end=1.0\n",
+      "nope");
+  expect_scene_error(
+      "title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+      "dt=-0.1\nt_end=1.0\n",
+      "dt");
+  expect_scene_error(
+      "title='x'\n[[runs]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+      "dt='big'\nt_end=1.0\n",
+      "dt");
+  expect_scene_error(
+      "title='x'\n[[orders]]\nlabel='a'\nproblems=['harmonic']\nmethods=['rk4']\n"
+      "dt0=0.1\nlevels=2\nt_end=1.0\n",
+      "levels");
   EXPECT_NO_THROW(load_scene(write_scene("title='x'\n" + good_block), false));
 }
 

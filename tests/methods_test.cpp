@@ -46,8 +46,8 @@ void expect_declared_order(const std::string& method, const Ladder& ladder) {
   // High orders reach the plateau sooner: start them at a larger dt.
   const double dt0 = declared >= 4 ? ladder.dt0 * 4 : ladder.dt0;
   const OrderStudy study = order_study(ladder.problem, method, dt0, ladder.levels, ladder.t_end);
-  ASSERT_TRUE(std::isfinite(study.fit.order)) << method << " on " << ladder.problem << ": "
-                                              << study.fit.note;
+  ASSERT_TRUE(std::isfinite(study.fit.order))
+      << method << " on " << ladder.problem << ": " << study.fit.note;
   // ±0.3: the tolerance of DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
   EXPECT_NEAR(study.fit.order, declared, 0.3)
       << method << " on " << ladder.problem << " (points " << study.row.at("points_used") << ")";
@@ -130,7 +130,10 @@ TEST_P(EveryMethod, SymplecticKeepsKeplerAngularMomentum) {
   const RunResult result = run_one("kepler:e=0.6", GetParam(), config);
   ASSERT_TRUE(result.ok) << result.row.at("message");
   const double angular0 = std::sqrt(1 - 0.6 * 0.6);
-  EXPECT_LT(result.metrics.at("angular_momentum_err_max") / angular0, 1e-13);
+  // Exact conservation up to rounding, which random-walks as eps * sqrt(steps * stages): about
+  // 1e-13 for a 5-stage composition over 1e5 steps. The bound is 1e-12, far below RK4's
+  // truncation drift (NegativeControl below) and the 1e-10 that separates the two classes.
+  EXPECT_LT(result.metrics.at("angular_momentum_err_max") / angular0, 1e-12);
 }
 
 TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
@@ -142,8 +145,7 @@ TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
   EXPECT_GT(result.metrics.at("angular_momentum_err_max"), 1e-10);
 }
 
-INSTANTIATE_TEST_SUITE_P(Registry, EveryMethod, testing::ValuesIn(fixed_step_methods()),
-                         test_name);
+INSTANTIATE_TEST_SUITE_P(Registry, EveryMethod, testing::ValuesIn(fixed_step_methods()), test_name);
 
 }  // namespace
 }  // namespace geomint

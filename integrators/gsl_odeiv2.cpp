@@ -1,0 +1,245 @@
+// GSL 2.7 odeiv2 wrappers: rk8pd, msbdf and rk4imp driven by gsl_odeiv2_evolve_apply, one
+// accepted step per adaptive_step (GSL reference manual, "Ordinary Differential Equations",
+// https://www.gnu.org/software/gsl/doc/html/ode-initval.html).
+#include <fmt/format.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+
+namespace geomint {
+namespace {
+
+struct DriverDeleter {
+  void operator()(gsl_odeiv2_driver* driver) const { gsl_odeiv2_driver_free(driver); }
+};
+using DriverPtr = std::unique_ptr<gsl_odeiv2_driver, DriverDeleter>;
+
+// GSL's default error handler aborts the process; inside a wrapper call its errors must become
+// status codes instead. The previous handler is restored on exit (the handler is global).
+class ScopedGslErrorsAsStatus {
+ public:
+  ScopedGslErrorsAsStatus() : previous_(gsl_set_error_handler_off()) {}
+  ~ScopedGslErrorsAsStatus() { gsl_set_error_handler(previous_); }
+  ScopedGslErrorsAsStatus(const ScopedGslErrorsAsStatus&) = delete;
+  ScopedGslErrorsAsStatus& operator=(const ScopedGslErrorsAsStatus&) = delete;
+
+ private:
+  gsl_error_handler_t* previous_;
+};
+
+enum class GslMethod { kRk8pd, kMsbdf, kRk4imp };
+
+// Starting step from the size of y and y' in the error norm (Hairer, Nørsett & Wanner I,
+// §II.4, first two stages of the starting-step algorithm): GSL has no estimate of its own, and
+// a poor guess only costs rejected steps.
+double starting_step(const Vec& y, const Vec& ydot, double rtol, double atol) {
+  const Vec scale = (atol + rtol * y.array().abs()).matrix();
+  const double d0 = std::sqrt((y.array() / scale.array()).square().mean());
+  const double d1 = std::sqrt((ydot.array() / scale.array()).square().mean());
+  if (!(d0 >= 1e-5 && d1 >= 1e-5) || !std::isfinite(d0 / d1)) return 1e-6;
+  return 0.01 * d0 / d1;
+}
+
+class GslOdeiv2 final : public Integrator {
+ public:
+  GslOdeiv2(GslMethod method, double rtol, double atol)
+      : method_(method), rtol_(rtol), atol_(atol) {}
+
+  MethodInfo info() const override {
+    switch (method_) {
+      case GslMethod::kRk8pd:
+        return {"gsl_rk8pd", 8, kExplicit | kAdaptive,
+                "GSL odeiv2 rk8pd: embedded Runge-Kutta Prince-Dormand (8, 9)"};
+      case GslMethod::kMsbdf:
+        // Variable order 1..5: the declared order is the maximum.
+        return {"gsl_msbdf", 5, kImplicit | kAdaptive | kNeedsHessian,
+                "GSL odeiv2 msbdf: variable-order BDF in Nordsieck form (Byrne & Hindmarsh)"};
+      case GslMethod::kRk4imp:
+        return {"gsl_rk4imp", 4, kImplicit | kAdaptive | kNeedsHessian,
+                "GSL odeiv2 rk4imp: 2-stage Gauss-Legendre implicit Runge-Kutta, step doubling"};
+    }
+    return {};
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    driver_.reset();
+    problem_ = &problem;
+    setup_status_ = StepStatus::success();
+    callback_error_.clear();
+    t_ = state.t;
+    const int dof = problem.dof();
+    y_.resize(2 * dof);
+    ydot_start_.resize(2 * dof);
+    Eigen::Map<Vec>(y_.data(), dof) = state.q;
+    Eigen::Map<Vec>(y_.data() + dof, dof) = state.p;
+    const bool needs_jacobian = method_ != GslMethod::kRk8pd;
+    if (needs_jacobian && !problem.has(kHessian)) {
+      setup_status_ = StepStatus::failure(
+          "needs_hessian",
+          fmt::format("{} needs the Jacobian, i.e. a problem Hessian", info().name));
+      return;
+    }
+    system_ = {&function, needs_jacobian ? &jacobian : nullptr, y_.size(), this};
+
+    if (function(t_, y_.data(), ydot_start_.data(), this) != GSL_SUCCESS) {
+      setup_status_ = StepStatus::failure("gsl_status_badfunc",
+                                          "f(t0, y0) is not finite or threw " + callback_error_);
+      return;
+    }
+    h_ = starting_step(y_buffer_, ydot_buffer_, rtol_, atol_);
+
+    const gsl_odeiv2_step_type* type = method_ == GslMethod::kRk8pd   ? gsl_odeiv2_step_rk8pd
+                                       : method_ == GslMethod::kMsbdf ? gsl_odeiv2_step_msbdf
+                                                                      : gsl_odeiv2_step_rk4imp;
+    // The driver owns step, control (standard y-control from atol/rtol) and evolve and wires
+    // them together; msbdf reads its error levels through it. Stepping itself is done with
+    // gsl_odeiv2_evolve_apply, which takes a single step (gsl_odeiv2_driver_apply would
+    // integrate to t1 in many).
+    const ScopedGslErrorsAsStatus errors_as_status;
+    driver_.reset(gsl_odeiv2_driver_alloc_y_new(&system_, type, h_, atol_, rtol_));
+    if (!driver_) {
+      setup_status_ =
+          StepStatus::failure("gsl_status_alloc", "gsl_odeiv2_driver_alloc_y_new failed");
+    }
+  }
+
+  StepStatus step(const Problem&, State&, double) override {
+    return StepStatus::failure(
+        "adaptive_only", "GSL odeiv2 wrappers are adaptive; the harness calls adaptive_step()");
+  }
+
+  StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
+    if (problem_ == nullptr)
+      return StepStatus::failure("not_reset", "adaptive_step before reset()");
+    if (!setup_status_.ok) return setup_status_;
+    if (&problem != problem_) {
+      return StepStatus::failure("problem_changed",
+                                 "adaptive_step called with another problem than reset()");
+    }
+    if (t_stop == state.t) return StepStatus::success();
+    if (!(t_stop > t_)) {
+      return StepStatus::failure(
+          "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
+    }
+    // evolve_apply lands exactly on t1 only when the proposed step exceeds t1 − t (it then
+    // stamps t = t1). A suggested step that would leave a sliver of less than 1% is stretched
+    // to cover it, so the run ends on t_stop without a tiny last step.
+    const double remaining = t_stop - t_;
+    const bool landing = t_ + 1.01 * h_ >= t_stop;
+    double h = landing ? 2 * remaining : h_;
+    double t = t_;
+    const unsigned long failed_before = driver_->e->failed_steps;
+    int status = GSL_SUCCESS;
+    {
+      const ScopedGslErrorsAsStatus errors_as_status;
+      status = gsl_odeiv2_evolve_apply(driver_->e, driver_->c, driver_->s, &system_, &t, t_stop, &h,
+                                       y_.data());
+    }
+    counters_.rejected += static_cast<long>(driver_->e->failed_steps - failed_before);
+    if (status != GSL_SUCCESS) {
+      std::string message = fmt::format("gsl_odeiv2_evolve_apply at t={:.6g}: {} (status {})", t_,
+                                        gsl_strerror(status), status);
+      if (!callback_error_.empty()) message += "; callback error: " + callback_error_;
+      return StepStatus::failure(fmt::format("gsl_status_{}", status), message);
+    }
+    ++counters_.steps;
+    // GSL leaves h untouched after the step that reaches t1; otherwise h is the next suggestion.
+    if (t != t_stop) h_ = h;
+    t_ = t;
+    const int dof = problem.dof();
+    state.q = Eigen::Map<const Vec>(y_.data(), dof);
+    state.p = Eigen::Map<const Vec>(y_.data() + dof, dof);
+    state.t = t_;
+    return StepStatus::success();
+  }
+
+ private:
+  // A non-finite derivative is a soft failure (GSL halves the step and retries); an exception is
+  // GSL_EBADFUNC, which ends the step at once.
+  static int function(double t, const double y[], double dydt[], void* self) {
+    auto& gsl = *static_cast<GslOdeiv2*>(self);
+    try {
+      const auto n = static_cast<Eigen::Index>(gsl.y_.size());
+      gsl.y_buffer_ = Eigen::Map<const Vec>(y, n);
+      gsl.problem_->first_order_rhs(t, gsl.y_buffer_, gsl.ydot_buffer_);
+      ++gsl.counters_.force_evals;
+      if (!gsl.ydot_buffer_.allFinite()) return GSL_ERANGE;
+      Eigen::Map<Vec>(dydt, n) = gsl.ydot_buffer_;
+      return GSL_SUCCESS;
+    } catch (const std::exception& error) {
+      gsl.callback_error_ = error.what();
+      return GSL_EBADFUNC;
+    }
+  }
+
+  // dfdy is row-major: dfdy[i·n + j] = ∂f_i/∂y_j. ∂f/∂t is zero unless a (possibly driven)
+  // force is present; then it is a central difference in t of the right-hand side.
+  static int jacobian(double t, const double y[], double* dfdy, double dfdt[], void* self) {
+    auto& gsl = *static_cast<GslOdeiv2*>(self);
+    try {
+      const auto n = static_cast<Eigen::Index>(gsl.y_.size());
+      gsl.y_buffer_ = Eigen::Map<const Vec>(y, n);
+      gsl.problem_->first_order_jacobian(t, gsl.y_buffer_, gsl.jacobian_);
+      ++gsl.counters_.hessian_evals;
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          dfdy, n, n) = Eigen::MatrixXd(gsl.jacobian_);
+      Eigen::Map<Vec> time_derivative(dfdt, n);
+      time_derivative.setZero();
+      if (gsl.problem_->has(kForce)) {
+        const double delta = 1e-7 * std::max(1.0, std::abs(t));
+        Vec plus, minus;
+        gsl.problem_->first_order_rhs(t + delta, gsl.y_buffer_, plus);
+        gsl.problem_->first_order_rhs(t - delta, gsl.y_buffer_, minus);
+        gsl.counters_.force_evals += 2;
+        time_derivative = (plus - minus) / (2 * delta);
+      }
+      return GSL_SUCCESS;
+    } catch (const std::exception& error) {
+      gsl.callback_error_ = error.what();
+      return GSL_EBADFUNC;
+    }
+  }
+
+  GslMethod method_;
+  double rtol_, atol_;
+  const Problem* problem_ = nullptr;
+  StepStatus setup_status_;
+  std::string callback_error_;
+  std::vector<double> y_;  // the solver's state of record (q, p)
+  std::vector<double> ydot_start_;
+  double t_ = 0.0;
+  double h_ = 0.0;  // step size carried across calls
+  gsl_odeiv2_system system_{};
+  Vec y_buffer_, ydot_buffer_;
+  SparseMatrix jacobian_;
+  DriverPtr driver_;  // references system_, so it is declared (and destroyed) after it
+};
+
+std::unique_ptr<Integrator> make_gsl(Params& params, GslMethod method) {
+  const double rtol = params.real(
+      "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
+  const double atol = params.real(
+      "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
+  return std::make_unique<GslOdeiv2>(method, rtol, atol);
+}
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_gsl_rk8pd(Params& params) {
+  return make_gsl(params, GslMethod::kRk8pd);
+}
+std::unique_ptr<Integrator> make_gsl_msbdf(Params& params) {
+  return make_gsl(params, GslMethod::kMsbdf);
+}
+std::unique_ptr<Integrator> make_gsl_rk4imp(Params& params) {
+  return make_gsl(params, GslMethod::kRk4imp);
+}
+
+}  // namespace geomint

@@ -1,0 +1,381 @@
+// Discrete Hamilton–Pontryagin integrator in (q, v, p) and its update as the minimisation of
+// E_k(v) = ½vᵀMv − p_kᵀv + ((1−α)/α)V(q_k + αhv) (PAPER.md §4; Kharevych et al. 2006, §4), with the
+// discrete Lagrange–d'Alembert force impulses of PAPER.md §2 (Marsden & West 2001, §3.2).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "integrators/integrator.hpp"
+#include "integrators/newton.hpp"
+
+namespace geomint {
+namespace {
+
+enum class ForceSlot { kMinus, kPlus, kSplit };
+enum class ForceAt { kNode, kMidpoint };
+
+// Same meaning as in discrete_lagrangian.cpp (see the forced-Noether note there).
+struct Forcing {
+  ForceSlot slot = ForceSlot::kPlus;
+  ForceAt at = ForceAt::kNode;
+  double minus_weight() const {
+    return slot == ForceSlot::kMinus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
+  }
+  double plus_weight() const {
+    return slot == ForceSlot::kPlus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
+  }
+};
+
+// Update from (q_k, p_k), with q^α = q_k + αhv and the impulses F_d∓ of the force_slot/force_at
+// options (defined as in discrete_lagrangian.cpp, whose α-rule is the same map):
+//   1. solve R(v) = Mv − p_k + (1−α)h∇V(q^α) − F_d⁻(v) = 0   (α = 0: ∇V(q_k), explicit)
+//   2. q_{k+1} = q_k + hv,   3. p_{k+1} = Mv − αh∇V(q^α) + F_d⁺(v).
+// v = (q_{k+1} − q_k)/h is the HP velocity variable; it is kept inside the integrator (velocity()),
+// State carries (q, p) only. α ∈ {0, 1} without an implicit impulse needs no solve (symplectic
+// Euler kick-first and drift-first); α = 1 has (1−α)/α = 0, so E_k is ½vᵀMv − p_kᵀv and nothing is
+// divided by α.
+//
+// Solvers (same start v₀ = M⁻¹p_k — then Σ(Mv − p_k) = 0 and every Newton update keeps it, so
+// linear momentum is exact through every iterate —, same tolerance ‖R‖ ≤ tol·max(1, ‖p_k‖ +
+// ‖p_k − b‖ + ‖(1−α)h∇V(q^α(v₀)) − F_d⁻(v₀)‖) with b = p_k (α > 0) or p_k − h∇V(q_k) (α = 0),
+// same polishing correction (NewtonOptions::polish), same sparse LDLT):
+//  - minimize: Newton on ∇E_k = R with an Armijo backtracking line search on E_k itself (counted
+//    in energy_evals) and an SPD safeguard: when the LDLT factor of the Hessian
+//    M + α(1−α)h²∇²V(q^α) (+ hC) has a non-positive pivot (non-convex V: springs or elements under
+//    compression, a pendulum past horizontal), M + α(1−α)h²∇²V + μM is factorised instead with
+//    μ = 10⁻³, 10⁻², … until every pivot is positive (NewtonSystem::spd_shift). The step is then a
+//    descent direction of E_k, so the iteration decreases E_k monotonically and cannot cycle;
+//    near a strict local minimiser the Hessian is SPD again and convergence is quadratic.
+//  - newton: plain Newton on R — full steps, no line search and no safeguard. This is the
+//    root-finding baseline of the paper's "> 2×" claim and deliberately has neither of the
+//    minimiser's globalisation devices: at large h it can cycle, diverge or land on a
+//    non-minimising stationary point where the minimiser succeeds.
+//
+// Forces and the minimiser. An impulse in the plus slot only enters step 3, so E_k is unchanged.
+// In the minus slot (or half of it, split) evaluated at the node q_k, a force that is affine in v
+// with a symmetric damping matrix, F(q_k, v) = F(q_k, 0) − C(q_k)v (linear damping: spring_net,
+// damped_oscillator), makes −F_d⁻ the gradient of the dissipation function
+// w⁻h[½vᵀC(q_k)v − F(q_k, 0)ᵀv], which is added to E_k exactly: the update stays a minimisation
+// (a Rayleigh-dissipation "incremental potential"). That structure is checked once per run (C
+// symmetric; F at a test velocity equal to the affine model). Otherwise — force_at=midpoint, where
+// F(q_k + (h/2)v, v) depends on v through q as well, non-symmetric C, or a force that is not affine
+// in v — R is not a gradient: minimize then falls back to Newton with a backtracking line search
+// on the merit ½‖R‖² (no objective, hence no SPD safeguard: the shifted step need not descend the
+// merit).
+class HamiltonPontryagin final : public Integrator {
+ public:
+  HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, double tolerance,
+                     int max_iterations)
+      : alpha_(alpha), minimize_(minimize), forcing_(forcing) {
+    NewtonOptions& options = newton_.options();
+    options.tolerance = tolerance;
+    options.max_iterations = max_iterations;
+    options.polish = true;  // momentum maps to round-off, not to the tolerance
+    options.line_search = minimize;
+  }
+
+  MethodInfo info() const override {
+    unsigned flags = kSymplectic | kVariational;
+    flags |= (alpha_ == 0.0 || alpha_ == 1.0) ? kExplicit : (kImplicit | kNeedsHessian);
+    if (alpha_ == 0.5) flags |= kSymmetric;
+    return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
+            "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
+            "§4; PAPER.md §4"};
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    newton_.forget_pattern();
+    damping_symmetric_.reset();
+    dissipation_potential_.reset();
+    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+  }
+
+  // The HP velocity v_{k+1} = (q_{k+1} − q_k)/h of the last step (p_{k+1} ≠ M v_{k+1} unless α =
+  // 0).
+  const Vec& velocity() const { return velocity_; }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    const Vec& mass = problem.mass();
+    const Vec& inverse_mass = problem.inverse_mass();
+    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
+      mass_diagonal_ = mass;
+      mass_matrix_ = SparseMatrix(mass.asDiagonal());
+    }
+    const bool forced = problem.has(kForce);
+    minus_ = forced ? forcing_.minus_weight() : 0.0;
+    const double plus = forced ? forcing_.plus_weight() : 0.0;
+    q0_ = state.q;
+    t0_ = state.t;
+    h_ = h;
+    memo_valid_ = false;
+    potential_memo_valid_ = false;
+
+    // b = p_k, or p_k − h∇V(q_k) for α = 0, where the potential impulse does not depend on v.
+    b_ = state.p;
+    if (alpha_ == 0.0) {
+      eval_gradient(problem, state.q, gradient_);
+      b_ -= h * gradient_;
+    }
+
+    Vec v = inverse_mass.cwiseProduct(state.p);
+    const bool coupled = alpha_ > 0.0 && alpha_ < 1.0;  // ∇V(q^α) depends on v
+    if (!coupled && minus_ == 0.0) {
+      v = inverse_mass.cwiseProduct(b_);  // E_k is quadratic with Hessian M: no solve
+    } else {
+      const StepStatus status = solve(problem, state, coupled, v);
+      if (!status.ok) return status;
+    }
+
+    // p_{k+1} = Mv − αh∇V(q^α) + F_d⁺.
+    const Vec q1 = state.q + h * v;
+    Vec p1 = mass.cwiseProduct(v);
+    if (coupled) {
+      implicit_terms(problem, v);  // no-op unless the last evaluation was elsewhere
+      p1 -= (alpha_ * h) * gradient_;
+    } else if (alpha_ == 1.0) {
+      eval_gradient(problem, q1, gradient_);
+      p1 -= h * gradient_;
+    }
+    if (plus > 0.0) {
+      const bool node = forcing_.at == ForceAt::kNode;
+      eval_counted_force(problem, node ? q1 : Vec(state.q + (h / 2) * v), v,
+                         node ? state.t + h : state.t + h / 2, force_);
+      p1 += (plus * h) * force_;
+    }
+    velocity_ = v;
+    state.q = q1;
+    state.p = p1;
+    state.t += h;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  StepStatus solve(const Problem& problem, const State& state, bool coupled, Vec& v) {
+    const Vec& mass = problem.mass();
+    if (minus_ > 0.0 && problem.has(kForceJacobian) && !damping_symmetric_) {
+      // Decided once per run: C = −∂F/∂v is symmetric for dissipative forces, not gyroscopic.
+      problem.force_jacobian_v(state.q, v, state.t, damping_);
+      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
+    }
+    // The exact-objective form needs −F_d⁻ to be a gradient in v (see the file comment).
+    linearised_ = false;
+    if (minimize_ && minus_ > 0.0 && forcing_.at == ForceAt::kNode && problem.has(kForceJacobian) &&
+        *damping_symmetric_) {
+      if (!dissipation_potential_) dissipation_potential_ = force_is_affine(problem, state, v);
+      if (*dissipation_potential_) {
+        // F(q_k, v) = F₀ − C₀v for this step; the residual uses the same model, so ∇E_k = R.
+        eval_counted_force(problem, q0_, Vec::Zero(v.size()), t0_, force_zero_);
+        problem.force_jacobian_v(q0_, Vec::Zero(v.size()), t0_, damping_zero_);
+        linearised_ = true;
+      }
+    }
+    const bool exact_objective = minimize_ && (minus_ == 0.0 || linearised_);
+
+    NewtonSystem system;
+    system.residual = [&](const Vec& x, Vec& residual) {
+      implicit_terms(problem, x);
+      residual = mass.cwiseProduct(x) - b_ + implicit_term_;
+    };
+    system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
+      jacobian = mass_matrix_;
+      if (coupled) {
+        eval_hessian(problem, q0_ + (alpha_ * h_) * x, hessian_);
+        jacobian += (alpha_ * (1 - alpha_) * h_ * h_) * hessian_;
+      }
+      if (minus_ > 0.0) add_impulse_jacobian(problem, x, jacobian);
+    };
+    system.symmetric = minus_ == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_);
+    if (exact_objective) {
+      // E_k and the sum of its terms' magnitudes (its round-off scale).
+      const auto terms = [&](const Vec& x, double& scale) {
+        const double kinetic = 0.5 * x.dot(mass.cwiseProduct(x));
+        const double linear = b_.dot(x);
+        double energy = kinetic - linear;
+        scale = std::abs(kinetic) + std::abs(linear);
+        if (coupled) {
+          // Memoised: the solver's first evaluation repeats the one at v₀ below.
+          if (!(potential_memo_valid_ && potential_memo_v_ == x)) {
+            potential_memo_ = eval_potential(problem, q0_ + (alpha_ * h_) * x);
+            potential_memo_v_ = x;
+            potential_memo_valid_ = true;
+          }
+          const double potential = ((1 - alpha_) / alpha_) * potential_memo_;
+          energy += potential;
+          scale += std::abs(potential);
+        }
+        if (linearised_) {
+          const double dissipation =
+              minus_ * h_ * (0.5 * x.dot(damping_zero_ * x) - force_zero_.dot(x));
+          energy += dissipation;
+          scale += std::abs(dissipation);
+        }
+        return energy;
+      };
+      system.objective = [&](const Vec& x) {
+        double scale = 0.0;
+        return terms(x, scale);
+      };
+      // E_k at v₀ is near −½p_kᵀM⁻¹p_k + V: its terms can cancel, so |E_k| understates the noise.
+      // V(x) itself is computed with an error of about ε(|V| + Σ|x_i||∂_iV|) — its terms, plus the
+      // rounding of the argument x (a pendulum after many turns, a net far from the origin).
+      terms(v, system.objective_scale);
+      if (coupled) {
+        implicit_terms(problem, v);  // memoised: ∇V(q^α(v₀))
+        system.objective_scale += ((1 - alpha_) / alpha_) *
+                                  (q0_ + (alpha_ * h_) * v).cwiseAbs().dot(gradient_.cwiseAbs());
+      }
+      system.spd_shift = mass_matrix_;
+    }
+
+    implicit_terms(problem, v);
+    const double residual_scale = state.p.norm() + (b_ - state.p).norm() + implicit_term_.norm();
+    const NewtonResult result = newton_.solve(system, v, residual_scale);
+    counters_.newton_iters += result.iterations;
+    // A shifted refactorisation costs what a linear solve costs: count it as one.
+    counters_.linear_solves += result.linear_solves + result.shift_factorisations;
+    if (!result.converged) {
+      return StepStatus::failure(result.reason,
+                                 fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),
+                                             minimize_ ? "minimize" : "newton", describe(result)));
+    }
+    return StepStatus::success();
+  }
+
+  // F(q_k, v) = F(q_k, 0) − C(q_k)v at a test velocity, and C independent of v: the structure
+  // that makes the minus impulse a dissipation gradient. Checked once per run.
+  bool force_is_affine(const Problem& problem, const State& state, const Vec& v_start) {
+    Vec v_test = v_start;
+    if (v_test.norm() == 0.0) v_test.setOnes();
+    Vec f_zero, f_test;
+    SparseMatrix c_zero, c_test;
+    eval_counted_force(problem, state.q, Vec::Zero(v_test.size()), state.t, f_zero);
+    eval_counted_force(problem, state.q, v_test, state.t, f_test);
+    problem.force_jacobian_v(state.q, Vec::Zero(v_test.size()), state.t, c_zero);
+    problem.force_jacobian_v(state.q, v_test, state.t, c_test);
+    const Vec model = f_zero - c_zero * v_test;
+    const double scale = f_test.norm() + f_zero.norm() + (c_zero * v_test).norm();
+    return (f_test - model).norm() <= 1e-12 * scale &&
+           (c_test - c_zero).norm() <= 1e-12 * c_zero.norm();
+  }
+
+  void eval_counted_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {
+    ++counters_.force_evals;
+    eval_force(problem, q, v, t, f);
+  }
+
+  // F_d⁻(v) = w⁻·h·F(x⁻, v, t⁻) with x⁻ = q_k (node) or q_k + (h/2)v (midpoint).
+  void minus_impulse(const Problem& problem, const Vec& v, Vec& impulse) {
+    if (linearised_) {
+      impulse = force_zero_ - damping_zero_ * v;
+    } else if (forcing_.at == ForceAt::kNode) {
+      eval_counted_force(problem, q0_, v, t0_, impulse);
+    } else {
+      eval_counted_force(problem, q0_ + (h_ / 2) * v, v, t0_ + h_ / 2, impulse);
+    }
+    impulse *= minus_ * h_;
+  }
+
+  // implicit_term_ = (1−α)h∇V(q^α(v)) − F_d⁻(v), memoised on v so that the gradient at the
+  // accepted iterate is reused for p_{k+1}.
+  void implicit_terms(const Problem& problem, const Vec& v) {
+    if (memo_valid_ && memo_v_ == v) return;
+    implicit_term_.setZero(v.size());
+    if (alpha_ > 0.0 && alpha_ < 1.0) {
+      eval_gradient(problem, q0_ + (alpha_ * h_) * v, gradient_);
+      implicit_term_ += ((1 - alpha_) * h_) * gradient_;
+    }
+    if (minus_ > 0.0) {
+      minus_impulse(problem, v, impulse_);
+      implicit_term_ -= impulse_;
+    }
+    memo_valid_ = true;
+    memo_v_ = v;
+  }
+
+  // −∂F_d⁻/∂v = w⁻·h·C. Exact at the node; at the midpoint the (h/2)∂F/∂q part is left out
+  // (problems do not provide it): only the Newton matrix is approximate, not the solution.
+  void add_impulse_jacobian(const Problem& problem, const Vec& v, SparseMatrix& jacobian) {
+    const bool node = forcing_.at == ForceAt::kNode;
+    if (linearised_) {
+      jacobian += (minus_ * h_) * damping_zero_;
+    } else if (problem.has(kForceJacobian)) {
+      problem.force_jacobian_v(node ? q0_ : Vec(q0_ + (h_ / 2) * v), v, node ? t0_ : t0_ + h_ / 2,
+                               damping_);
+      jacobian += (minus_ * h_) * damping_;
+    } else {
+      jacobian -= central_difference_jacobian(
+          [&](const Vec& x, Vec& impulse) {
+            eval_force(problem, node ? q0_ : Vec(q0_ + (h_ / 2) * x), x, node ? t0_ : t0_ + h_ / 2,
+                       impulse);
+            impulse *= minus_ * h_;
+          },
+          v);
+      counters_.force_evals += 2 * v.size();
+    }
+  }
+
+  double alpha_;
+  bool minimize_;
+  Forcing forcing_;
+  NewtonSolver newton_;
+  Vec velocity_;  // HP velocity v_{k+1}
+
+  // Per-step data used by the residual and objective.
+  Vec q0_, b_;
+  double t0_ = 0.0, h_ = 0.0, minus_ = 0.0;
+  bool linearised_ = false;
+  Vec force_zero_;             // F(q_k, 0) in the dissipation-potential form
+  SparseMatrix damping_zero_;  // C(q_k) in the dissipation-potential form
+  Vec implicit_term_, impulse_, gradient_, force_;
+  bool memo_valid_ = false;
+  Vec memo_v_;
+  bool potential_memo_valid_ = false;
+  double potential_memo_ = 0.0;  // V(q^α(potential_memo_v_))
+  Vec potential_memo_v_;
+
+  Vec mass_diagonal_;
+  SparseMatrix mass_matrix_, hessian_, damping_;
+  std::optional<bool> damping_symmetric_;      // C = Cᵀ, decided on the first forced solve
+  std::optional<bool> dissipation_potential_;  // F affine in v at the node, decided once per run
+};
+
+Forcing read_forcing(Params& params) {
+  Forcing forcing;
+  const std::string slot =
+      params.choice("force_slot", "plus", {"minus", "plus", "split"},
+                    "where the step's force impulse h F goes: F_d- (at q_k), F_d+ (at q_k+1), half "
+                    "each");
+  forcing.slot = slot == "minus"  ? ForceSlot::kMinus
+                 : slot == "plus" ? ForceSlot::kPlus
+                                  : ForceSlot::kSplit;
+  const std::string at =
+      params.choice("force_at", "node", {"node", "midpoint"},
+                    "evaluate each impulse's force at its own node, or at q_k+1/2 for all slots");
+  forcing.at = at == "node" ? ForceAt::kNode : ForceAt::kMidpoint;
+  return forcing;
+}
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_hp(Params& params) {
+  const double alpha = params.real(
+      "alpha", 0.5, "position of the potential's node q_k + alpha h v, in [0, 1]",
+      [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+  const std::string solver = params.choice(
+      "solver", "minimize", {"minimize", "newton"},
+      "minimise E_k with line search and SPD safeguard, or plain Newton on the residual");
+  const Forcing forcing = read_forcing(params);
+  const double tolerance = params.real(
+      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|grad V| + |F_d-|)",
+      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
+  const long max_iterations =
+      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", forcing, tolerance,
+                                              static_cast<int>(max_iterations));
+}
+
+}  // namespace geomint

@@ -1,0 +1,134 @@
+// Implicit midpoint rule y₁ = y₀ + h f((y₀ + y₁)/2) on y = (q, p) with forces (Hairer, Lubich &
+// Wanner, GNI §II.1 and §VI.3; PAPER.md §1: for constant M it is the variational midpoint rule
+// L_d = h L((q_k + q_{k+1})/2, v) and HP with α = ½; Marsden & West 2001, §2.6).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <optional>
+
+#include "integrators/integrator.hpp"
+#include "integrators/newton.hpp"
+
+namespace geomint {
+namespace {
+
+// With q̄ = (q₀ + q₁)/2 and p̄ = (p₀ + p₁)/2 the rule reads q̄ − q₀ = (h/2)M⁻¹p̄ and
+// p̄ = p₀ + (h/2)[−∇V(q̄) + F(q̄, M⁻¹p̄, t + h/2)]. The unknown is the midpoint velocity
+// v̄ = M⁻¹p̄ = 2(q̄ − q₀)/h (q̄ itself up to an affine change of variables, which keeps the matrix
+// M-scaled and symmetric):
+//   R(v̄) = M v̄ − p₀ + (h/2)∇V(q₀ + (h/2)v̄) − (h/2)F(q₀ + (h/2)v̄, v̄, t + h/2) = 0,
+//   ∂R/∂v̄ = M + (h²/4)∇²V(q̄) + (h/2)C(q̄, v̄)   (C = −∂F/∂v; the (h²/4)∂F/∂q part is left out as
+//   in implicit_euler, or the whole force part is differenced without force_jacobian_v),
+// then q₁ = q₀ + h v̄ and p₁ = 2M v̄ − p₀. Declared variational: for constant M this is exactly
+// the DEL map of the midpoint discrete Lagrangian (del:rule=midpoint, hp:alpha=0.5), and with a
+// force it is that map with F_d⁻ = F_d⁺ = (h/2)F(q̄, v̄) (force_slot=split, force_at=midpoint).
+class ImplicitMidpoint final : public Integrator {
+ public:
+  ImplicitMidpoint(double tolerance, int max_iterations) {
+    newton_.options().tolerance = tolerance;
+    newton_.options().max_iterations = max_iterations;
+    newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
+  }
+
+  MethodInfo info() const override {
+    return {"implicit_midpoint", 2,
+            kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
+            "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; PAPER.md §1"};
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    newton_.forget_pattern();
+    damping_symmetric_.reset();
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    const Vec& mass = problem.mass();
+    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
+      mass_diagonal_ = mass;
+      mass_matrix_ = SparseMatrix(mass.asDiagonal());
+    }
+    const bool forced = problem.has(kForce);
+    const double t_mid = state.t + h / 2;
+    Vec v = problem.inverse_mass().cwiseProduct(state.p);
+    if (forced && problem.has(kForceJacobian) && !damping_symmetric_) {
+      problem.force_jacobian_v(state.q, v, state.t, damping_);
+      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
+    }
+
+    // −(h/2)[−∇V(q̄) + F(q̄, v̄, t + h/2)], the implicit part of R, memoised on v̄ (the solver's
+    // first evaluation repeats the one for the residual scale).
+    bool memo_valid = false;
+    Vec memo_v;
+    const auto impulse = [&](const Vec& x, Vec& out) {
+      if (memo_valid && memo_v == x) return;
+      memo_valid = true;
+      memo_v = x;
+      const Vec q_mid = state.q + (h / 2) * x;
+      eval_gradient(problem, q_mid, out);
+      if (forced) {
+        ++counters_.force_evals;
+        eval_force(problem, q_mid, x, t_mid, force_);
+        out -= force_;
+      }
+      out *= h / 2;
+    };
+    NewtonSystem system;
+    system.residual = [&](const Vec& x, Vec& residual) {
+      impulse(x, impulse_);
+      residual = mass.cwiseProduct(x) - state.p + impulse_;
+    };
+    system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
+      const Vec q_mid = state.q + (h / 2) * x;
+      eval_hessian(problem, q_mid, hessian_);
+      jacobian = mass_matrix_ + (h * h / 4) * hessian_;
+      if (!forced) return;
+      if (problem.has(kForceJacobian)) {
+        problem.force_jacobian_v(q_mid, x, t_mid, damping_);
+        jacobian += (h / 2) * damping_;
+      } else {
+        jacobian -= (h / 2) * central_difference_jacobian(
+                                  [&](const Vec& y, Vec& f) {
+                                    eval_force(problem, state.q + (h / 2) * y, y, t_mid, f);
+                                  },
+                                  x);
+        counters_.force_evals += 2 * x.size();
+      }
+    };
+    system.symmetric = !forced || (problem.has(kForceJacobian) && *damping_symmetric_);
+
+    // Start v̄ = M⁻¹p₀ (linear momentum exact through every iterate, as for del and hp).
+    impulse(v, impulse_);
+    const double residual_scale = state.p.norm() + impulse_.norm();
+    const NewtonResult result = newton_.solve(system, v, residual_scale);
+    counters_.newton_iters += result.iterations;
+    counters_.linear_solves += result.linear_solves;
+    if (!result.converged) return StepStatus::failure(result.reason, describe(result));
+
+    state.q += h * v;
+    state.p = 2 * mass.cwiseProduct(v) - state.p;
+    state.t += h;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
+ private:
+  NewtonSolver newton_;
+  Vec mass_diagonal_;
+  SparseMatrix mass_matrix_, hessian_, damping_;
+  std::optional<bool> damping_symmetric_;
+  Vec impulse_, force_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_implicit_midpoint(Params& params) {
+  const double tolerance = params.real(
+      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|F|/2)",
+      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
+  const long max_iterations =
+      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  return std::make_unique<ImplicitMidpoint>(tolerance, static_cast<int>(max_iterations));
+}
+
+}  // namespace geomint

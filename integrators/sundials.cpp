@@ -1,0 +1,762 @@
+// SUNDIALS 6.4 wrappers: CVODE (BDF/Adams), IDA on y' − f(t, y) = 0, ARKODE explicit RK (Hindmarsh
+// et al., ACM TOMS 31 (2005); user guides v6.4.1 at sundials.readthedocs.io). Each adaptive_step
+// is one internal step: *_ONE_STEP with the stop time at t_stop.
+#include <arkode/arkode_arkstep.h>
+#include <arkode/arkode_erkstep.h>
+#include <cvode/cvode.h>
+#include <fmt/format.h>
+#include <ida/ida.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+
+namespace geomint {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// RAII for SUNDIALS handles. Members holding them are declared context first, solver memory
+// last, so destruction frees the solver before the objects it references.
+
+struct ContextDeleter {
+  void operator()(SUNContext context) const { SUNContext_Free(&context); }
+};
+struct VectorDeleter {
+  void operator()(N_Vector vector) const { N_VDestroy(vector); }
+};
+struct MatrixDeleter {
+  void operator()(SUNMatrix matrix) const { SUNMatDestroy(matrix); }
+};
+struct LinearSolverDeleter {
+  void operator()(SUNLinearSolver solver) const { SUNLinSolFree(solver); }
+};
+struct CvodeDeleter {
+  void operator()(void* memory) const { CVodeFree(&memory); }
+};
+struct IdaDeleter {
+  void operator()(void* memory) const { IDAFree(&memory); }
+};
+struct FreeDeleter {
+  void operator()(char* text) const { std::free(text); }
+};
+
+using ContextPtr = std::unique_ptr<std::remove_pointer_t<SUNContext>, ContextDeleter>;
+using VectorPtr = std::unique_ptr<std::remove_pointer_t<N_Vector>, VectorDeleter>;
+using MatrixPtr = std::unique_ptr<std::remove_pointer_t<SUNMatrix>, MatrixDeleter>;
+using LinearSolverPtr =
+    std::unique_ptr<std::remove_pointer_t<SUNLinearSolver>, LinearSolverDeleter>;
+template <typename Deleter>
+using MemoryPtr = std::unique_ptr<void, Deleter>;
+
+// The *GetReturnFlagName functions return malloc'ed text.
+std::string flag_name(char* (*lookup)(long), int flag) {
+  const std::unique_ptr<char, FreeDeleter> name(lookup(flag));
+  return name ? std::string(name.get()) : std::string("unknown flag");
+}
+
+Eigen::Map<const Vec> view(N_Vector v) {
+  return {N_VGetArrayPointer(v), static_cast<Eigen::Index>(N_VGetLength(v))};
+}
+Eigen::Map<Vec> view_mutable(N_Vector v) {
+  return {N_VGetArrayPointer(v), static_cast<Eigen::Index>(N_VGetLength(v))};
+}
+
+// A = scale·J + shift·I into a dense SUNMatrix (column-major).
+void fill_dense(const SparseMatrix& jacobian, double scale, double shift, SUNMatrix matrix) {
+  SUNMatZero(matrix);
+  for (int col = 0; col < jacobian.outerSize(); ++col) {
+    sunrealtype* column = SUNDenseMatrix_Column(matrix, col);
+    for (SparseMatrix::InnerIterator it(jacobian, col); it; ++it) {
+      column[it.row()] += scale * it.value();
+    }
+    column[col] += shift;
+  }
+}
+
+// Parameters shared by every SUNDIALS wrapper.
+struct SundialsSettings {
+  double rtol = 1e-8;
+  double atol = 1e-10;
+  long max_steps = 1000000;
+};
+
+SundialsSettings read_settings(Params& params) {
+  SundialsSettings settings;
+  settings.rtol = params.real(
+      "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
+  settings.atol = params.real(
+      "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
+  settings.max_steps = params.integer(
+      "max_steps", 1000000,
+      "maximum number of internal steps over the whole run (the run fails with flag -1, "
+      "TOO_MUCH_WORK, when it is reached)",
+      1, 1000000000000L);
+  return settings;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared plumbing: context, callbacks into the Problem (first_order_rhs/first_order_jacobian),
+// error capture and the run-total step limit.
+//
+// reset() creates the solver; setup problems become setup_status_, reported by the first
+// adaptive_step, because reset() has no status to return. The solver's own y is the state of
+// record: after each step it is copied into State, and edits to State between steps are ignored.
+class SundialsIntegrator : public Integrator {
+ public:
+  StepStatus step(const Problem&, State&, double) override {
+    return StepStatus::failure("adaptive_only",
+                               "SUNDIALS wrappers are adaptive; the harness calls adaptive_step()");
+  }
+
+ protected:
+  SundialsIntegrator(const SundialsSettings& settings, std::string library)
+      : settings_(settings), library_(std::move(library)) {}
+
+  // Base reset, a fresh context and y0 = (q, p). Returns false (setup_status_ set) on failure.
+  bool begin_reset(const Problem& problem, const State& state) {
+    Integrator::reset(problem, state, 0.0);
+    problem_ = &problem;
+    setup_status_ = StepStatus::success();
+    library_message_.clear();
+    callback_error_.clear();
+    extra_rhs_evals_ = extra_jacobian_evals_ = 0;
+    t_ = state.t;
+    n_ = 2 * problem.dof();
+    y_.reset();  // before the context it was created in
+    context_.reset();
+    SUNContext context = nullptr;
+    if (SUNContext_Create(nullptr, &context) != 0) {
+      return setup_failed(-1, "SUNContext_Create failed");
+    }
+    context_.reset(context);
+    y_.reset(N_VNew_Serial(n_, context_.get()));
+    if (!y_) return setup_failed(-1, "N_VNew_Serial failed");
+    auto y = view_mutable(y_.get());
+    y.head(problem.dof()) = state.q;
+    y.tail(problem.dof()) = state.p;
+    return true;
+  }
+
+  // Records a failed library call during setup (only the first failure is kept).
+  bool setup_failed(int flag, const std::string& what) {
+    if (setup_status_.ok) {
+      setup_status_ = StepStatus::failure(fmt::format("{}_flag_{}", library_, flag),
+                                          fmt::format("{} setup: {}", library_, what));
+    }
+    return false;
+  }
+  bool check_setup(int flag, const char* call) {
+    if (flag >= 0) return true;
+    return setup_failed(flag, fmt::format("{} returned {} {}", call, flag, library_message_));
+  }
+
+  // Guards shared by every adaptive_step before it asks the library for a step. Returns false
+  // with `status` set when no library step should be taken (setup failure, t_stop reached or
+  // behind, or the run-total step limit).
+  bool ready_to_step(const Problem& problem, const State& state, double t_stop, long steps_taken,
+                     StepStatus& status) {
+    status = StepStatus::success();
+    if (problem_ == nullptr) {
+      status = StepStatus::failure("not_reset", "adaptive_step called before reset()");
+      return false;
+    }
+    if (!setup_status_.ok) {
+      status = setup_status_;
+      return false;
+    }
+    if (&problem != problem_) {
+      status = StepStatus::failure("problem_changed",
+                                   "adaptive_step called with another problem than reset()");
+      return false;
+    }
+    if (t_stop == state.t) return false;
+    if (!(t_stop > t_)) {
+      status = StepStatus::failure(
+          "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
+      return false;
+    }
+    // SUNDIALS applies mxstep per call, and in ONE_STEP mode every call takes one step, so the
+    // run-total limit is enforced here and reported as the library's TOO_MUCH_WORK flag (-1).
+    if (steps_taken >= settings_.max_steps) {
+      status = StepStatus::failure(
+          fmt::format("{}_flag_-1", library_),
+          fmt::format("{}: too much work: max_steps={} internal steps taken before t={:.6g}",
+                      library_, settings_.max_steps, t_));
+      return false;
+    }
+    return true;
+  }
+
+  StepStatus library_failure(int flag, char* (*lookup)(long int)) {
+    std::string message =
+        fmt::format("{} returned {} ({})", library_, flag_name(lookup, flag), flag);
+    if (!library_message_.empty()) message += ": " + library_message_;
+    if (!callback_error_.empty()) message += "; callback error: " + callback_error_;
+    return StepStatus::failure(fmt::format("{}_flag_{}", library_, flag), message);
+  }
+
+  // Copies the solver's y (the state of record) into State. A return at the stop time is
+  // stamped with t_stop exactly, so the caller's loop ends on it without a sliver step.
+  void publish(N_Vector y, double t_returned, double t_stop, bool at_stop, State& state) {
+    const auto values = view(y);
+    const int dof = n_ / 2;
+    state.q = values.head(dof);
+    state.p = values.tail(dof);
+    t_ = at_stop ? t_stop : t_returned;
+    state.t = t_;
+  }
+
+  // y' = f(t, y). A non-finite derivative is reported as recoverable (positive return), so the
+  // solver retries with a smaller step; an exception is unrecoverable and its text is kept.
+  int evaluate_rhs(double t, N_Vector y, N_Vector ydot) noexcept {
+    try {
+      y_buffer_ = view(y);
+      problem_->first_order_rhs(t, y_buffer_, ydot_buffer_);
+      if (!ydot_buffer_.allFinite()) return 1;
+      view_mutable(ydot) = ydot_buffer_;
+      return 0;
+    } catch (const std::exception& error) {
+      callback_error_ = error.what();
+      return -1;
+    }
+  }
+
+  // jacobian_ = ∂f/∂y at (t, y).
+  int evaluate_jacobian(double t, N_Vector y) noexcept {
+    try {
+      y_buffer_ = view(y);
+      problem_->first_order_jacobian(t, y_buffer_, jacobian_);
+      jacobian_.makeCompressed();
+      return 0;
+    } catch (const std::exception& error) {
+      callback_error_ = error.what();
+      return -1;
+    }
+  }
+
+  // Keeps the library's last error text for the failure message instead of printing it.
+  static void record_message(int, const char* module, const char* function, char* message,
+                             void* self) {
+    static_cast<SundialsIntegrator*>(self)->library_message_ = fmt::format(
+        "[{} {}] {}", module ? module : "", function ? function : "", message ? message : "");
+  }
+
+  SundialsSettings settings_;
+  std::string library_;  // flag prefix: "cvode", "ida", "arkode"
+  const Problem* problem_ = nullptr;
+  int n_ = 0;
+  double t_ = 0.0;  // time of the solver's current y
+  StepStatus setup_status_;
+  std::string library_message_;
+  std::string callback_error_;
+  long extra_rhs_evals_ = 0;       // evaluations made outside the library (IDA's y'(0))
+  long extra_jacobian_evals_ = 0;  // ... (the KLU sparsity probe)
+  Vec y_buffer_, ydot_buffer_;
+  SparseMatrix jacobian_;
+
+  // Declared in this order so that derived classes' solver memory (declared later) goes first.
+  ContextPtr context_;
+  VectorPtr y_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// CVODE: variable-order BDF (stiff) or Adams–Moulton (non-stiff), Newton iteration with the
+// analytic Jacobian when the problem has a Hessian, else SUNDIALS's difference quotients.
+// MethodInfo::order is the maximum order; the registry-driven order fits skip adaptive methods.
+
+enum class LinearSolverKind { kDense, kKlu };
+
+class Cvode final : public SundialsIntegrator {
+ public:
+  Cvode(bool bdf, const SundialsSettings& settings, int max_order, LinearSolverKind solver)
+      : SundialsIntegrator(settings, "cvode"),
+        bdf_(bdf),
+        max_order_(max_order),
+        solver_kind_(solver) {}
+
+  MethodInfo info() const override {
+    return {bdf_ ? "cvode_bdf" : "cvode_adams", max_order_, kImplicit | kAdaptive,
+            bdf_ ? "SUNDIALS CVODE, variable-order BDF (CVODE user guide v6.4.1, §2.1)"
+                 : "SUNDIALS CVODE, variable-order Adams-Moulton (CVODE user guide v6.4.1, §2.1)"};
+  }
+
+  void reset(const Problem& problem, const State& state, double) override {
+    memory_.reset();
+    linear_solver_.reset();
+    matrix_.reset();
+    if (!begin_reset(problem, state)) return;
+    memory_.reset(CVodeCreate(bdf_ ? CV_BDF : CV_ADAMS, context_.get()));
+    if (!memory_) {
+      setup_failed(-1, "CVodeCreate failed");
+      return;
+    }
+    void* cvode = memory_.get();
+    if (!check_setup(CVodeSetErrHandlerFn(cvode, &record_message, this), "CVodeSetErrHandlerFn") ||
+        !check_setup(CVodeInit(cvode, &rhs, state.t, y_.get()), "CVodeInit") ||
+        !check_setup(CVodeSetUserData(cvode, this), "CVodeSetUserData") ||
+        !check_setup(CVodeSStolerances(cvode, settings_.rtol, settings_.atol),
+                     "CVodeSStolerances") ||
+        !check_setup(CVodeSetMaxOrd(cvode, max_order_), "CVodeSetMaxOrd")) {
+      return;
+    }
+    const bool analytic = problem.has(kHessian);
+    analytic_jacobian_ = analytic;
+    if (solver_kind_ == LinearSolverKind::kKlu) {
+      if (!analytic) {
+        setup_status_ = StepStatus::failure(
+            "needs_hessian", "linear_solver=klu needs the sparse Jacobian, i.e. a problem Hessian");
+        return;
+      }
+      // Size the sparse matrix from the Jacobian at y0 plus its diagonal (see fill_sparse).
+      ++extra_jacobian_evals_;
+      if (evaluate_jacobian(state.t, y_.get()) != 0) {
+        setup_failed(-1, "first_order_jacobian threw: " + callback_error_);
+        return;
+      }
+      matrix_.reset(SUNSparseMatrix(n_, n_, jacobian_.nonZeros() + n_, CSC_MAT, context_.get()));
+      if (matrix_) linear_solver_.reset(SUNLinSol_KLU(y_.get(), matrix_.get(), context_.get()));
+    } else {
+      matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
+      if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
+    }
+    if (!matrix_ || !linear_solver_) {
+      setup_failed(-1, "could not create the matrix or linear solver");
+      return;
+    }
+    pattern_columns_.clear();
+    pattern_rows_.clear();
+    if (!check_setup(CVodeSetLinearSolver(cvode, linear_solver_.get(), matrix_.get()),
+                     "CVodeSetLinearSolver")) {
+      return;
+    }
+    if (analytic) check_setup(CVodeSetJacFn(cvode, &jacobian), "CVodeSetJacFn");
+  }
+
+  StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
+    StepStatus status;
+    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    void* cvode = memory_.get();
+    int flag = CVodeSetStopTime(cvode, t_stop);
+    double t_returned = t_;
+    if (flag >= 0) flag = CVode(cvode, t_stop, y_.get(), &t_returned, CV_ONE_STEP);
+    update_counters();
+    if (flag < 0) return library_failure(flag, &CVodeGetReturnFlagName);
+    publish(y_.get(), t_returned, t_stop, flag == CV_TSTOP_RETURN || t_returned >= t_stop, state);
+    return StepStatus::success();
+  }
+
+ private:
+  static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* self) {
+    return static_cast<Cvode*>(self)->evaluate_rhs(t, y, ydot);
+  }
+
+  static int jacobian(sunrealtype t, N_Vector y, N_Vector, SUNMatrix matrix, void* self, N_Vector,
+                      N_Vector, N_Vector) {
+    auto& cvode = *static_cast<Cvode*>(self);
+    if (const int flag = cvode.evaluate_jacobian(t, y); flag != 0) return flag;
+    if (cvode.solver_kind_ == LinearSolverKind::kDense) {
+      fill_dense(cvode.jacobian_, 1.0, 0.0, matrix);
+      return 0;
+    }
+    return cvode.fill_sparse(matrix);
+  }
+
+  // Writes jacobian_ into the CSC matrix with an explicit (possibly zero) diagonal: CVODE forms
+  // I − γJ in place, and a stored diagonal keeps that from restructuring the matrix. KLU
+  // re-factors with the symbolic analysis of its first factorization, so a changed pattern (a
+  // Hessian entry that became an exact zero and was dropped) forces a new analysis.
+  int fill_sparse(SUNMatrix matrix) {
+    columns_.assign(1, 0);
+    rows_.clear();
+    values_.clear();
+    for (int col = 0; col < n_; ++col) {
+      bool diagonal_done = false;
+      for (SparseMatrix::InnerIterator it(jacobian_, col); it; ++it) {
+        if (!diagonal_done && it.row() >= col) {
+          if (it.row() > col) {
+            rows_.push_back(col);
+            values_.push_back(0.0);
+          }
+          diagonal_done = true;
+        }
+        rows_.push_back(it.row());
+        values_.push_back(it.value());
+      }
+      if (!diagonal_done) {
+        rows_.push_back(col);
+        values_.push_back(0.0);
+      }
+      columns_.push_back(static_cast<sunindextype>(rows_.size()));
+    }
+    const auto nonzeros = static_cast<sunindextype>(rows_.size());
+    if (SUNSparseMatrix_NNZ(matrix) < nonzeros &&
+        SUNSparseMatrix_Reallocate(matrix, nonzeros) != 0) {
+      callback_error_ = "SUNSparseMatrix_Reallocate failed";
+      return -1;
+    }
+    std::copy(columns_.begin(), columns_.end(), SUNSparseMatrix_IndexPointers(matrix));
+    std::copy(rows_.begin(), rows_.end(), SUNSparseMatrix_IndexValues(matrix));
+    std::copy(values_.begin(), values_.end(), SUNSparseMatrix_Data(matrix));
+    if (columns_ != pattern_columns_ || rows_ != pattern_rows_) {
+      if (!pattern_columns_.empty() &&
+          SUNLinSol_KLUReInit(linear_solver_.get(), matrix, nonzeros, SUNKLU_REINIT_PARTIAL) != 0) {
+        callback_error_ = "SUNLinSol_KLUReInit failed";
+        return -1;
+      }
+      pattern_columns_ = columns_;
+      pattern_rows_ = rows_;
+    }
+    return 0;
+  }
+
+  void update_counters() {
+    void* cvode = memory_.get();
+    long steps = 0, rhs_evals = 0, rhs_evals_ls = 0, jacobian_evals = 0, newton_iters = 0,
+         error_test_fails = 0, solve_fails = 0;
+    CVodeGetNumSteps(cvode, &steps);
+    CVodeGetNumRhsEvals(cvode, &rhs_evals);
+    CVodeGetNumLinRhsEvals(cvode, &rhs_evals_ls);
+    CVodeGetNumJacEvals(cvode, &jacobian_evals);
+    CVodeGetNumNonlinSolvIters(cvode, &newton_iters);
+    CVodeGetNumErrTestFails(cvode, &error_test_fails);
+    CVodeGetNumStepSolveFails(cvode, &solve_fails);
+    counters_.steps = steps;
+    counters_.force_evals = rhs_evals + rhs_evals_ls + extra_rhs_evals_;
+    // Difference-quotient Jacobians evaluate no Hessian; their f calls are in rhs_evals_ls.
+    counters_.hessian_evals = analytic_jacobian_ ? jacobian_evals + extra_jacobian_evals_ : 0;
+    counters_.newton_iters = newton_iters;
+    counters_.linear_solves = newton_iters;  // direct solver: one solve per Newton iteration
+    counters_.rejected = error_test_fails + solve_fails;
+  }
+
+  bool bdf_;
+  bool analytic_jacobian_ = false;
+  int max_order_;
+  LinearSolverKind solver_kind_;
+  std::vector<sunindextype> columns_, rows_, pattern_columns_, pattern_rows_;
+  std::vector<double> values_;
+  MatrixPtr matrix_;
+  LinearSolverPtr linear_solver_;
+  MemoryPtr<CvodeDeleter> memory_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// IDA on F(t, y, y') = y' − f(t, y) = 0 (no algebraic part yet; constraints come later). The
+// initial y'(0) = f(0, y0) is consistent by construction, so IDACalcIC is not needed. Newton
+// matrix dF/dy + c_j dF/dy' = c_j I − ∂f/∂y, dense.
+class Ida final : public SundialsIntegrator {
+ public:
+  Ida(const SundialsSettings& settings, int max_order)
+      : SundialsIntegrator(settings, "ida"), max_order_(max_order) {}
+
+  MethodInfo info() const override {
+    return {"ida", max_order_, kImplicit | kAdaptive,
+            "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
+  }
+
+  void reset(const Problem& problem, const State& state, double) override {
+    memory_.reset();
+    linear_solver_.reset();
+    matrix_.reset();
+    yp_.reset();
+    if (!begin_reset(problem, state)) return;
+    yp_.reset(N_VNew_Serial(n_, context_.get()));
+    if (!yp_) {
+      setup_failed(-1, "N_VNew_Serial failed");
+      return;
+    }
+    ++extra_rhs_evals_;
+    if (evaluate_rhs(state.t, y_.get(), yp_.get()) != 0) {
+      setup_failed(-1, "f(t0, y0) is not finite or threw " + callback_error_);
+      return;
+    }
+    memory_.reset(IDACreate(context_.get()));
+    if (!memory_) {
+      setup_failed(-1, "IDACreate failed");
+      return;
+    }
+    void* ida = memory_.get();
+    if (!check_setup(IDASetErrHandlerFn(ida, &record_message, this), "IDASetErrHandlerFn") ||
+        !check_setup(IDAInit(ida, &residual, state.t, y_.get(), yp_.get()), "IDAInit") ||
+        !check_setup(IDASetUserData(ida, this), "IDASetUserData") ||
+        !check_setup(IDASStolerances(ida, settings_.rtol, settings_.atol), "IDASStolerances") ||
+        !check_setup(IDASetMaxOrd(ida, max_order_), "IDASetMaxOrd")) {
+      return;
+    }
+    matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
+    if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
+    if (!matrix_ || !linear_solver_) {
+      setup_failed(-1, "could not create the dense matrix or linear solver");
+      return;
+    }
+    if (!check_setup(IDASetLinearSolver(ida, linear_solver_.get(), matrix_.get()),
+                     "IDASetLinearSolver")) {
+      return;
+    }
+    analytic_jacobian_ = problem.has(kHessian);
+    if (analytic_jacobian_) check_setup(IDASetJacFn(ida, &jacobian), "IDASetJacFn");
+  }
+
+  StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
+    StepStatus status;
+    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    void* ida = memory_.get();
+    int flag = IDASetStopTime(ida, t_stop);
+    double t_returned = t_;
+    if (flag >= 0) flag = IDASolve(ida, t_stop, &t_returned, y_.get(), yp_.get(), IDA_ONE_STEP);
+    update_counters();
+    if (flag < 0) return library_failure(flag, &IDAGetReturnFlagName);
+    publish(y_.get(), t_returned, t_stop, flag == IDA_TSTOP_RETURN || t_returned >= t_stop, state);
+    return StepStatus::success();
+  }
+
+ private:
+  // F = y' − f(t, y).
+  static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* self) {
+    auto& ida = *static_cast<Ida*>(self);
+    const int flag = ida.evaluate_rhs(t, y, r);
+    if (flag != 0) return flag;
+    view_mutable(r) = view(yp) - view(r);
+    return 0;
+  }
+
+  static int jacobian(sunrealtype t, sunrealtype c_j, N_Vector y, N_Vector, N_Vector,
+                      SUNMatrix matrix, void* self, N_Vector, N_Vector, N_Vector) {
+    auto& ida = *static_cast<Ida*>(self);
+    if (const int flag = ida.evaluate_jacobian(t, y); flag != 0) return flag;
+    fill_dense(ida.jacobian_, -1.0, c_j, matrix);
+    return 0;
+  }
+
+  void update_counters() {
+    void* ida = memory_.get();
+    long steps = 0, residual_evals = 0, residual_evals_ls = 0, jacobian_evals = 0, newton_iters = 0,
+         error_test_fails = 0, solve_fails = 0;
+    IDAGetNumSteps(ida, &steps);
+    IDAGetNumResEvals(ida, &residual_evals);
+    IDAGetNumLinResEvals(ida, &residual_evals_ls);
+    IDAGetNumJacEvals(ida, &jacobian_evals);
+    IDAGetNumNonlinSolvIters(ida, &newton_iters);
+    IDAGetNumErrTestFails(ida, &error_test_fails);
+    IDAGetNumStepSolveFails(ida, &solve_fails);
+    counters_.steps = steps;
+    // Each residual evaluation is one evaluation of f.
+    counters_.force_evals = residual_evals + residual_evals_ls + extra_rhs_evals_;
+    counters_.hessian_evals = analytic_jacobian_ ? jacobian_evals : 0;
+    counters_.newton_iters = newton_iters;
+    counters_.linear_solves = newton_iters;  // direct solver: one solve per Newton iteration
+    counters_.rejected = error_test_fails + solve_fails;
+  }
+
+  int max_order_;
+  bool analytic_jacobian_ = false;
+  VectorPtr yp_;
+  MatrixPtr matrix_;
+  LinearSolverPtr linear_solver_;
+  MemoryPtr<IdaDeleter> memory_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// ARKODE with a built-in embedded explicit Butcher table (ARKODE user guide v5.4, §2.2, §8.1).
+// SUNDIALS 6.4's ERKStep reuses the last stage derivative as f(t_{n+1}, y_{n+1}) whenever
+// c_s = 1, also for tables that are not first-same-as-last (llnl/sundials issue #311): Verner
+// 8-5-6 drops to third order, Fehlberg 13-7-8 to seventh. So ERKStep is used only for FSAL
+// tables, where the reuse is right and saves one f per step; the others run through ARKStep in
+// explicit-only mode, which evaluates every stage.
+
+struct ErkTable {
+  ARKODE_ERKTableID id;
+  int order;
+};
+const std::map<std::string, ErkTable>& erk_tables() {
+  static const std::map<std::string, ErkTable> tables = {
+      {"dormand_prince", {ARKODE_DORMAND_PRINCE_7_4_5, 5}},
+      {"verner_8_5_6", {ARKODE_VERNER_8_5_6, 6}},
+      {"fehlberg_13_7_8", {ARKODE_FEHLBERG_13_7_8, 8}},
+  };
+  return tables;
+}
+
+// First same as last: the last stage is evaluated at the new solution (last row of A = b).
+bool is_fsal(ARKODE_ERKTableID id) {
+  const ARKodeButcherTable table = ARKodeButcherTable_LoadERK(id);
+  if (table == nullptr) return false;
+  const int last = table->stages - 1;
+  bool fsal = table->c[last] == 1.0;
+  for (int j = 0; j < table->stages; ++j) fsal = fsal && table->A[last][j] == table->b[j];
+  ARKodeButcherTable_Free(table);
+  return fsal;
+}
+
+// The calls that differ between ERKStep and ARKStep, so one wrapper drives either.
+struct ArkodeApi {
+  const char* name;
+  void* (*create)(ARKRhsFn f, sunrealtype t0, N_Vector y0, SUNContext context);
+  int (*set_error_handler)(void* memory, ARKErrHandlerFn handler, void* data);
+  int (*set_user_data)(void* memory, void* data);
+  int (*tolerances)(void* memory, sunrealtype rtol, sunrealtype atol);
+  int (*set_table)(void* memory, ARKODE_ERKTableID id);
+  int (*set_stop_time)(void* memory, sunrealtype t_stop);
+  int (*evolve)(void* memory, sunrealtype t_out, N_Vector y, sunrealtype* t_returned, int task);
+  int (*steps)(void* memory, long* count);
+  int (*rhs_evals)(void* memory, long* count);
+  int (*error_test_fails)(void* memory, long* count);
+  char* (*flag_name)(long flag);
+  void (*free)(void** memory);
+};
+
+const ArkodeApi kErkStep = {
+    "ERKStep",
+    &ERKStepCreate,
+    &ERKStepSetErrHandlerFn,
+    &ERKStepSetUserData,
+    &ERKStepSStolerances,
+    &ERKStepSetTableNum,
+    &ERKStepSetStopTime,
+    &ERKStepEvolve,
+    &ERKStepGetNumSteps,
+    &ERKStepGetNumRhsEvals,
+    &ERKStepGetNumErrTestFails,
+    &ERKStepGetReturnFlagName,
+    &ERKStepFree,
+};
+
+const ArkodeApi kArkStepExplicit = {
+    "ARKStep",
+    [](ARKRhsFn f, sunrealtype t0, N_Vector y0, SUNContext context) {
+      return ARKStepCreate(f, nullptr, t0, y0, context);
+    },
+    &ARKStepSetErrHandlerFn,
+    &ARKStepSetUserData,
+    &ARKStepSStolerances,
+    [](void* memory, ARKODE_ERKTableID id) {
+      return ARKStepSetTableNum(memory, ARKODE_DIRK_NONE, id);
+    },
+    &ARKStepSetStopTime,
+    &ARKStepEvolve,
+    &ARKStepGetNumSteps,
+    [](void* memory, long* count) {
+      long implicit_evals = 0;
+      return ARKStepGetNumRhsEvals(memory, count, &implicit_evals);
+    },
+    &ARKStepGetNumErrTestFails,
+    &ARKStepGetReturnFlagName,
+    &ARKStepFree,
+};
+
+struct ArkodeDeleter {
+  const ArkodeApi* api = nullptr;
+  void operator()(void* memory) const { api->free(&memory); }
+};
+
+class ArkodeErk final : public SundialsIntegrator {
+ public:
+  ArkodeErk(const SundialsSettings& settings, std::string table)
+      : SundialsIntegrator(settings, "arkode"),
+        table_name_(std::move(table)),
+        api_(is_fsal(erk_tables().at(table_name_).id) ? &kErkStep : &kArkStepExplicit) {}
+
+  MethodInfo info() const override {
+    return {"arkode_erk", erk_tables().at(table_name_).order, kExplicit | kAdaptive,
+            fmt::format("SUNDIALS ARKODE {}, table {} (ARKODE user guide v5.4.1, §8.1)", api_->name,
+                        table_name_)};
+  }
+
+  void reset(const Problem& problem, const State& state, double) override {
+    memory_.reset();
+    if (!begin_reset(problem, state)) return;
+    memory_ = MemoryPtr<ArkodeDeleter>(api_->create(&rhs, state.t, y_.get(), context_.get()),
+                                       ArkodeDeleter{api_});
+    if (!memory_) {
+      setup_failed(-1, "ARKODE create failed");
+      return;
+    }
+    void* ark = memory_.get();
+    if (!check_setup(api_->set_error_handler(ark, &record_message, this), "SetErrHandlerFn") ||
+        !check_setup(api_->set_user_data(ark, this), "SetUserData") ||
+        !check_setup(api_->tolerances(ark, settings_.rtol, settings_.atol), "SStolerances")) {
+      return;
+    }
+    check_setup(api_->set_table(ark, erk_tables().at(table_name_).id), "SetTableNum");
+  }
+
+  StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
+    StepStatus status;
+    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    void* ark = memory_.get();
+    int flag = api_->set_stop_time(ark, t_stop);
+    double t_returned = t_;
+    if (flag >= 0) flag = api_->evolve(ark, t_stop, y_.get(), &t_returned, ARK_ONE_STEP);
+    update_counters();
+    if (flag < 0) return library_failure(flag, api_->flag_name);
+    publish(y_.get(), t_returned, t_stop, flag == ARK_TSTOP_RETURN || t_returned >= t_stop, state);
+    return StepStatus::success();
+  }
+
+ private:
+  static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void* self) {
+    return static_cast<ArkodeErk*>(self)->evaluate_rhs(t, y, ydot);
+  }
+
+  void update_counters() {
+    void* ark = memory_.get();
+    long steps = 0, rhs_evals = 0, error_test_fails = 0;
+    api_->steps(ark, &steps);
+    api_->rhs_evals(ark, &rhs_evals);
+    api_->error_test_fails(ark, &error_test_fails);
+    counters_.steps = steps;
+    counters_.force_evals = rhs_evals;
+    counters_.rejected = error_test_fails;
+  }
+
+  std::string table_name_;
+  const ArkodeApi* api_;
+  MemoryPtr<ArkodeDeleter> memory_{nullptr, ArkodeDeleter{api_}};
+};
+
+std::unique_ptr<Integrator> make_cvode(Params& params, bool bdf) {
+  const SundialsSettings settings = read_settings(params);
+  const int limit = bdf ? 5 : 12;
+  const auto max_order = static_cast<int>(
+      params.integer("max_order", limit, "maximum order of the variable-order formulas", 1, limit));
+  const std::string solver =
+      params.choice("linear_solver", "dense", {"dense", "klu"},
+                    "Newton linear solver: dense LU, or KLU sparse LU on the sparse Jacobian");
+  return std::make_unique<Cvode>(
+      bdf, settings, max_order,
+      solver == "klu" ? LinearSolverKind::kKlu : LinearSolverKind::kDense);
+}
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_cvode_bdf(Params& params) { return make_cvode(params, true); }
+
+std::unique_ptr<Integrator> make_cvode_adams(Params& params) { return make_cvode(params, false); }
+
+std::unique_ptr<Integrator> make_ida(Params& params) {
+  const SundialsSettings settings = read_settings(params);
+  const auto max_order = static_cast<int>(
+      params.integer("max_order", 5, "maximum order of the variable-order BDF formulas", 1, 5));
+  return std::make_unique<Ida>(settings, max_order);
+}
+
+std::unique_ptr<Integrator> make_arkode_erk(Params& params) {
+  const SundialsSettings settings = read_settings(params);
+  std::vector<std::string> names;
+  for (const auto& [name, table] : erk_tables()) names.push_back(name);
+  const std::string table =
+      params.choice("table", "dormand_prince", names, "embedded explicit Butcher table");
+  return std::make_unique<ArkodeErk>(settings, table);
+}
+
+}  // namespace geomint

@@ -1,0 +1,132 @@
+// Kepler problem V = −1/|q| in the plane, started at perihelion as in Hairer, Lubich & Wanner,
+// GNI (I.2.12): a = 1, period 2π, H = −½. Exact solution from Kepler's equation E − e sin E = t.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// E − sin E without the cancellation of the direct difference for small E (Taylor series),
+// which near perihelion of a very eccentric orbit is all of the residual of Kepler's equation.
+double e_minus_sin(double E) {
+  if (std::abs(E) >= 1) return E - std::sin(E);
+  double term = E * E * E / 6;
+  double sum = 0;
+  for (int n = 0; std::abs(term) > DBL_EPSILON * std::abs(sum) || n == 0; ++n) {
+    sum += term;
+    term *= -E * E / ((2 * n + 4) * (2 * n + 5));
+  }
+  return sum;
+}
+
+// 1 − e cos E written as (1 − e) + 2e sin²(E/2), exact to rounding even when e → 1 and E → 0.
+double one_minus_e_cos(double E, double e) {
+  const double s = std::sin(E / 2);
+  return (1 - e) + 2 * e * s * s;
+}
+
+// Eccentric anomaly E for mean anomaly M in [−π, π]: safeguarded Newton. On [0, π] the root lies
+// in [M, M + e] (because E − M = e sin E ∈ [0, e]) and the residual is increasing and convex,
+// so bisection inside that bracket catches every step Newton would throw out of it.
+double eccentric_anomaly(double mean_anomaly, double e) {
+  const double M = std::abs(mean_anomaly);
+  double lo = M;
+  double hi = std::min(M + e, kPi);
+  // Danby's starting value M + 0.85 e (sin M ≥ 0 here).
+  double E = std::min(M + 0.85 * e, hi);
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const double residual = (1 - e) * E + e * e_minus_sin(E) - M;
+    if (residual > 0) {
+      hi = E;
+    } else {
+      lo = E;
+    }
+    double next = E - residual / one_minus_e_cos(E, e);
+    if (!(next >= lo && next <= hi)) next = 0.5 * (lo + hi);
+    const double change = std::abs(next - E);
+    E = next;
+    if (change < 4 * DBL_EPSILON) return std::copysign(E, mean_anomaly);
+  }
+  throw std::logic_error("kepler: Newton iteration for Kepler's equation did not converge");
+}
+
+class Kepler final : public Problem {
+ public:
+  explicit Kepler(double e) : e_(e), minor_axis_(std::sqrt((1 - e) * (1 + e))) {
+    set_mass(Vec::Ones(2));
+    set_capabilities(kHessian | kExact | kPeriod | kAngularMomentum | kOmegaMax);
+    set_defaults(0.01, 10 * 2 * kPi);
+  }
+
+  State initial_state() const override {
+    State state{0.0, Vec(2), Vec(2)};
+    state.q << 1 - e_, 0;
+    state.p << 0, std::sqrt((1 + e_) / (1 - e_));
+    return state;
+  }
+
+  double potential(const Vec& q) const override { return -1 / q.norm(); }
+  void gradient(const Vec& q, Vec& g) const override {
+    const double r = q.norm();
+    g = q / (r * r * r);
+  }
+  // ∇²V = I/r³ − 3 q qᵀ/r⁵.
+  void hessian(const Vec& q, SparseMatrix& H) const override {
+    const double r = q.norm();
+    const double inv_r3 = 1 / (r * r * r);
+    const double inv_r5 = inv_r3 / (r * r);
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        entries.emplace_back(i, j, (i == j ? inv_r3 : 0.0) - 3 * q[i] * q[j] * inv_r5);
+      }
+    }
+    H.resize(2, 2);
+    H.setFromTriplets(entries.begin(), entries.end());
+  }
+
+  // Mean motion 1 and perihelion at t = 0, so the mean anomaly is t itself; the exact reduction
+  // to [−π, π] makes exact(t + 2π) agree with exact(t) to rounding for any t.
+  State exact(double t) const override {
+    const double E = eccentric_anomaly(std::remainder(t, 2 * kPi), e_);
+    const double half_sine = std::sin(E / 2);
+    const double sine = std::sin(E);
+    const double cosine = std::cos(E);
+    const double anomaly_rate = 1 / one_minus_e_cos(E, e_);  // dE/dt
+    State state{t, Vec(2), Vec(2)};
+    state.q << (1 - e_) - 2 * half_sine * half_sine, minor_axis_ * sine;  // (cos E − e, b sin E)
+    state.p << -sine * anomaly_rate, minor_axis_ * cosine * anomaly_rate;
+    return state;
+  }
+  double period() const override { return 2 * kPi; }
+  Vec angular_momentum(const Vec& q, const Vec& p) const override {
+    return Vec::Constant(1, q[0] * p[1] - q[1] * p[0]);
+  }
+  // The fastest rate on the orbit, the angular velocity at perihelion L/r² = √((1+e)/(1−e)³),
+  // which also bounds the linearised tangential frequency r^(−3/2) there; independent of q
+  // because a fixed step has to resolve the whole orbit.
+  double omega_max(const Vec&) const override { return std::sqrt((1 + e_) / std::pow(1 - e_, 3)); }
+
+ private:
+  double e_;
+  double minor_axis_;  // b = √(1 − e²) for a = 1
+};
+
+}  // namespace
+
+std::unique_ptr<Problem> make_kepler(Params& params) {
+  const double e = params.real(
+      "e", 0.6, "eccentricity (semi-major axis 1, period 2pi)",
+      [](double x) { return x >= 0 && x < 1; }, "in [0, 1)");
+  return std::make_unique<Kepler>(e);
+}
+
+}  // namespace geomint

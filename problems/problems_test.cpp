@@ -1,0 +1,547 @@
+// Registry-driven checks of every problem (DESIGN.md §7): derivatives against finite
+// differences, the exact solution against the equations of motion and an independent RK4 run,
+// invariants along the exact solution, and validation of spec strings.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cctype>
+#include <cfloat>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+namespace {
+
+// Non-default, non-unit parameter sets per registry name; a problem missing here still gets
+// every test with its default spec.
+const std::map<std::string, std::vector<std::string>>& extra_specs() {
+  static const std::map<std::string, std::vector<std::string>> table = {
+      {"harmonic", {"harmonic:omega=3,mass=2,q0=0.5,v0=-1", "harmonic:omega=0.2,q0=0,v0=2"}},
+      {"pendulum",
+       {"pendulum:theta0=1.2,omega0=2.5,v0=0.3", "pendulum:theta0=-2.0",
+        "pendulum:theta0=-0.4,v0=-0.7", "pendulum:theta0=3.0", "pendulum:theta0=7,v0=-0.2",
+        "pendulum:v0=3,omega0=1"}},
+      {"kepler", {"kepler:e=0", "kepler:e=0.9", "kepler:e=0.99"}},
+      {"damped_oscillator", {"damped_oscillator:omega=2.5,zeta=0.3,q0=-0.4,v0=1.2"}},
+      {"spring_net", {"spring_net:dim=3,nx=3,ny=3,nz=2,damping=0.5,stiffness=30"}},
+      {"elastic_bar",
+       {"elastic_bar:material=stvk,init=bend", "elastic_bar:init=twist,nx=3,ny=1,nz=1",
+        "elastic_bar:clamp=none,nx=3,ny=1,nz=1,damping=0.01"}},
+  };
+  return table;
+}
+
+std::vector<std::string> all_specs() {
+  std::vector<std::string> specs;
+  for (const auto& entry : problem_registry()) {
+    specs.push_back(entry.name);
+    const auto extra = extra_specs().find(entry.name);
+    if (extra != extra_specs().end()) {
+      specs.insert(specs.end(), extra->second.begin(), extra->second.end());
+    }
+  }
+  return specs;
+}
+
+// gtest names allow only [A-Za-z0-9_]: "pendulum:theta0=-2.0" -> "pendulum_theta0_m2p0".
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string out;
+  for (char c : info.param) {
+    if (std::isalnum(static_cast<unsigned char>(c))) {
+      out += c;
+    } else if (c == '-') {
+      out += 'm';
+    } else if (c == '.') {
+      out += 'p';
+    } else {
+      out += '_';
+    }
+  }
+  return out;
+}
+
+double inf_norm(const Vec& v) { return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>(); }
+
+// Components probed by finite differences: all of them for small systems, an even spread of
+// about 48 for large ones so the suite stays fast when large meshes join the registry.
+std::vector<int> probe_indices(int n) {
+  const int stride = std::max(1, n / 48);
+  std::vector<int> indices;
+  for (int j = 0; j < n; j += stride) indices.push_back(j);
+  return indices;
+}
+
+// Natural time unit of a problem: 1/omega_max, else period/2π, else 1.
+double time_scale(const Problem& problem) {
+  if (problem.has(kOmegaMax)) return 1 / problem.omega_max(problem.initial_state().q);
+  if (problem.has(kPeriod)) return problem.period() / (2 * std::numbers::pi);
+  return 1.0;
+}
+
+// Horizon for checks along the exact solution: a few periods, else the default run length.
+double horizon(const Problem& problem) {
+  return problem.has(kPeriod) ? 3.3 * problem.period() : problem.default_t_end();
+}
+
+// The initial configuration, small deterministic perturbations of it (5% of its size, small
+// enough to stay clear of singularities such as Kepler's origin) and points on the exact orbit.
+std::vector<Vec> sample_configurations(const Problem& problem) {
+  const Vec q0 = problem.initial_state().q;
+  std::vector<Vec> points = {q0};
+  std::mt19937 generator(12345);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double amplitude = 0.05 * (inf_norm(q0) > 0 ? inf_norm(q0) : 1.0);
+  for (int k = 0; k < 3; ++k) {
+    Vec q = q0;
+    Vec step(q.size());
+    for (int i = 0; i < q.size(); ++i) step[i] = amplitude * uniform(generator);
+    // Stay inside the domain of V (an inverted neo-Hookean element has V = +inf): halve the step
+    // until the potential is finite.
+    while (!std::isfinite(problem.potential(q0 + step))) step /= 2;
+    q += step;
+    points.push_back(q);
+  }
+  if (problem.has(kExact)) {
+    for (double fraction : {0.13, 0.41, 0.77}) {
+      points.push_back(problem.exact(fraction * horizon(problem)).q);
+    }
+  }
+  return points;
+}
+
+// Right-hand side of Hamilton's equations (q̇, ṗ) = (M⁻¹p, −∇V(q) + F(q, v, t)).
+Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
+  const int n = problem.dof();
+  Vec rhs(2 * n);
+  const Vec v = problem.inverse_mass().cwiseProduct(p);
+  Vec g;
+  problem.gradient(q, g);
+  rhs.head(n) = v;
+  rhs.tail(n) = -g;
+  if (problem.has(kForce)) {
+    Vec f;
+    problem.force(q, v, t, f);
+    rhs.tail(n) += f;
+  }
+  return rhs;
+}
+
+// Numbers compare by value ("0.90" and "0.9"), anything else (choices, flags) as text.
+bool same_value(const std::string& a, const std::string& b) {
+  char* end_a = nullptr;
+  char* end_b = nullptr;
+  const double x = std::strtod(a.c_str(), &end_a);
+  const double y = std::strtod(b.c_str(), &end_b);
+  if (*end_a == '\0' && *end_b == '\0' && end_a != a.c_str() && end_b != b.c_str()) return x == y;
+  return a == b;
+}
+
+Vec stacked(const State& state) {
+  Vec y(state.q.size() + state.p.size());
+  y << state.q, state.p;
+  return y;
+}
+
+class ProblemTest : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override { problem_ = make_problem(GetParam()); }
+  std::unique_ptr<Problem> problem_;
+};
+
+TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
+  const Problem& problem = *problem_;
+  const State start = problem.initial_state();
+  ASSERT_GT(problem.dof(), 0);
+  EXPECT_EQ(start.q.size(), problem.dof());
+  EXPECT_EQ(start.p.size(), problem.dof());
+  EXPECT_EQ(problem.inverse_mass().size(), problem.dof());
+  EXPECT_EQ(start.t, 0.0);
+  for (int i = 0; i < problem.dof(); ++i) {
+    EXPECT_GT(problem.mass()[i], 0.0);
+    // One rounding in the reciprocal.
+    EXPECT_NEAR(problem.mass()[i] * problem.inverse_mass()[i], 1.0, 2 * DBL_EPSILON);
+  }
+  // Kinetic energy summed independently of Problem::kinetic; a few roundings per term.
+  double kinetic = 0;
+  for (int i = 0; i < problem.dof(); ++i)
+    kinetic += 0.5 * start.p[i] * start.p[i] / problem.mass()[i];
+  EXPECT_NEAR(problem.kinetic(start.p), kinetic, 8 * DBL_EPSILON * kinetic);
+  EXPECT_NEAR(problem.energy(start.q, start.p), kinetic + problem.potential(start.q),
+              8 * DBL_EPSILON * (kinetic + std::abs(problem.potential(start.q))));
+  EXPECT_GT(problem.default_dt(), 0.0);
+  EXPECT_GT(problem.default_t_end(), problem.default_dt());
+  if (problem.has(kPeriod)) {
+    EXPECT_GT(problem.period(), 0.0);
+  }
+  if (!problem.has(kExact)) {
+    EXPECT_THROW(problem.exact(1.0), std::logic_error);
+  }
+}
+
+TEST_P(ProblemTest, GradientMatchesFiniteDifferences) {
+  const Problem& problem = *problem_;
+  for (const Vec& q : sample_configurations(problem)) {
+    Vec g;
+    problem.gradient(q, g);
+    ASSERT_EQ(g.size(), problem.dof());
+    // Step ~ eps^(1/3) relative to the configuration size balances O(h²) truncation against
+    // rounding. Allowed: 1e-7 relative (truncation is ~1e-10 here) plus the rounding of the
+    // two potential values amplified by 1/h.
+    const double h = 1e-5 * std::max(inf_norm(q), 0.1);
+    // Richardson extrapolation (4 D(h) - D(2h))/3 cancels the O(h^2) truncation, which for a stiff
+    // problem near equilibrium (elastic energy at rest: small gradient, large third derivative)
+    // exceeds 1e-7 |g|. Rounding is that of the largest potential value in the stencil.
+    for (int j : probe_indices(problem.dof())) {
+      Vec plus = q, minus = q, plus2 = q, minus2 = q;
+      plus[j] += h;
+      minus[j] -= h;
+      plus2[j] += 2 * h;
+      minus2[j] -= 2 * h;
+      const double values[4] = {problem.potential(plus), problem.potential(minus),
+                                problem.potential(plus2), problem.potential(minus2)};
+      double largest = std::abs(problem.potential(q));
+      for (double value : values) largest = std::max(largest, std::abs(value));
+      // Relative to the gradient's size over the stencil, not only at q, where it may vanish
+      // (a free elastic body at rest: g = 0, V = 0, and only the O(h^4) remainder is left).
+      Vec g_far;
+      double gradient_size = inf_norm(g);
+      for (const Vec* x : {&plus2, &minus2}) {
+        problem.gradient(*x, g_far);
+        gradient_size = std::max(gradient_size, inf_norm(g_far));
+      }
+      const double tolerance = 1e-7 * gradient_size + 100 * DBL_EPSILON * largest / h;
+      const double difference = (8 * (values[0] - values[1]) - (values[2] - values[3])) / (12 * h);
+      EXPECT_NEAR(g[j], difference, tolerance) << "component " << j << " at q = " << q.transpose();
+    }
+  }
+}
+
+TEST_P(ProblemTest, HessianMatchesFiniteDifferencesAndIsSymmetric) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kHessian)) GTEST_SKIP() << "no Hessian declared";
+  const int n = problem.dof();
+  for (const Vec& q : sample_configurations(problem)) {
+    SparseMatrix H;
+    problem.hessian(q, H);
+    ASSERT_EQ(H.rows(), n);
+    ASSERT_EQ(H.cols(), n);
+    const Eigen::MatrixXd dense(H);
+    const double size = dense.cwiseAbs().maxCoeff();
+    // Symmetry should hold to rounding of the assembly, not only approximately.
+    EXPECT_LE((dense - dense.transpose()).cwiseAbs().maxCoeff(), 4 * DBL_EPSILON * size);
+    Vec g;
+    problem.gradient(q, g);
+    const double h = 1e-5 * std::max(inf_norm(q), 0.1);
+    // Same reasoning as for the gradient, one derivative higher: 1e-6 relative plus rounding.
+    const double tolerance = 1e-6 * size + 100 * DBL_EPSILON * inf_norm(g) / h;
+    for (int j : probe_indices(n)) {
+      Vec plus = q, minus = q, plus2 = q, minus2 = q;
+      plus[j] += h;
+      minus[j] -= h;
+      plus2[j] += 2 * h;
+      minus2[j] -= 2 * h;
+      Vec g_plus, g_minus, g_plus2, g_minus2;
+      problem.gradient(plus, g_plus);
+      problem.gradient(minus, g_minus);
+      problem.gradient(plus2, g_plus2);
+      problem.gradient(minus2, g_minus2);
+      // Richardson-extrapolated, as for the gradient.
+      const Vec column = (8 * (g_plus - g_minus) - (g_plus2 - g_minus2)) / (12 * h);
+      for (int i = 0; i < n; ++i) {
+        EXPECT_NEAR(dense(i, j), column[i], tolerance) << "entry (" << i << ", " << j << ")";
+      }
+    }
+  }
+}
+
+TEST_P(ProblemTest, ExactStartsAtInitialState) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kExact)) GTEST_SKIP() << "no exact solution declared";
+  const State start = problem.initial_state();
+  const State exact = problem.exact(0.0);
+  EXPECT_EQ(exact.t, 0.0);
+  ASSERT_EQ(exact.q.size(), start.q.size());
+  ASSERT_EQ(exact.p.size(), start.p.size());
+  // Special functions (elliptic, Kepler's equation) reproduce the start to a few ulps; 1e-13
+  // leaves room for the conditioning near a separatrix but catches a wrong phase or branch.
+  const double q_scale = std::max(inf_norm(start.q), 1.0);
+  const double p_scale = std::max(inf_norm(start.p), inf_norm(start.q) / time_scale(problem));
+  EXPECT_LE(inf_norm(exact.q - start.q), 1e-13 * q_scale) << exact.q.transpose();
+  EXPECT_LE(inf_norm(exact.p - start.p), 1e-13 * p_scale) << exact.p.transpose();
+}
+
+TEST_P(ProblemTest, ExactSatisfiesEquationsOfMotion) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kExact)) GTEST_SKIP() << "no exact solution declared";
+  // Central differences in t with h = 1e-4 of the time unit: truncation ~1e-9 and rounding
+  // ~1e-12 relative to the rate of change, well inside 1e-6.
+  const double h = 1e-4 * time_scale(problem);
+  const double step = horizon(problem) / 23;
+  for (int k = 0; k <= 23; ++k) {
+    const double t = k * step + 0.1 * step;
+    const State at = problem.exact(t);
+    const Vec rate = (stacked(problem.exact(t + h)) - stacked(problem.exact(t - h))) / (2 * h);
+    const Vec rhs = hamilton_rhs(problem, t, at.q, at.p);
+    EXPECT_LE(inf_norm(rate - rhs), 1e-6 * inf_norm(rhs))
+        << "t = " << t << "\n difference quotient: " << rate.transpose()
+        << "\n equations of motion: " << rhs.transpose();
+  }
+}
+
+TEST_P(ProblemTest, ExactMatchesIndependentRk4) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kExact)) GTEST_SKIP() << "no exact solution declared";
+  // Past one full period so that phase, period and any argument reduction are all exercised.
+  const double t_end =
+      problem.has(kPeriod) ? 1.3 * problem.period() : std::min(problem.default_t_end(), 20.0);
+  // h·omega_max = 0.002: RK4's global error ~ (h omega)^4 ~ 1e-11, far below the 1e-8 allowed.
+  const long steps = std::lround(std::ceil(t_end / (0.002 * time_scale(problem))));
+  if (steps > 10'000'000) GTEST_SKIP() << "too stiff for a quick RK4 reference (" << steps << ")";
+  const double h = t_end / static_cast<double>(steps);
+  const int n = problem.dof();
+  const State start = problem.initial_state();
+  Vec y = stacked(start);
+  const auto f = [&](double t, const Vec& z) {
+    return hamilton_rhs(problem, t, z.head(n), z.tail(n));
+  };
+  for (long k = 0; k < steps; ++k) {
+    const double t = static_cast<double>(k) * h;
+    const Vec k1 = f(t, y);
+    const Vec k2 = f(t + h / 2, y + h / 2 * k1);
+    const Vec k3 = f(t + h / 2, y + h / 2 * k2);
+    const Vec k4 = f(t + h, y + h * k3);
+    y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  const State exact = problem.exact(t_end);
+  const double q_scale = std::max(inf_norm(start.q), inf_norm(exact.q));
+  const double p_scale = std::max(inf_norm(start.p), inf_norm(exact.p));
+  EXPECT_LE(inf_norm(y.head(n) - exact.q), 1e-8 * q_scale)
+      << "rk4 " << y.head(n).transpose() << " exact " << exact.q.transpose();
+  EXPECT_LE(inf_norm(y.tail(n) - exact.p), 1e-8 * p_scale)
+      << "rk4 " << y.tail(n).transpose() << " exact " << exact.p.transpose();
+}
+
+TEST_P(ProblemTest, InvariantsAreConstantAlongExact) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kExact)) GTEST_SKIP() << "no exact solution declared";
+  const State start = problem.initial_state();
+  const double energy0 = problem.energy(start.q, start.p);
+  // Relative to the sizes of the two energy terms, which cancel for bound orbits (Kepler).
+  const double energy_scale =
+      std::max(problem.kinetic(start.p) + std::abs(problem.potential(start.q)), DBL_MIN);
+  const double momentum_scale = std::max(inf_norm(start.q) * inf_norm(start.p), DBL_MIN);
+  std::vector<double> times;
+  for (int k = 0; k <= 200; ++k) times.push_back(k * horizon(problem) / 200);
+  // A late time checks that long runs do not lose accuracy (argument reduction).
+  if (problem.has(kPeriod)) times.push_back(1000.37 * problem.period());
+  // Round-off level: a few dozen ulps of the state feed each invariant.
+  constexpr double kTolerance = 1e-12;
+  for (double t : times) {
+    const State at = problem.exact(t);
+    if (!problem.has(kForce)) {
+      EXPECT_LE(std::abs(problem.energy(at.q, at.p) - energy0), kTolerance * energy_scale)
+          << "energy at t = " << t;
+    }
+    if (problem.has(kAngularMomentum)) {
+      const Vec drift =
+          problem.angular_momentum(at.q, at.p) - problem.angular_momentum(start.q, start.p);
+      EXPECT_LE(inf_norm(drift), kTolerance * momentum_scale) << "angular momentum at t = " << t;
+    }
+    if (problem.has(kLinearMomentum)) {
+      const Vec drift =
+          problem.linear_momentum(at.q, at.p) - problem.linear_momentum(start.q, start.p);
+      EXPECT_LE(inf_norm(drift), kTolerance * std::max(inf_norm(start.p), DBL_MIN))
+          << "linear momentum at t = " << t;
+    }
+  }
+}
+
+TEST_P(ProblemTest, ExactReturnsAfterPeriod) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kPeriod) || !problem.has(kExact)) GTEST_SKIP() << "no period or exact solution";
+  const double period = problem.period();
+  // 1e-10: the phase error of one period is rounding of T times the rates.
+  for (double t : {0.0, 0.37 * period, 2.9 * period}) {
+    const Vec now = stacked(problem.exact(t));
+    const Vec later = stacked(problem.exact(t + period));
+    EXPECT_LE(inf_norm(later - now), 1e-10 * std::max(inf_norm(now), 1.0)) << "t = " << t;
+  }
+}
+
+TEST_P(ProblemTest, OmegaMaxBoundsLinearisedFrequency) {
+  const Problem& problem = *problem_;
+  if (!problem.has(kOmegaMax)) GTEST_SKIP() << "no omega_max declared";
+  if (!problem.has(kHessian) || problem.dof() > 200) GTEST_SKIP() << "needs a small Hessian";
+  // omega_max may be a bound over the motion rather than over all of configuration space
+  // (Kepler's perihelion rate), so it is checked on states the motion visits.
+  std::vector<Vec> visited = {problem.initial_state().q};
+  if (problem.has(kExact)) {
+    for (int k = 1; k <= 40; ++k) visited.push_back(problem.exact(k * horizon(problem) / 40).q);
+  }
+  for (const Vec& q : visited) {
+    const double omega = problem.omega_max(q);
+    EXPECT_TRUE(std::isfinite(omega) && omega > 0) << omega;
+    SparseMatrix H;
+    problem.hessian(q, H);
+    // Frequencies are square roots of the positive eigenvalues of M^(-1/2) H M^(-1/2).
+    const Vec scale = problem.inverse_mass().cwiseSqrt();
+    const Eigen::MatrixXd scaled = scale.asDiagonal() * Eigen::MatrixXd(H) * scale.asDiagonal();
+    const double top =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled).eigenvalues().maxCoeff();
+    EXPECT_GE(omega * (1 + 1e-12), std::sqrt(std::max(top, 0.0))) << "q = " << q.transpose();
+  }
+}
+
+TEST_P(ProblemTest, CanonicalSpecIsSortedCompleteAndStable) {
+  const Problem& problem = *problem_;
+  const std::string& canonical = problem.spec();
+  const Spec parsed = Spec::parse(canonical);
+  EXPECT_EQ(parsed.name, problem.name());
+  // Keys in the string itself must be sorted (Spec::parse sorts them anyway).
+  std::vector<std::string> keys;
+  const auto colon = canonical.find(':');
+  for (size_t start = colon; start != std::string::npos;) {
+    const auto end = canonical.find('=', start);
+    keys.push_back(canonical.substr(start + 1, end - start - 1));
+    start = canonical.find(',', end);
+  }
+  EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end())) << canonical;
+  // Every user-given value survives; defaults are filled for the rest.
+  for (const auto& [key, value] : Spec::parse(GetParam()).values) {
+    ASSERT_TRUE(parsed.values.count(key)) << key << " missing from " << canonical;
+    EXPECT_TRUE(same_value(parsed.values.at(key), value))
+        << key << ": " << value << " became " << parsed.values.at(key);
+  }
+  const auto again = make_problem(canonical);
+  EXPECT_EQ(again->spec(), canonical);
+  EXPECT_EQ(stacked(again->initial_state()), stacked(problem.initial_state()));
+}
+
+TEST_P(ProblemTest, RejectsUnknownKeysAndMalformedValues) {
+  const std::string name = problem_->name();
+  try {
+    make_problem(name + ":no_such_key=1");
+    ADD_FAILURE() << "unknown key accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("no_such_key"), std::string::npos) << message;
+    // The message lists the valid keys.
+    for (const auto& [key, value] : Spec::parse(problem_->spec()).values) {
+      EXPECT_NE(message.find(key), std::string::npos) << key << " not listed in: " << message;
+    }
+  }
+  for (const auto& [key, value] : Spec::parse(problem_->spec()).values) {
+    try {
+      make_problem(name + ":" + key + "=not_a_number");
+      ADD_FAILURE() << key << "=not_a_number accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(key), std::string::npos) << error.what();
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, ProblemTest, ::testing::ValuesIn(all_specs()), test_name);
+
+TEST(ProblemRegistry, ExtraSpecTableNamesExist) {
+  for (const auto& [name, specs] : extra_specs()) {
+    bool found = false;
+    for (const auto& entry : problem_registry()) found = found || entry.name == name;
+    EXPECT_TRUE(found) << name << " is not in the registry";
+    for (const auto& spec : specs) EXPECT_EQ(Spec::parse(spec).name, name) << spec;
+  }
+}
+
+TEST(ProblemFactory, UnknownProblemListsValidNames) {
+  try {
+    make_problem("no_such_problem:e=0.5");
+    ADD_FAILURE() << "unknown problem accepted";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("no_such_problem"), std::string::npos) << message;
+    for (const auto& entry : problem_registry()) {
+      EXPECT_NE(message.find(entry.name), std::string::npos) << message;
+    }
+  }
+}
+
+TEST(ProblemFactory, CanonicalSpecSortsKeysAndFillsDefaults) {
+  EXPECT_EQ(make_problem("kepler")->spec(), "kepler:e=0.6");
+  EXPECT_EQ(make_problem("kepler:e=0.90")->spec(), "kepler:e=0.9");
+  EXPECT_EQ(make_problem("harmonic:v0=2,omega=3")->spec(), "harmonic:mass=1,omega=3,q0=1,v0=2");
+  EXPECT_EQ(make_problem("pendulum")->spec(), "pendulum:omega0=1,theta0=0.5,v0=0");
+}
+
+TEST(ProblemFactory, OutOfRangeValuesNameTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"kepler:e=1.0", "e=1"},           {"kepler:e=-0.1", "e=-0.1"},
+      {"harmonic:omega=-1", "omega=-1"}, {"harmonic:mass=0", "mass=0"},
+      {"pendulum:omega0=0", "omega0=0"}, {"pendulum:theta0=inf", "theta0"},
+  };
+  for (const auto& [spec, expected] : cases) {
+    try {
+      make_problem(spec);
+      ADD_FAILURE() << spec << " accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(expected), std::string::npos)
+          << spec << ": " << error.what();
+    }
+  }
+}
+
+TEST(PendulumProblem, NearSeparatrixStillExact) {
+  const auto problem = make_problem("pendulum:theta0=3.0");
+  ASSERT_TRUE(problem->has(kExact));
+  ASSERT_TRUE(problem->has(kPeriod));
+  // Released from rest it swings to −θ0 in half a period (time symmetry); 1e-12 absolute
+  // allows for the condition of the elliptic functions at k = sin(1.5).
+  const State half = problem->exact(problem->period() / 2);
+  EXPECT_NEAR(half.q[0], -3.0, 1e-12);
+  EXPECT_NEAR(half.p[0], 0.0, 1e-12);
+  // Near the separatrix the period is much longer than the small-angle 2π.
+  EXPECT_GT(problem->period(), 2 * 2 * std::numbers::pi);
+}
+
+TEST(PendulumProblem, RotatingHasNoExactSolution) {
+  const auto problem = make_problem("pendulum:v0=3,omega0=1");
+  EXPECT_FALSE(problem->has(kExact));
+  EXPECT_FALSE(problem->has(kPeriod));
+  EXPECT_TRUE(problem->has(kHessian));
+  EXPECT_TRUE(problem->has(kOmegaMax));
+}
+
+TEST(PendulumProblem, PeriodMatchesSmallAmplitudeSeries) {
+  // T = (2π/ω0)(1 + θ0²/16 + 11θ0⁴/3072 + O(θ0⁶)); at θ0 = 0.1 the O(θ0⁶) remainder is ~1e-7.
+  const double theta0 = 0.1;
+  const double omega0 = 2.5;
+  const auto problem = make_problem("pendulum:theta0=0.1,omega0=2.5");
+  const double series =
+      2 * std::numbers::pi / omega0 * (1 + theta0 * theta0 / 16 + 11 * std::pow(theta0, 4) / 3072);
+  EXPECT_NEAR(problem->period(), series, 1e-8 * series);
+}
+
+TEST(KeplerProblem, InvariantsMatchOrbitalElements) {
+  // Semi-major axis 1: H = −1/(2a) = −½ and |L| = √(a(1 − e²)), to rounding.
+  for (double e : {0.0, 0.3, 0.6, 0.9, 0.99}) {
+    const auto problem = make_problem("kepler:e=" + format_number(e));
+    const State start = problem->initial_state();
+    EXPECT_NEAR(problem->energy(start.q, start.p), -0.5, 64 * DBL_EPSILON / (1 - e)) << e;
+    EXPECT_NEAR(problem->angular_momentum(start.q, start.p)[0], std::sqrt(1 - e * e),
+                16 * DBL_EPSILON)
+        << e;
+    // Aphelion at half a period: q = (−(1 + e), 0).
+    const State aphelion = problem->exact(std::numbers::pi);
+    EXPECT_NEAR(aphelion.q[0], -(1 + e), 16 * DBL_EPSILON) << e;
+    EXPECT_NEAR(aphelion.q[1], 0.0, 16 * DBL_EPSILON) << e;
+  }
+}
+
+}  // namespace
+}  // namespace geomint
