@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace geomint {
@@ -118,6 +119,52 @@ std::vector<std::string> column_union(const std::vector<Row>& rows,
   }
   columns.insert(columns.end(), present.begin(), present.end());
   return columns;
+}
+
+std::vector<Row> parse_csv(const std::string& text) {
+  // Splits one record; a quoted field runs to the next unpaired quote ("" is a literal quote).
+  auto split = [](const std::string& line) {
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (size_t i = 0; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = !quoted;
+      } else if (c == ',' && !quoted) {
+        fields.emplace_back();
+      } else {
+        fields.back() += c;
+      }
+    }
+    return fields;
+  };
+  std::vector<Row> rows;
+  std::vector<std::string> header;
+  std::istringstream in(text);
+  std::string line;
+  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const auto fields = split(line);
+    if (header.empty()) {
+      header = fields;
+      continue;
+    }
+    if (fields.size() > header.size()) {
+      throw std::runtime_error("CSV line " + std::to_string(line_number) + " has " +
+                               std::to_string(fields.size()) + " fields, the header " +
+                               std::to_string(header.size()));
+    }
+    Row row;
+    for (size_t i = 0; i < fields.size(); ++i) {
+      if (!fields[i].empty()) row[header[i]] = fields[i];
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
 }
 
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,

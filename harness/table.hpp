@@ -23,6 +23,11 @@ std::vector<std::string> column_union(const std::vector<Row>& rows,
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
                    const std::vector<std::pair<std::string, std::string>>& provenance_lines);
 
+// Parses CSV text as written by to_csv: `#` provenance lines are skipped, the first other line
+// is the header, quoted fields may contain ',' and '""'. Empty fields are left out of the row.
+// Throws std::runtime_error naming the line when a row has more fields than the header.
+std::vector<Row> parse_csv(const std::string& text);
+
 // Markdown pipe table; numbers are shortened to `digits` significant digits for reading.
 std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::string>& columns,
                         int digits = 3);

@@ -95,6 +95,14 @@ TEST(Table, CsvHasProvenanceHeaderAndQuotes) {
             "# geomint: test\nmethod,dt,wall_s\n\"hp:alpha=0.5,solver=newton\",0.1,\n,0.2,1\n");
 }
 
+TEST(Table, ParseCsvRoundTripsToCsv) {
+  const std::vector<Row> rows = {{{"method", "hp:alpha=0.5,solver=newton"}, {"dt", "0.1"}},
+                                 {{"dt", "0.2"}, {"wall_s", "1"}, {"message", "say \"no\""}}};
+  const auto columns = column_union(rows, standard_columns());
+  EXPECT_EQ(parse_csv(to_csv(rows, columns, {{"geomint", "test"}})), rows);
+  EXPECT_THROW(parse_csv("a,b\n1,2,3\n"), std::runtime_error);
+}
+
 TEST(Table, AtomicWriteLeavesNoTemporaryFile) {
   const auto dir = std::filesystem::temp_directory_path() / "geomint_atomic_test";
   std::filesystem::remove_all(dir);
