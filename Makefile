@@ -5,7 +5,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
-.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick bench format clean
+.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates bench format clean
 
 all: build
 
@@ -33,6 +33,12 @@ reproduce-figures: build
 # CI-sized variant: quick_* settings, output under results/<scene>/quick/ (not committed).
 reproduce-quick: build
 	@QUICK=1 bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
+
+# Accuracy gates: the published claims (results/gates.toml) checked against the result tables;
+# exits 1 and prints the failing rows when a number left its band. Run after reproduce-figures.
+GATES ?= results/gates.toml
+gates: build
+	@$(BUILD_DIR)/geomint gate $(GATES) $(wildcard results/*/summary.csv results/*/order.csv results/*/stability.csv)
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done

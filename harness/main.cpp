@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "harness/gate.hpp"
 #include "harness/order.hpp"
 #include "harness/run.hpp"
 #include "harness/scene.hpp"
@@ -103,6 +104,14 @@ int main(int argc, char** argv) {
   sweep->add_option("--out", sweep_out,
                     "output folder (default: the scene's folder; with --quick: <folder>/quick)");
 
+  std::string gates_path;
+  std::vector<std::string> gate_results;
+  auto* gate = app.add_subcommand(
+      "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
+  gate->add_option("gates", gates_path, "GATES.toml with [[gate]] blocks")->required();
+  gate->add_option("results", gate_results, "result CSV files (summary.csv, order.csv, ...)")
+      ->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -169,6 +178,19 @@ int main(int argc, char** argv) {
                  study.row.at("declared_order"), study.row.at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
       return 0;
+    }
+    if (*gate) {
+      const std::vector<Gate> gates = load_gates(gates_path);
+      const auto outcomes = check_gates(gates, load_result_files(gate_results));
+      int failed = 0;
+      for (const auto& outcome : outcomes) {
+        failed += outcome.passed ? 0 : 1;
+        fmt::print("{} {} ({} row(s))\n", outcome.passed ? "PASS" : "FAIL", outcome.gate->name,
+                   outcome.rows_checked);
+        for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
+      }
+      fmt::print("{} of {} gate(s) passed\n", outcomes.size() - failed, outcomes.size());
+      return failed == 0 ? 0 : kExitFailed;
     }
     if (*sweep) {
       const Scene scene = load_scene(scene_path, quick);

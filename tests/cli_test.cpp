@@ -164,6 +164,28 @@ std::set<std::string> readme_table_names(const std::string& marker) {
   return names;
 }
 
+TEST(Cli, GateExitsZeroOnPassOneOnFailTwoOnBadInput) {
+  const std::string root = GEOMINT_SOURCE_DIR;
+  const std::string results = root + "/results/fig1_pendulum/summary.csv";
+  EXPECT_EQ(geomint("gate " + root + "/results/gates.toml " + results + " " + root +
+                    "/results/order_basic/order.csv")
+                .exit_code,
+            0);
+  const fs::path failing = scratch("failing_gates.toml");
+  std::ofstream(failing) << "[[gate]]\nname = \"too strict\"\nwhere = { method = "
+                            "\"stormer_verlet\", label = \"short\" }\ncolumn = "
+                            "\"energy_err_max\"\nmax = 1e-9\n";
+  const Outcome failed = geomint("gate " + failing.string() + " " + results);
+  EXPECT_EQ(failed.exit_code, 1) << failed.output;
+  EXPECT_NE(failed.output.find("FAIL too strict"), std::string::npos) << failed.output;
+  const fs::path malformed = scratch("malformed_gates.toml");
+  std::ofstream(malformed) << "[[gate]]\nname = \"x\"\ncolumn = \"status\"\n";
+  const Outcome bad = geomint("gate " + malformed.string() + " " + results);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("min"), std::string::npos) << bad.output;
+  EXPECT_EQ(geomint("gate " + failing.string() + " /nonexistent.csv").exit_code, 2);
+}
+
 TEST(Readme, MethodAndProblemTablesMatchTheRegistry) {
   std::set<std::string> methods, problems;
   for (const auto& entry : integrator_registry()) methods.insert(entry.name);
