@@ -9,6 +9,7 @@
 
 #include "harness/gate.hpp"
 #include "harness/order.hpp"
+#include "harness/reference.hpp"
 #include "harness/run.hpp"
 #include "harness/scene.hpp"
 
@@ -104,6 +105,18 @@ int main(int argc, char** argv) {
   sweep->add_option("--out", sweep_out,
                     "output folder (default: the scene's folder; with --quick: <folder>/quick)");
 
+  double reference_every = 0;
+  auto* reference = app.add_subcommand(
+      "reference",
+      "Write a reference solution (Gauss s=3 in long double, checked at 2*dt) to "
+      "results/references/<problem>.csv");
+  reference->add_option("--problem", problem_spec, "problem spec")->required();
+  reference->add_option("--t-end", t_end, "horizon (> 0)")->required();
+  reference->add_option("--dt", dt, "step (default: the problem's default dt / 8)");
+  reference->add_option("--every", reference_every,
+                        "spacing of the written rows (default: t-end/100; must divide t-end)");
+  reference->add_option("--out", out_path, "output file (default: results/references/...)");
+
   std::string gates_path;
   std::vector<std::string> gate_results;
   auto* gate = app.add_subcommand(
@@ -177,6 +190,23 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
                  study.row.at("declared_order"), study.row.at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
+      return 0;
+    }
+    if (*reference) {
+      ReferenceOptions options;
+      options.problem_spec = problem_spec;
+      options.t_end = t_end;
+      options.dt = dt;
+      options.output_every = reference_every;
+      options.out_path = out_path;
+      options.command_line = command_line;
+      const ReferenceSummary summary = generate_reference(options);
+      fmt::print("{}\n", summary.path);
+      fmt::print(stderr,
+                 "reference: dt={:.6g}, {} steps, estimated error final {:.3g}, max {:.3g} "
+                 "(difference to the 2*dt run), {:.1f} s\n",
+                 summary.dt, summary.steps, summary.estimated_error_final,
+                 summary.estimated_error_max, summary.seconds);
       return 0;
     }
     if (*gate) {

@@ -2,8 +2,11 @@
 // exact solution.
 #include "harness/observers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
+#include <vector>
 
 namespace geomint {
 namespace {
@@ -97,6 +100,166 @@ class ExactErrorObserver : public Observer {
   double error_max_ = 0, error_final_ = 0;
 };
 
+// phase_err: the time shift τ for which the exact solution best matches the computed state,
+// min over τ of ‖(q_k, p_k) − exact(t_k + τ)‖₂, as the angle 2πτ/T in radians (positive: the
+// computed motion is ahead). τ is followed through kPhaseCheckpoints checkpoints, each search
+// centred on the previous shift, so it unwraps past half a period. period_err: relative error
+// (T_computed − T)/T = −s/(1 + s) of the period, from the least-squares slope s of τ against t.
+class PhaseObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State& state, double t_end) override {
+    problem_ = &problem;
+    period_ = problem.period();
+    interval_ = (t_end - state.t) / kPhaseCheckpoints;
+    next_checkpoint_ = state.t + interval_;
+    times_ = {state.t};
+    shifts_ = {0.0};
+  }
+  void observe(const Problem& problem, const State& state) override {
+    if (!state.q.allFinite() || !state.p.allFinite()) return;
+    last_ = state;
+    if (state.t < next_checkpoint_ - 1e-9 * interval_) return;
+    shifts_.push_back(best_shift(problem, state, shifts_.back()));
+    times_.push_back(state.t);
+    while (next_checkpoint_ <= state.t + 1e-9 * interval_) next_checkpoint_ += interval_;
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    std::vector<double> times = times_, shifts = shifts_;
+    if (last_.q.size() > 0 && last_.t > times.back()) {
+      shifts.push_back(best_shift(*problem_, last_, shifts.back()));
+      times.push_back(last_.t);
+    }
+    if (times.size() < 2) return;
+    const double slope = window_maxima_slope(times, shifts);
+    metrics["phase_err"] = 2 * std::numbers::pi * shifts.back() / period_;
+    metrics["period_err"] = -slope / (1 + slope);
+  }
+
+ private:
+  static constexpr int kPhaseCheckpoints = 32;
+  static constexpr int kGrid = 2048;
+
+  static double distance_squared(const Problem& problem, const State& state, double t) {
+    const State exact = problem.exact(t);
+    return (state.q - exact.q).squaredNorm() + (state.p - exact.p).squaredNorm();
+  }
+  // Grid over one period centred on `guess` (fine enough for the perihelion passage of
+  // e = 0.99), then golden-section refinement around the three best local minima.
+  double best_shift(const Problem& problem, const State& state, double guess) const {
+    const double spacing = period_ / kGrid;
+    std::vector<double> value(kGrid + 1);
+    for (int i = 0; i <= kGrid; ++i) {
+      value[i] = distance_squared(problem, state, state.t + guess + (i - kGrid / 2) * spacing);
+    }
+    std::vector<int> minima;
+    for (int i = 0; i <= kGrid; ++i) {
+      if ((i == 0 || value[i] <= value[i - 1]) && (i == kGrid || value[i] <= value[i + 1])) {
+        minima.push_back(i);
+      }
+    }
+    std::sort(minima.begin(), minima.end(), [&](int a, int b) { return value[a] < value[b]; });
+    if (minima.size() > 3) minima.resize(3);
+    double best = guess, best_value = std::numeric_limits<double>::infinity();
+    const double golden = (std::sqrt(5.0) - 1) / 2;
+    for (int i : minima) {
+      double lo = guess + (i - kGrid / 2 - 1) * spacing, hi = lo + 2 * spacing;
+      double x1 = hi - golden * (hi - lo), x2 = lo + golden * (hi - lo);
+      double f1 = distance_squared(problem, state, state.t + x1);
+      double f2 = distance_squared(problem, state, state.t + x2);
+      for (int iteration = 0; iteration < 60; ++iteration) {
+        if (f1 < f2) {
+          hi = x2, x2 = x1, f2 = f1;
+          x1 = hi - golden * (hi - lo);
+          f1 = distance_squared(problem, state, state.t + x1);
+        } else {
+          lo = x1, x1 = x2, f1 = f2;
+          x2 = lo + golden * (hi - lo);
+          f2 = distance_squared(problem, state, state.t + x2);
+        }
+      }
+      const double x = f1 < f2 ? x1 : x2;
+      const double f = std::min(f1, f2);
+      if (f < best_value) best = x, best_value = f;
+    }
+    return best;
+  }
+
+  const Problem* problem_ = nullptr;
+  double period_ = 1, interval_ = 1, next_checkpoint_ = 0;
+  std::vector<double> times_, shifts_;
+  State last_;
+};
+
+// perihelion_err: precession of the apsidal line per orbit (radians, positive = prograde) of a
+// planar orbit: the least-squares slope, over the passages, of the angle of the computed maxima
+// of |q|, each refined by a parabola through the three step points around it. It is measured at
+// the apocentre, where the step points are dense even when e = 0.99 sweeps radians per step
+// through the pericentre. Needs two passages and an eccentric orbit
+// ((r_max − r_min)/(r_max + r_min) ≥ 1e-3).
+class PericentreObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State& state, double) override {
+    double r_min = std::numeric_limits<double>::infinity(), r_max = 0;
+    for (int i = 0; i < 256; ++i) {
+      const double r = problem.exact(state.t + i * problem.period() / 256).q.norm();
+      r_min = std::min(r_min, r), r_max = std::max(r_max, r);
+    }
+    eccentric_ = (r_max - r_min) >= 1e-3 * (r_max + r_min);
+    push(state);
+  }
+  void observe(const Problem&, const State& state) override {
+    if (!eccentric_ || !state.q.allFinite()) return;
+    push(state);
+    if (count_ < 3 || !(r_[1] > r_[0] && r_[1] >= r_[2])) return;
+    // Vertex of the parabola through (t, r) at the three points, then the angle there by
+    // quadratic interpolation.
+    const double t0 = t_[0], t1 = t_[1], t2 = t_[2];
+    const double d01 = (r_[1] - r_[0]) / (t1 - t0), d12 = (r_[2] - r_[1]) / (t2 - t1);
+    const double curvature = (d12 - d01) / (t2 - t0);
+    double vertex = curvature < 0 ? 0.5 * (t0 + t1) - d01 / (2 * curvature) : t1;
+    vertex = std::clamp(vertex, t0, t2);
+    double angle = 0;
+    for (int i = 0; i < 3; ++i) {
+      double weight = 1;
+      for (int j = 0; j < 3; ++j) {
+        if (j != i) weight *= (vertex - t_[j]) / (t_[i] - t_[j]);
+      }
+      angle += weight * angle_[i];
+    }
+    passages_.push_back(angle);
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    if (!eccentric_ || passages_.size() < 2) return;
+    std::vector<double> index(passages_.size());
+    for (size_t i = 0; i < index.size(); ++i) index[i] = static_cast<double>(i);
+    // The unwrapped angle gains a whole turn per orbit; what is left is the precession.
+    const double turn = 2 * std::numbers::pi;
+    const double slope = window_maxima_slope(index, passages_);
+    metrics["perihelion_err"] = slope - turn * std::round(slope / turn);
+  }
+
+ private:
+  // Keeps the last three step points with the polar angle unwrapped along the trajectory.
+  void push(const State& state) {
+    double angle = std::atan2(state.q[1], state.q[0]);
+    if (count_ > 0) {
+      const double previous = angle_[count_ < 3 ? count_ - 1 : 2];
+      angle = previous + std::remainder(angle - previous, 2 * std::numbers::pi);
+    }
+    if (count_ == 3) {
+      for (int i = 0; i < 2; ++i) t_[i] = t_[i + 1], r_[i] = r_[i + 1], angle_[i] = angle_[i + 1];
+    } else {
+      ++count_;
+    }
+    t_[count_ - 1] = state.t, r_[count_ - 1] = state.q.norm(), angle_[count_ - 1] = angle;
+  }
+
+  bool eccentric_ = false;
+  int count_ = 0;
+  double t_[3] = {}, r_[3] = {}, angle_[3] = {};
+  std::vector<double> passages_;
+};
+
 }  // namespace
 
 bool has_energy_reference(const Problem& problem) {
@@ -115,6 +278,12 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
         std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
   }
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
+  if (problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce)) {
+    observers.push_back(std::make_unique<PhaseObserver>());
+    if (problem.has(kAngularMomentum) && problem.dof() == 2) {
+      observers.push_back(std::make_unique<PericentreObserver>());
+    }
+  }
   return observers;
 }
 

@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 
 #include "harness/observers.hpp"
+#include "harness/reference.hpp"
 
 namespace geomint {
 namespace {
@@ -213,6 +215,16 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   row["t_end"] = format_number(config.t_end);
 
   auto observers = make_metric_observers(*problem);
+  if (!problem->has(kExact) && !config.reference_dir.empty()) {
+    const std::string path = reference_path(config.reference_dir, problem->spec());
+    if (std::filesystem::exists(path)) {
+      auto reference = load_reference(path, *problem);  // InputError when malformed
+      if (reference->row_at(problem->initial_state().t + config.t_end) >= 0) {
+        observers.push_back(make_reference_observer(std::move(reference)));
+        row["reference"] = std::filesystem::path(path).filename().string();
+      }
+    }
+  }
   std::unique_ptr<SeriesWriter> series;
   if (!config.series_path.empty()) {
     series = std::make_unique<SeriesWriter>(*problem, config, integrator->spec());

@@ -19,6 +19,10 @@ struct RunConfig {
   bool series_state = false;  // force q, p columns for problems with > 64 dof
   int timing_repeats = 3;     // separate timed runs without observers; 0 = no wall_s
   std::string command_line;   // for the series provenance
+  // Problems without an exact solution: error_final/error_max against the reference file
+  // <reference_dir>/<problem>.csv when it exists and has a row at t_end (harness/reference.hpp);
+  // the row's column `reference` names the file.
+  std::string reference_dir = "results/references";
 };
 
 struct RunResult {

@@ -182,8 +182,11 @@ Scene load_scene(const std::string& path, bool quick) {
   const auto order_tables = tables_of(root, "orders", path);
   top.known("runs");
   top.known("orders");
-  if (run_tables.empty() && order_tables.empty()) {
-    throw InputError(fmt::format("{}: no [[runs]] or [[orders]] block: nothing to run", path));
+  const auto stability_tables = tables_of(root, "stability", path);
+  top.known("stability");
+  if (run_tables.empty() && order_tables.empty() && stability_tables.empty()) {
+    throw InputError(
+        fmt::format("{}: no [[runs]], [[orders]] or [[stability]] block: nothing to run", path));
   }
   std::set<std::string> labels;
   for (size_t i = 0; i < run_tables.size(); ++i) {
@@ -248,6 +251,47 @@ Scene load_scene(const std::string& path, bool quick) {
     if (!labels.insert(block.label).second)
       throw InputError(fmt::format("{}: label used twice", where));
     scene.orders.push_back(block);
+  }
+  for (size_t i = 0; i < stability_tables.size(); ++i) {
+    BlockReader reader(*stability_tables[i], fmt::format("{}: [[stability]] #{}", path, i + 1));
+    StabilityBlock block;
+    block.label = reader.string("label", true);
+    const std::string where = fmt::format("{}: [[stability]] '{}'", path, block.label);
+    block.problems = reader.strings("problems", true);
+    block.methods = reader.strings("methods", true);
+    StabilityOptions& options = block.options;
+    options.homega_min = reader.number("homega_min", false, options.homega_min);
+    options.homega_max = reader.number("homega_max", false, options.homega_max);
+    options.h_min = reader.number("h_min", false, 0);
+    options.h_max = reader.number("h_max", false, 0);
+    options.periods = reader.number("periods", false, options.periods);
+    options.t_end = reader.number("t_end", false, 0);
+    options.min_steps = reader.integer("min_steps", false, options.min_steps);
+    options.growth = reader.number("growth", false, options.growth);
+    options.scan_points_per_decade = static_cast<int>(
+        reader.integer("scan_points_per_decade", false, options.scan_points_per_decade));
+    options.rel_tol = reader.number("rel_tol", false, options.rel_tol);
+    const double quick_periods = reader.number("quick_periods", false, 0);
+    const long quick_min_steps = reader.integer("quick_min_steps", false, 0);
+    const double quick_rel_tol = reader.number("quick_rel_tol", false, 0);
+    reader.finish();
+    if (quick && quick_periods > 0) options.periods = quick_periods;
+    if (quick && quick_min_steps > 0) options.min_steps = quick_min_steps;
+    if (quick && quick_rel_tol > 0) options.rel_tol = quick_rel_tol;
+    validate_stability_options(options, where);
+    bool all_adaptive = false;
+    validate_specs(block.problems, block.methods, where, &all_adaptive);
+    for (const auto& method : block.methods) {
+      if (make_integrator(method)->info().flags & kAdaptive) {
+        throw InputError(
+            fmt::format("{}: method '{}' is adaptive: a stability search needs a "
+                        "fixed-step method",
+                        where, method));
+      }
+    }
+    if (!labels.insert(block.label).second)
+      throw InputError(fmt::format("{}: label used twice", where));
+    scene.stability.push_back(block);
   }
   top.finish();
   return scene;
@@ -346,9 +390,23 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       }
     }
   }
+  struct StabilityJob {
+    std::string label, problem, method;
+    const StabilityOptions* options;
+    Row row;
+  };
+  std::vector<StabilityJob> stability_jobs;
+  for (const auto& block : scene.stability) {
+    for (const auto& problem : block.problems) {
+      for (const auto& method : block.methods) {
+        stability_jobs.push_back({block.label, problem, method, &block.options, {}});
+      }
+    }
+  }
   size_t timed = 0;
   for (const auto& job : jobs) timed += job.timed;
-  Progress progress(jobs.size() + order_jobs.size() + timed, options.progress);
+  Progress progress(jobs.size() + order_jobs.size() + stability_jobs.size() + timed,
+                    options.progress);
 
   // Accuracy runs (parallel); specs were validated when the scene was loaded.
   parallel_for(jobs.size() + order_jobs.size(), options.jobs, [&](size_t i) {
@@ -363,6 +421,21 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       job.study =
           order_study(job.problem, job.method, job.block->dt0, job.block->levels, job.block->t_end);
     }
+    progress.tick();
+  });
+  // Stability searches (parallel; each is a sequence of short runs without observers).
+  parallel_for(stability_jobs.size(), options.jobs, [&](size_t i) {
+    StabilityJob& job = stability_jobs[i];
+    try {
+      job.row = stability_search(job.problem, job.method, *job.options).row;
+    } catch (const std::exception& error) {
+      // E.g. a problem without omega_max given an h*omega range: a row, not a crashed thread.
+      job.row = {{"problem", job.problem},
+                 {"method", job.method},
+                 {"status", "error"},
+                 {"message", error.what()}};
+    }
+    job.row["label"] = job.label;
     progress.tick();
   });
   // Timing runs, one at a time so they do not compete for cores.
@@ -420,6 +493,19 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     markdown += "## Fitted convergence orders (order.csv)\n\n" +
                 to_markdown(order_rows, {"problem", "method", "order", "declared_order",
                                          "points_used", "message"}) +
+                "\n";
+  }
+  if (!stability_jobs.empty()) {
+    std::vector<Row> stability_rows;
+    for (const auto& job : stability_jobs) stability_rows.push_back(job.row);
+    write_file_atomic(
+        (out / "stability.csv").string(),
+        to_csv(stability_rows, column_union(stability_rows, stability_columns()), lines));
+    markdown += "## Largest stable h*omega (stability.csv)\n\n" +
+                to_markdown(stability_rows,
+                            {"label", "problem", "method", "homega_max_measured", "predicted",
+                             "rel_diff", "status", "message"},
+                            6) +
                 "\n";
   }
   markdown += fmt::format("Produced by `{}`.\n", options.command_line);

@@ -1,10 +1,13 @@
 // Scenes (DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs (problems ×
-// methods × dt) and of order studies; `sweep` runs them (accuracy runs in parallel, timing runs
-// one at a time) and writes summary.csv, order.csv, series/ and table.md into the folder.
+// methods × dt), of order studies and of stability searches; `sweep` runs them (accuracy runs in
+// parallel, timing runs one at a time) and writes summary.csv, order.csv, stability.csv, series/
+// and table.md into the folder.
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "harness/stability.hpp"
 
 namespace geomint {
 
@@ -32,6 +35,7 @@ struct Scene {
   std::vector<std::string> table_columns;  // summary columns for table.md; empty = automatic
   std::vector<RunBlock> runs;
   std::vector<OrderBlock> orders;
+  std::vector<StabilityBlock> stability;  // [[stability]]: largest stable h*omega per method
 };
 
 // Parses and validates a scene file: unknown or missing keys, wrong types, bad specs and bad

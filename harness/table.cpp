@@ -94,6 +94,8 @@ const std::vector<std::string>& standard_columns() {
                                                    "error_final",
                                                    "error_max",
                                                    "phase_err",
+                                                   "period_err",
+                                                   "perihelion_err",
                                                    "order",
                                                    "declared_order",
                                                    "points_used",

@@ -18,8 +18,8 @@ enum class ForceAt { kNode, kMidpoint };
 
 // Same meaning as in discrete_lagrangian.cpp (see the forced-Noether note there).
 struct Forcing {
-  ForceSlot slot = ForceSlot::kPlus;
-  ForceAt at = ForceAt::kNode;
+  ForceSlot slot = ForceSlot::kSplit;
+  ForceAt at = ForceAt::kMidpoint;
   double minus_weight() const {
     return slot == ForceSlot::kMinus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
   }
@@ -63,7 +63,9 @@ struct Forcing {
 // F(q_k + (h/2)v, v) depends on v through q as well, non-symmetric C, or a force that is not affine
 // in v — R is not a gradient: minimize then falls back to Newton with a backtracking line search
 // on the merit ½‖R‖² (no objective, hence no SPD safeguard: the shifted step need not descend the
-// merit).
+// merit). The default (force_slot=split, force_at=midpoint, as in discrete_lagrangian.cpp) is such
+// a case: on a forced problem minimize is a line-searched Newton on R; force_at=node keeps the
+// exact objective.
 class HamiltonPontryagin final : public Integrator {
  public:
   HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, double tolerance,
@@ -346,14 +348,14 @@ class HamiltonPontryagin final : public Integrator {
 Forcing read_forcing(Params& params) {
   Forcing forcing;
   const std::string slot =
-      params.choice("force_slot", "plus", {"minus", "plus", "split"},
+      params.choice("force_slot", "split", {"minus", "plus", "split"},
                     "where the step's force impulse h F goes: F_d- (at q_k), F_d+ (at q_k+1), half "
                     "each");
   forcing.slot = slot == "minus"  ? ForceSlot::kMinus
                  : slot == "plus" ? ForceSlot::kPlus
                                   : ForceSlot::kSplit;
   const std::string at =
-      params.choice("force_at", "node", {"node", "midpoint"},
+      params.choice("force_at", "midpoint", {"node", "midpoint"},
                     "evaluate each impulse's force at its own node, or at q_k+1/2 for all slots");
   forcing.at = at == "node" ? ForceAt::kNode : ForceAt::kMidpoint;
   return forcing;

@@ -128,6 +128,9 @@ class Newmark final : public Integrator {
         jacobian *= h;
       };
       system.symmetric = !forced || (problem.has(kForceJacobian) && *damping_symmetric_);
+      // total_ holds the force at q₁(a₀) after the first residual: h‖M a‖ and h‖∇V‖ are the
+      // terms R cancels, and for hω ≫ 1 the latter dominates ‖p‖ + h‖M a₀‖ by (hω)².
+      system.scale_after_first_residual = [&] { return std::abs(h) * total_.norm(); };
       const double residual_scale = state.p.norm() + std::abs(h) * mass.cwiseProduct(a0_).norm();
       const NewtonResult result = newton_.solve(system, a1, residual_scale);
       counters_.newton_iters += result.iterations;

@@ -68,6 +68,11 @@ struct NewtonSystem {
   // direction of E, so the line search can always make progress; near a strict minimiser J is
   // positive definite again and the iteration is plain Newton. Empty (default): no safeguard.
   SparseMatrix spd_shift;
+  // Optional: called once, right after R(x₀) is evaluated, to add the size of the terms R
+  // balances as found at x₀ (e.g. h‖∇V(q₁(x₀))‖ when the stiff part only shows there) to the
+  // caller's residual_scale. Without it, a stiff step (hω ≫ 1) can ask for a residual below the
+  // round-off of its own terms and fail although the iteration has converged.
+  std::function<double()> scale_after_first_residual;
 };
 
 struct NewtonResult {

@@ -1,10 +1,12 @@
-// Planar pendulum θ̈ = −ω0² sin θ (unit mass, V = ω0²(1 − cos θ)). While it librates the exact
-// solution is sin(θ/2) = k sn(u0 + ω0 t | k²), θ̇ = 2 k ω0 cn(u0 + ω0 t | k²) (DLMF §22.19(i)).
+// Planar pendulum θ̈ = −ω0² sin θ (unit mass, V = ω0²(1 − cos θ)), exact through Jacobi elliptic
+// functions (DLMF §22.19(i)): librating, sin(θ/2) = k sn(u0 + ω0 t | k²); rotating (k > 1),
+// θ/2 = am(u0 ± k ω0 t | 1/k²). Modulus and complementary modulus are kept apart so that the
+// solution stays exact to rounding next to the separatrix k = 1.
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_mode.h>
 #include <gsl/gsl_sf_ellint.h>
-#include <gsl/gsl_sf_elljac.h>
 
+#include <cfloat>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -24,42 +26,97 @@ void check_gsl(int status, const char* function) {
   }
 }
 
-double complete_elliptic_k(double k) {
+// Carlson's R_F; K and F below use it with the complementary parameter m' = 1 − m given
+// directly, which GSL's K(k) and F(φ, k) would recompute as 1 − k² and lose near k = 1.
+double carlson_rf(double x, double y, double z) {
   gsl_sf_result result;
-  check_gsl(gsl_sf_ellint_Kcomp_e(k, GSL_PREC_DOUBLE, &result), "gsl_sf_ellint_Kcomp_e");
+  check_gsl(gsl_sf_ellint_RF_e(x, y, z, GSL_PREC_DOUBLE, &result), "gsl_sf_ellint_RF_e");
   return result.val;
 }
 
-// Incomplete F(φ, k) for φ in [−π, π]. The outer quarters are reflected into |φ| ≤ π/2 with
-// F(π − φ) = 2K − F(φ), so nothing depends on how a GSL version treats larger |φ|.
-double incomplete_elliptic_f(double phi, double k, double quarter_period) {
+// K(m) = R_F(0, m', 1) (DLMF 19.25.1).
+double complete_elliptic_k(double complementary_m) { return carlson_rf(0, complementary_m, 1); }
+
+// F(φ | m) = sin φ R_F(cos²φ, cos²φ + m' sin²φ, 1) for |φ| ≤ π/2 (DLMF 19.25.5, with
+// 1 − m sin²φ written without cancellation); the outer quarters use F(π − φ) = 2K − F(φ).
+double incomplete_elliptic_f(double phi, double complementary_m, double quarter_period) {
   const bool outer_quarter = std::abs(phi) > kPi / 2;
   const double inner_phi = outer_quarter ? std::copysign(kPi, phi) - phi : phi;
-  gsl_sf_result result;
-  check_gsl(gsl_sf_ellint_F_e(inner_phi, k, GSL_PREC_DOUBLE, &result), "gsl_sf_ellint_F_e");
-  return outer_quarter ? std::copysign(2 * quarter_period, phi) - result.val : result.val;
+  const double s = std::sin(inner_phi);
+  const double c = std::cos(inner_phi);
+  const double value = s * carlson_rf(c * c, c * c + complementary_m * s * s, 1);
+  return outer_quarter ? std::copysign(2 * quarter_period, phi) - value : value;
+}
+
+struct Jacobi {
+  double am, sn, cn, dn;
+};
+
+// am, sn, cn, dn of (u | m) by the descending Landen/AGM scheme (DLMF 22.20(ii)) started from
+// b0 = √m' and c1 = m / (2(1 + √m')), so that nothing is formed as 1 − m. am is continuous in u.
+Jacobi jacobi_elliptic(double u, double m, double complementary_m) {
+  constexpr int kMaxLevels = 32;
+  double a[kMaxLevels + 1], c[kMaxLevels + 1];
+  a[0] = 1;
+  double b = std::sqrt(complementary_m);
+  c[1] = m / (2 * (1 + b));
+  int levels = 0;
+  while (levels < kMaxLevels && (levels == 0 || std::abs(c[levels]) > DBL_EPSILON * a[levels])) {
+    ++levels;
+    const double a_next = 0.5 * (a[levels - 1] + b);
+    if (levels > 1) c[levels] = c[levels - 1] * c[levels - 1] / (4 * a_next);
+    b = std::sqrt(a[levels - 1] * b);
+    a[levels] = a_next;
+    if (c[1] == 0) break;
+  }
+  double phi = std::ldexp(a[levels] * u, levels);
+  for (int n = levels; n >= 1; --n) phi = 0.5 * (phi + std::asin(c[n] / a[n] * std::sin(phi)));
+  const double sn = std::sin(phi);
+  const double cn = std::cos(phi);
+  // dn = √(1 − m sn²) = √(cn² + m' sn²) without cancellation.
+  return {phi, sn, cn, std::sqrt(cn * cn + complementary_m * sn * sn)};
 }
 
 class Pendulum final : public Problem {
  public:
   Pendulum(double theta0, double omega0, double v0) : theta0_(theta0), omega0_(omega0), v0_(v0) {
-    // k² = E / (2 ω0²) with E = ½ θ̇² + 2 ω0² sin²(θ/2); the motion librates iff k < 1.
-    const double half_angle_sine = std::sin(theta0 / 2);
-    modulus_ = std::hypot(half_angle_sine, v0 / (2 * omega0));
-    // Closer to the separatrix K(k) and the phase become too ill-conditioned to be "exact".
-    librating_ = modulus_ < 1 - 1e-12;
+    // k² = E / (2 ω0²) with E = ½ θ̇² + 2 ω0² sin²(θ/2); the motion librates iff k < 1. With
+    // s = sin(θ0/2), c = |cos(θ0/2)|, w = |v0|/(2ω0): k² = s² + w² and 1 − k² = (c − w)(c + w),
+    // which keeps its relative accuracy at θ0 = π − 1e-6 where 1 − k² ~ 1e-13.
+    const double reduced_theta0 = std::remainder(theta0, 2 * kPi);  // in [−π, π]
+    // The formulas live on [−π, π]; whole turns in θ0 are carried as an offset.
+    turns_offset_ = theta0 - reduced_theta0;
+    const double s = std::sin(reduced_theta0 / 2);
+    const double c = std::cos(reduced_theta0 / 2);
+    const double w = std::abs(v0) / (2 * omega0);
+    const double modulus_squared = s * s + w * w;
+    const double one_minus_k2 = (c - w) * (c + w);
+    modulus_ = std::sqrt(modulus_squared);
+    // On the separatrix itself (and within k' < 1e-10 of it) the period is infinite or too
+    // ill-conditioned to call anything exact.
+    const bool has_exact = std::abs(one_minus_k2) >= 1e-20;
+    librating_ = one_minus_k2 > 0;
 
     unsigned capabilities = kHessian | kOmegaMax;
-    if (librating_) {
+    if (has_exact && librating_) {
       capabilities |= kExact | kPeriod;
-      quarter_period_ = complete_elliptic_k(modulus_);
-      // The formula lives on (−π, π]; whole turns in θ0 are carried as an offset.
-      const double reduced_theta0 = std::remainder(theta0, 2 * kPi);
-      turns_offset_ = theta0 - reduced_theta0;
+      parameter_ = modulus_squared;
+      complementary_parameter_ = one_minus_k2;
+      quarter_period_ = complete_elliptic_k(complementary_parameter_);
       // am(u0) = φ0 with k sn(u0) = sin(θ0/2) and 2 k ω0 cn(u0) = v0; from rest at θ0 > 0
       // this gives φ0 = π/2 and u0 = K.
-      const double phi0 = std::atan2(std::sin(reduced_theta0 / 2), v0 / (2 * omega0));
-      phase0_ = incomplete_elliptic_f(phi0, modulus_, quarter_period_);
+      const double phi0 = std::atan2(s, v0 / (2 * omega0));
+      phase0_ = incomplete_elliptic_f(phi0, complementary_parameter_, quarter_period_);
+    } else if (has_exact) {
+      // Rotation: θ/2 = am(u0 + σ k ω0 t | 1/k²), σ = sign(v0), u0 = F(θ0/2 | 1/k²);
+      // 1 − 1/k² = (w − c)(w + c)/k².
+      capabilities |= kExact | kPeriod;
+      parameter_ = 1 / modulus_squared;
+      complementary_parameter_ = -one_minus_k2 / modulus_squared;
+      quarter_period_ = complete_elliptic_k(complementary_parameter_);
+      direction_ = v0 < 0 ? -1.0 : 1.0;
+      phase0_ =
+          incomplete_elliptic_f(reduced_theta0 / 2, complementary_parameter_, quarter_period_);
     }
     set_mass(Vec::Ones(1));
     set_capabilities(capabilities);
@@ -87,19 +144,30 @@ class Pendulum final : public Problem {
   }
 
   State exact(double t) const override {
-    if (!librating_) return Problem::exact(t);
-    // sn, cn are 4K-periodic; reducing the argument exactly (std::remainder) keeps GSL's
-    // Landen iteration accurate at large t.
-    const double u = std::remainder(phase0_ + omega0_ * t, 4 * quarter_period_);
-    double sn = 0, cn = 0, dn = 0;
-    check_gsl(gsl_sf_elljac_e(u, modulus_ * modulus_, &sn, &cn, &dn), "gsl_sf_elljac_e");
-    // cos(θ/2) = dn, so atan2 stays well conditioned near θ = ±π where arcsin is not.
-    const double theta = turns_offset_ + 2 * std::atan2(modulus_ * sn, dn);
-    return {t, Vec::Constant(1, theta), Vec::Constant(1, 2 * modulus_ * omega0_ * cn)};
+    if (!has(kExact)) return Problem::exact(t);
+    if (librating_) {
+      // sn, cn are 4K-periodic; reducing the argument exactly (std::remainder) keeps the
+      // Landen iteration accurate at large t.
+      const double u = std::remainder(phase0_ + omega0_ * t, 4 * quarter_period_);
+      const Jacobi f = jacobi_elliptic(u, parameter_, complementary_parameter_);
+      // cos(θ/2) = dn, so atan2 stays well conditioned near θ = ±π where arcsin is not.
+      const double theta = turns_offset_ + 2 * std::atan2(modulus_ * f.sn, f.dn);
+      return {t, Vec::Constant(1, theta), Vec::Constant(1, 2 * modulus_ * omega0_ * f.cn)};
+    }
+    // am(u + 2K) = am(u) + π: whole half-periods of am are counted, the rest is reduced.
+    const double u = phase0_ + direction_ * modulus_ * omega0_ * t;
+    const double half_turns = std::round(u / (2 * quarter_period_));
+    const double reduced_u = u - half_turns * 2 * quarter_period_;
+    const Jacobi f = jacobi_elliptic(reduced_u, parameter_, complementary_parameter_);
+    const double theta = turns_offset_ + 2 * f.am + 2 * kPi * half_turns;
+    return {t, Vec::Constant(1, theta),
+            Vec::Constant(1, 2 * direction_ * modulus_ * omega0_ * f.dn)};
   }
+  // Libration: 4K(k)/ω0; rotation: the time of one revolution, 2K(1/k)/(k ω0).
   double period() const override {
-    if (!librating_) return Problem::period();
-    return 4 * quarter_period_ / omega0_;
+    if (!has(kPeriod)) return Problem::period();
+    if (librating_) return 4 * quarter_period_ / omega0_;
+    return 2 * quarter_period_ / (modulus_ * omega0_);
   }
   // The linearised frequency ω0 √(cos θ) is largest at the bottom (on the upper half the
   // linearisation is unstable, not oscillatory), so ω0 bounds it for every θ.
@@ -109,10 +177,13 @@ class Pendulum final : public Problem {
   double theta0_;
   double omega0_;
   double v0_;
-  double modulus_ = 0;  // k of the elliptic functions (GSL's parameter is m = k²)
+  double modulus_ = 0;  // k = √(E / 2ω0²); the motion librates iff k < 1
   bool librating_ = false;
-  double quarter_period_ = 0;  // K(k)
+  // Parameter m of the elliptic functions (k² librating, 1/k² rotating) and m' = 1 − m.
+  double parameter_ = 0, complementary_parameter_ = 1;
+  double quarter_period_ = 0;  // K(m)
   double phase0_ = 0;          // u0
+  double direction_ = 1;       // sign of the rotation
   double turns_offset_ = 0;    // θ0 minus its representative in [−π, π]
 };
 

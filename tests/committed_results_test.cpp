@@ -79,6 +79,7 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
     ASSERT_TRUE(parse_number(committed.at("t_end"), t_end)) << committed.at("t_end");
     config.t_end = t_end;
     config.timing_repeats = 0;
+    config.reference_dir = (fs::path(GEOMINT_SOURCE_DIR) / "results" / "references").string();
     const RunResult rerun = run_one(committed.at("problem"), committed.at("method"), config);
     ++checked;
     const std::string where = committed.at("problem") + " / " + committed.at("method") +

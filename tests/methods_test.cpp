@@ -43,9 +43,12 @@ constexpr Ladder kKeplerLadder{"kepler:e=0.6", 0.02, 7, 5.0};
 
 void expect_declared_order(const std::string& method, const Ladder& ladder) {
   const int declared = make_integrator(method)->info().order;
-  // High orders reach the plateau sooner: start them at a larger dt.
-  const double dt0 = declared >= 4 ? ladder.dt0 * 4 : ladder.dt0;
-  const OrderStudy study = order_study(ladder.problem, method, dt0, ladder.levels, ladder.t_end);
+  // High orders reach the plateau sooner: start them at a larger dt (×4 from order 4, ×16 from
+  // order 8) and end orders >= 6 two levels earlier. On Kepler the round-off plateau sits near
+  // 1e-13, above the fit's plateau floor, so a finest point there would bend the slope.
+  const double dt0 = ladder.dt0 * (declared >= 8 ? 16 : declared >= 4 ? 4 : 1);
+  const int levels = declared >= 6 ? ladder.levels - 2 : ladder.levels;
+  const OrderStudy study = order_study(ladder.problem, method, dt0, levels, ladder.t_end);
   ASSERT_TRUE(std::isfinite(study.fit.order))
       << method << " on " << ladder.problem << ": " << study.fit.note;
   // ±0.3: the tolerance of DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
@@ -61,8 +64,10 @@ TEST_P(EveryMethod, DeclaredOrderOnKepler) { expect_declared_order(GetParam(), k
 // (explicit Euler, RK4) has trend × T ≈ err_max.
 bool energy_bounded_without_drift(const std::string& method, double* ratio) {
   RunConfig config;
-  config.dt = 0.05;
-  config.t_end = 5000.0;  // 1e5 steps
+  // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
+  // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
+  config.dt = make_integrator(method)->info().order >= 6 ? 0.2 : 0.05;
+  config.t_end = 1e5 * config.dt;
   config.timing_repeats = 0;
   const RunResult result = run_one("pendulum:theta0=1.5", method, config);
   if (!result.ok) {

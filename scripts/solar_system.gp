@@ -1,0 +1,62 @@
+# Outer solar system (GNI I.2.4): energy and angular-momentum error over 1e6 days, and the orbits.
+# Run inside results/solar_system (scripts/reproduce.sh does); reads series/{h10,h100,orbits}/.
+load scripts."/common.gp"
+methods = "stormer_verlet symplectic_euler_a hp_alpha_0.5 rk4"
+file(l, m) = "series/".l."/".m.".csv"
+# |L| of the initial state (GNI Table 2.1 data), for the relative angular-momentum error.
+L0 = 6.0782528363529986e-05
+names = "Sun Jupiter Saturn Uranus Neptune Pluto"
+max(a, b) = a > b ? a : b
+# Initial energy and angular momentum: the first row of any run (all start from Table 2.1).
+first = file("h10", "stormer_verlet")
+stats first using "energy" every ::0::0 nooutput; E0 = STATS_min
+stats first using "angular_momentum_0" every ::0::0 nooutput; L0x = STATS_min
+stats first using "angular_momentum_1" every ::0::0 nooutput; L0y = STATS_min
+stats first using "angular_momentum_2" every ::0::0 nooutput; L0z = STATS_min
+
+do for [format in "png pdf"] {
+  if (format eq "png") { set term @png_term; set term pngcairo size 1100,500 } else { set term @pdf_term; set term pdfcairo size 8in,3.6in }
+  set termoption noenhanced
+
+  # Relative energy error, both step sizes side by side on log-log axes: bounded oscillation for
+  # the symplectic methods, linear drift for RK4.
+  set output "energy.".format
+  set multiplot layout 1,2 title "Relative energy error |H - H0|/|H0|, outer solar system"
+  set xlabel "t [days]"; set ylabel "relative energy error"
+  set logscale xy; set format x "1e%T"; set format y "1e%T"; set xrange [1e3:1e6]
+  set key below horizontal
+  do for [h in "10 100"] {
+    set title "h = ".h." days"
+    plot for [i=1:words(methods)] file("h".h, word(methods,i)) \
+         using "t":(abs(column("energy") - E0) / abs(E0)) with lines ls i title word(methods,i)
+  }
+  unset multiplot
+
+  # Relative angular-momentum error |L - L0|/|L0| (round-off for the symplectic methods).
+  set output "angular_momentum.".format
+  set multiplot layout 1,2 title "Relative angular-momentum error |L - L0|/|L0|"
+  set ylabel "relative angular-momentum error"; set yrange [1e-17:*]
+  do for [h in "10 100"] {
+    set title "h = ".h." days"
+    plot for [i=1:words(methods)] file("h".h, word(methods,i)) \
+         using "t":(max(1e-17, sqrt((column("angular_momentum_0") - L0x)**2 + \
+                                   (column("angular_momentum_1") - L0y)**2 + \
+                                   (column("angular_momentum_2") - L0z)**2) / L0)) \
+         with lines ls i title word(methods,i)
+  }
+  unset multiplot
+  unset logscale; set format x "% h"; set format y "% h"; set xrange [*:*]; set yrange [*:*]
+
+  # Heliocentric orbits projected on the x-y plane (Stormer-Verlet, h = 10 days, 2e5 days); the
+  # barycentre drifts because GNI's initial data do not have zero total momentum.
+  if (format eq "png") { set term pngcairo size 800,800 } else { set term pdfcairo size 6in,6in }
+  set termoption noenhanced
+  set output "orbits.".format
+  set title "Heliocentric orbits, x-y projection (stormer_verlet, h = 10 days, T = 2e5 days)"
+  set xlabel "x - x_Sun [AU]"; set ylabel "y - y_Sun [AU]"; set size ratio -1; set key inside top right vertical
+  plot for [b=1:5] file("orbits", "stormer_verlet") \
+       using (column(sprintf("q_%d", 3*b)) - column("q_0")):(column(sprintf("q_%d", 3*b+1)) - column("q_1")) \
+       with lines ls b+1 title word(names, b+1), \
+       "+" using (0):(0) every ::0::0 with points pt 7 ps 2 lc rgb "#d62728" title "Sun"
+  set size noratio
+}
