@@ -148,8 +148,8 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
 
   evaluate(x, residual);
   if (system.scale_after_first_residual) {
-    result.threshold = options_.tolerance *
-                       std::max(1.0, residual_scale + system.scale_after_first_residual());
+    result.threshold =
+        options_.tolerance * std::max(1.0, residual_scale + system.scale_after_first_residual());
   }
   result.residual_norm = residual.norm();
   if (options_.record_history) result.residual_history.push_back(result.residual_norm);
