@@ -122,5 +122,34 @@ TEST(SolarSystemRuns, SymplecticMethodsKeepAngularMomentumAndBoundEnergy) {
   EXPECT_LE(verlet.metrics.at("energy_err_max"), 2e-5);
 }
 
+TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
+  // Issue 4: every registered variational method keeps the free, spinning bar's linear and
+  // angular momentum to solver tolerance; implicit Euler (not variational) is the negative
+  // control. Absolute errors; |L0| is O(1) for the default spin.
+  const std::string problem = "elastic_bar:nx=4,ny=1,nz=1,clamp=none";
+  int checked = 0;
+  for (const auto& entry : integrator_registry()) {
+    const unsigned flags = make_integrator(entry.name)->info().flags;
+    if (!(flags & kVariational) || (flags & kAdaptive)) continue;
+    RunConfig config;
+    config.dt = 0.004;
+    config.t_end = 1.0;
+    config.timing_repeats = 0;
+    const RunResult result = run_one(problem, entry.name, config);
+    ASSERT_TRUE(result.ok) << entry.name << ": " << result.row.at("message");
+    EXPECT_LE(result.metrics.at("momentum_err_max"), 1e-10) << entry.name;
+    EXPECT_LE(result.metrics.at("angular_momentum_err_max"), 1e-10) << entry.name;
+    ++checked;
+  }
+  EXPECT_GE(checked, 6);
+  RunConfig config;
+  config.dt = 0.004;
+  config.t_end = 1.0;
+  config.timing_repeats = 0;
+  const RunResult euler = run_one(problem, "implicit_euler", config);
+  ASSERT_TRUE(euler.ok);
+  EXPECT_GT(euler.metrics.at("angular_momentum_err_max"), 1e-4);
+}
+
 }  // namespace
 }  // namespace geomint
