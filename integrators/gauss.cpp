@@ -14,18 +14,13 @@ namespace geomint {
 // quadratic invariants (GNI §IV.2), angular momentum among them.
 std::unique_ptr<Integrator> make_gauss(Params& params) {
   const long stages = params.integer("s", 2, "Gauss-Legendre stages (order 2s)", 1, 3);
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale sqrt(s)(|p| + h|f|))",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
   const coefficients::PartitionedTableau& tableau = stages == 1   ? coefficients::kGauss1
                                                     : stages == 2 ? coefficients::kGauss2
                                                                   : coefficients::kGauss3;
   MethodInfo info{
       "gauss", tableau.order, kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
       fmt::format("{}, order {}; Butcher 1964; GNI §II.1.3, §VI.4", tableau.source, tableau.order)};
-  return make_partitioned_rk(tableau, std::move(info), tolerance, static_cast<int>(max_iterations));
+  return make_partitioned_rk(tableau, std::move(info), params);
 }
 
 }  // namespace geomint

@@ -13,11 +13,6 @@ namespace geomint {
 // the invariants qᵀCp, angular momentum among them (GNI §IV.2).
 std::unique_ptr<Integrator> make_lobatto3ab(Params& params) {
   const long stages = params.integer("s", 3, "Lobatto stages (order 2s - 2)", 2, 4);
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale sqrt(s)(|p| + h|f|))",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
   const coefficients::PartitionedTableau& tableau = stages == 2   ? coefficients::kLobatto2
                                                     : stages == 3 ? coefficients::kLobatto3
                                                                   : coefficients::kLobatto4;
@@ -25,7 +20,7 @@ std::unique_ptr<Integrator> make_lobatto3ab(Params& params) {
       "lobatto3ab", tableau.order,
       kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
       fmt::format("{}, order {}; GNI §II.2.2, §VI.4; Jay 1996", tableau.source, tableau.order)};
-  return make_partitioned_rk(tableau, std::move(info), tolerance, static_cast<int>(max_iterations));
+  return make_partitioned_rk(tableau, std::move(info), params);
 }
 
 }  // namespace geomint

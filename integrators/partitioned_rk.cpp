@@ -211,10 +211,14 @@ class ImplicitPartitionedRk final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_partitioned_rk(const coefficients::PartitionedTableau& tableau,
-                                                MethodInfo info, double tolerance,
-                                                int max_iterations) {
+                                                MethodInfo info, Params& params) {
+  const double tolerance = params.real(
+      "tol", 1e-12, "Newton relative residual tolerance (scale sqrt(s)(|p| + h|f|))",
+      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
+  const long max_iterations =
+      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
   return std::make_unique<ImplicitPartitionedRk>(tableau, std::move(info), tolerance,
-                                                 max_iterations);
+                                                 static_cast<int>(max_iterations));
 }
 
 }  // namespace geomint

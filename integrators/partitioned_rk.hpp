@@ -12,10 +12,9 @@ namespace geomint {
 
 // The method Q_i = q₀ + hΣ_j a_ij V_j, M V_i = P_i = p₀ + hΣ_j â_ij f(Q_j, V_j, t₀ + c_j h),
 // q₁ = q₀ + hΣ_j b_j V_j, p₁ = p₀ + hΣ_j b_j f(Q_j, V_j, t₀ + c_j h), with the total force
-// f = −∇V + F. `info` is returned by info() as given (name, order, flags, reference);
-// `tolerance` and `max_iterations` configure the stage solve.
+// f = −∇V + F. `info` is returned by info() as given (name, order, flags, reference); the
+// stage solve's options `tol` and `max_iter` are read from `params` (shared by every tableau).
 std::unique_ptr<Integrator> make_partitioned_rk(const coefficients::PartitionedTableau& tableau,
-                                                MethodInfo info, double tolerance,
-                                                int max_iterations);
+                                                MethodInfo info, Params& params);
 
 }  // namespace geomint
