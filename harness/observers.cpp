@@ -49,7 +49,7 @@ class EnergyObserver : public Observer {
       times.push_back(t0_ + (w + 0.5) * window_length_);
       maxima.push_back(window_max_[w]);
     }
-    metrics["energy_drift"] = window_maxima_slope(times, maxima);
+    metrics["energy_drift"] = least_squares_slope(times, maxima);
   }
 
  private:
@@ -130,7 +130,7 @@ class PhaseObserver : public Observer {
       times.push_back(last_.t);
     }
     if (times.size() < 2) return;
-    const double slope = window_maxima_slope(times, shifts);
+    const double slope = least_squares_slope(times, shifts);
     metrics["phase_err"] = 2 * std::numbers::pi * shifts.back() / period_;
     metrics["period_err"] = -slope / (1 + slope);
   }
@@ -234,7 +234,7 @@ class PericentreObserver : public Observer {
     for (size_t i = 0; i < index.size(); ++i) index[i] = static_cast<double>(i);
     // The unwrapped angle gains a whole turn per orbit; what is left is the precession.
     const double turn = 2 * std::numbers::pi;
-    const double slope = window_maxima_slope(index, passages_);
+    const double slope = least_squares_slope(index, passages_);
     metrics["perihelion_err"] = slope - turn * std::round(slope / turn);
   }
 
@@ -287,19 +287,18 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
   return observers;
 }
 
-double window_maxima_slope(const std::vector<double>& window_time,
-                           const std::vector<double>& window_max) {
-  const size_t n = window_time.size();
+double least_squares_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = x.size();
   if (n < 2) return 0.0;
-  double mean_t = 0, mean_e = 0;
+  double mean_x = 0, mean_y = 0;
   for (size_t i = 0; i < n; ++i) {
-    mean_t += window_time[i] / n;
-    mean_e += window_max[i] / n;
+    mean_x += x[i] / n;
+    mean_y += y[i] / n;
   }
   double sxy = 0, sxx = 0;
   for (size_t i = 0; i < n; ++i) {
-    sxy += (window_time[i] - mean_t) * (window_max[i] - mean_e);
-    sxx += (window_time[i] - mean_t) * (window_time[i] - mean_t);
+    sxy += (x[i] - mean_x) * (y[i] - mean_y);
+    sxx += (x[i] - mean_x) * (x[i] - mean_x);
   }
   return sxx > 0 ? sxy / sxx : 0.0;
 }

@@ -29,8 +29,8 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
 // for forced problems that have one; false when neither applies.
 bool has_energy_reference(const Problem& problem);
 
-// Least-squares slope of per-window maxima (window centre time, max value); 0 for < 2 windows.
-double window_maxima_slope(const std::vector<double>& window_time,
-                           const std::vector<double>& window_max);
+// Least-squares slope of y against x (energy drift over per-window maxima, phase shift against
+// time, order of log error against log dt); 0 for fewer than 2 points or constant x.
+double least_squares_slope(const std::vector<double>& x, const std::vector<double>& y);
 
 }  // namespace geomint

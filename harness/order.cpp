@@ -7,23 +7,10 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/observers.hpp"
+
 namespace geomint {
 namespace {
-
-double least_squares_slope(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = static_cast<double>(x.size());
-  double mean_x = 0, mean_y = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    mean_x += x[i] / n;
-    mean_y += y[i] / n;
-  }
-  double sxy = 0, sxx = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    sxy += (x[i] - mean_x) * (y[i] - mean_y);
-    sxx += (x[i] - mean_x) * (x[i] - mean_x);
-  }
-  return sxy / sxx;
-}
 
 double local_slope(const std::vector<double>& dts, const std::vector<double>& errors, int a,
                    int b) {

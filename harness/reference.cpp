@@ -1,5 +1,5 @@
-// Reference solutions (see reference.hpp). Gauss–Legendre s = 3 coefficients: Hairer, Lubich,
-// Wanner, Geometric Numerical Integration (2nd ed.), Table II.1.2.
+// Reference solutions (see reference.hpp): Gauss–Legendre s = 3 (GNI Table II.1.2; the tableau
+// of integrators/high_order_coefficients.hpp, checked there in long double) in long double.
 #include "harness/reference.hpp"
 
 #include <fmt/format.h>
@@ -13,6 +13,7 @@
 
 #include "harness/scene.hpp"
 #include "harness/table.hpp"
+#include "integrators/high_order_coefficients.hpp"
 
 namespace geomint {
 namespace {
@@ -21,33 +22,8 @@ using Real = long double;
 using VecL = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 
 constexpr int kStages = 3;
+static_assert(coefficients::kGauss3.stages == kStages);
 constexpr int kMaxStageIterations = 100;
-
-// Gauss–Legendre collocation, s = 3, order 6, in long double.
-struct GaussTable {
-  Real a[kStages][kStages];
-  Real b[kStages];
-  Real c[kStages];
-};
-
-GaussTable gauss3() {
-  const Real r = std::sqrt(15.0L);
-  GaussTable g{};
-  const Real a[kStages][kStages] = {
-      {5.0L / 36, 2.0L / 9 - r / 15, 5.0L / 36 - r / 30},
-      {5.0L / 36 + r / 24, 2.0L / 9, 5.0L / 36 - r / 24},
-      {5.0L / 36 + r / 30, 2.0L / 9 + r / 15, 5.0L / 36},
-  };
-  for (int i = 0; i < kStages; ++i) {
-    for (int j = 0; j < kStages; ++j) g.a[i][j] = a[i][j];
-  }
-  g.b[0] = g.b[2] = 5.0L / 18;
-  g.b[1] = 4.0L / 9;
-  g.c[0] = 0.5L - r / 10;
-  g.c[1] = 0.5L;
-  g.c[2] = 0.5L + r / 10;
-  return g;
-}
 
 // The first-order field f(t, y) with y = (q, p) in long double. q' = M⁻¹p is formed in long
 // double; p' = −∇V(q) + F comes from the problem in double (problems offer only double), so each
@@ -79,8 +55,7 @@ class Field {
 // at the reference step) and a Kahan-compensated state update.
 class GaussIntegrator {
  public:
-  explicit GaussIntegrator(const Problem& problem)
-      : field_(problem), table_(gauss3()), n_(2 * problem.dof()) {
+  explicit GaussIntegrator(const Problem& problem) : field_(problem), n_(2 * problem.dof()) {
     for (auto& z : z_) z = VecL::Zero(n_);
     for (auto& f : f_) f = VecL::Zero(n_);
     compensation_ = VecL::Zero(n_);
@@ -133,7 +108,7 @@ class GaussIntegrator {
 
  private:
   Field field_;
-  GaussTable table_;
+  const coefficients::PartitionedTableau& table_ = coefficients::kGauss3;  // â = a for Gauss
   int n_;
   VecL z_[kStages], f_[kStages], next_z_, stage_, increment_, compensation_;
 };

@@ -80,9 +80,9 @@ TEST(OrderFit, NeedsThreePoints) {
   EXPECT_NE(fit.note.find("need 3"), std::string::npos);
 }
 
-TEST(Drift, SlopeOfWindowMaxima) {
-  EXPECT_NEAR(window_maxima_slope({1, 2, 3, 4}, {2, 4, 6, 8}), 2.0, 1e-14);
-  EXPECT_NEAR(window_maxima_slope({1, 2, 3, 4}, {5, 5, 5, 5}), 0.0, 1e-14);
+TEST(Drift, LeastSquaresSlope) {
+  EXPECT_NEAR(least_squares_slope({1, 2, 3, 4}, {2, 4, 6, 8}), 2.0, 1e-14);
+  EXPECT_NEAR(least_squares_slope({1, 2, 3, 4}, {5, 5, 5, 5}), 0.0, 1e-14);
 }
 
 TEST(Table, CsvHasProvenanceHeaderAndQuotes) {
