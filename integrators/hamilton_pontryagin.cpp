@@ -217,7 +217,8 @@ class HamiltonPontryagin final : public Integrator {
         }
         return energy;
       };
-      system.objective = [&](const Vec& x) {
+      // By value: `terms` is local to this block and the solver calls the objective after it.
+      system.objective = [terms](const Vec& x) {
         double scale = 0.0;
         return terms(x, scale);
       };
