@@ -94,7 +94,9 @@ class ImplicitPartitionedRk final : public Integrator {
       }
     };
 
+    double inner_scale = 0.0;
     NewtonSystem system;
+    system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& v, Vec& residual) {
       evaluate_stages(v);
       residual.resize(stages_ * n);
@@ -108,12 +110,14 @@ class ImplicitPartitionedRk final : public Integrator {
     };
     system.jacobian = [&](const Vec& v, SparseMatrix& jacobian) {
       std::vector<Eigen::Triplet<double>> triplets;
+      inner_scale = 0.0;
       for (int j = 0; j < stages_; ++j) {
         Vec qj = q0;
         for (int k = 0; k < stages_; ++k) {
           if (a_(j, k) != 0.0) qj += (h * a_(j, k)) * v.segment(k * n, n);
         }
         eval_hessian(problem, qj, hessians_[j]);
+        inner_scale += std::abs(h) * gradient_term_scale(hessians_[j], qj);
         if (forced) damping_at(problem, qj, v.segment(j * n, n), t0 + c_[j] * h, dampings_[j]);
       }
       for (int i = 0; i < stages_; ++i) {
