@@ -122,6 +122,8 @@ int main(int argc, char** argv) {
   auto* gate = app.add_subcommand(
       "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
   gate->add_option("gates", gates_path, "GATES.toml with [[gate]] blocks")->required();
+  bool gate_verbose = false;
+  gate->add_flag("--verbose", gate_verbose, "print every checked row, not only the failing ones");
   gate->add_option("results", gate_results,
                    "result CSV files (summary.csv, order.csv, ...) or scene folders "
                    "(results/<scene>, results/<scene>/quick)")
@@ -221,7 +223,9 @@ int main(int argc, char** argv) {
         failed += outcome.passed ? 0 : 1;
         fmt::print("{} {} ({} row(s))\n", outcome.passed ? "PASS" : "FAIL", outcome.gate->name,
                    outcome.rows_checked);
-        for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
+        if (!outcome.passed || gate_verbose) {
+          for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
+        }
       }
       if (applicable == 0) {
         throw InputError(fmt::format(
