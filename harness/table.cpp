@@ -23,7 +23,11 @@
 
 namespace geomint {
 
-const char* version();
+// harness/build_info.cpp, generated at build time by scripts/build_info.cmake.
+const char* build_version();
+const char* build_git_sha();
+const char* build_compiler();
+const char* build_flags();
 
 namespace {
 
@@ -62,9 +66,9 @@ std::string shorten_number(const std::string& text, int digits) {
 std::vector<std::pair<std::string, std::string>> provenance(const std::string& command_line) {
   const auto now = std::chrono::system_clock::now();
   return {
-      {"geomint", fmt::format("{} ({})", version(), GEOMINT_GIT_SHA)},
-      {"compiler", GEOMINT_COMPILER},
-      {"flags", GEOMINT_CXX_FLAGS},
+      {"geomint", fmt::format("{} ({})", build_version(), build_git_sha())},
+      {"compiler", build_compiler()},
+      {"flags", build_flags()},
       {"libraries",
        fmt::format("Eigen {}.{}.{}, GSL {}, SUNDIALS {}, Boost {}.{}, fmt {}", EIGEN_WORLD_VERSION,
                    EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, GSL_VERSION, SUNDIALS_VERSION,
