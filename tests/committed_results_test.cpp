@@ -108,7 +108,8 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
 INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_with_summary()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            std::string name;
-                           for (char c : info.param) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           for (char c : info.param)
+                             name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });
 
