@@ -154,10 +154,14 @@ class Outcome:
     output: str
 
 
+LIVE: set[int] = set()  # process groups of running children, killed on SIGINT/SIGTERM
+
+
 def run(command: list[str], cwd: Path, timeout: float, log_path: Path | None = None) -> Outcome:
     start = time.monotonic()
     with subprocess.Popen(command, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           text=True, errors="replace", start_new_session=True) as process:
+        LIVE.add(process.pid)
         try:
             output, _ = process.communicate(timeout=timeout)
             code: int | None = process.returncode
@@ -165,6 +169,8 @@ def run(command: list[str], cwd: Path, timeout: float, log_path: Path | None = N
             os.killpg(process.pid, signal.SIGKILL)
             output, _ = process.communicate()
             code = None
+        finally:
+            LIVE.discard(process.pid)
     seconds = time.monotonic() - start
     if log_path is not None:
         log_path.parent.mkdir(parents=True, exist_ok=True)
@@ -475,7 +481,28 @@ def write_reports(records: list[Record], scratch: Path, header: list[str]) -> tu
 # ---------------------------------------------------------------------------------------------
 
 
+class Interrupted(Exception):
+    pass
+
+
+def on_signal(number, _frame):
+    for group in list(LIVE):
+        try:
+            os.killpg(group, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    raise Interrupted(f"signal {number}")
+
+
+def count_tests(build: Path, binary: str, gtest_filter: str) -> int:
+    outcome = run([str(build / TEST_BINARIES[binary]), "--gtest_list_tests",
+                   f"--gtest_filter={gtest_filter}"], build, 120)
+    return sum(1 for line in outcome.output.splitlines() if line.startswith("  "))
+
+
 def main() -> int:
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
     repo = Path(__file__).resolve().parent.parent
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -547,6 +574,14 @@ def main() -> int:
         log(f"mutation: the unmutated copy does not build (see {log_path})")
         return 2
     log(f"mutation: baseline build {outcome.seconds:.0f} s")
+    empty = sorted({f"{m.id}: {spec}" for m in selected for spec in m.tests
+                    if count_tests(build, spec.split(":", 1)[0],
+                                   test_invocations([spec])[spec.split(":", 1)[0]]) == 0})
+    if empty:
+        log("mutation: broken mutant list: these test entries select no test (gtest filters "
+            "match the full name, e.g. Registry/EveryMethod.X/rk4: write *EveryMethod.*):\n  "
+            + "\n  ".join(empty))
+        return 2
     mode = gate_mode(geomint, src)
 
     baseline_failures: dict[str, set[str]] = {}
@@ -688,4 +723,8 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except Interrupted as interruption:
+        log(f"mutation: interrupted ({interruption}); the scratch copy was restored")
+        sys.exit(130)
