@@ -1,11 +1,14 @@
-// Accuracy gates: gates file parsing (toml++), result CSV loading and the checks (gate.hpp).
+// Accuracy gates: gates file parsing (toml++), result table loading with scene and variant, and
+// the checks (gate.hpp).
 #include "harness/gate.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -17,6 +20,8 @@
 
 namespace geomint {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::optional<double> parse_number(const std::string& text) {
   if (text.empty()) return std::nullopt;
@@ -48,9 +53,126 @@ bool values_match(const std::string& expected, const std::string& actual) {
   return std::abs(*a - *b) <= 1e-12 * std::max(std::abs(*a), std::abs(*b));
 }
 
+const char* const kAllowedKeys =
+    "name, scene, table, variants, file, where, column, min, max, equals, quick_min, quick_max, "
+    "quick_equals";
+
+// Reads one [[gate]] block's keys (typed, with messages naming the gate and the key).
+class GateBlock {
+ public:
+  GateBlock(const toml::table& block, std::string where) : block_(block), where_(std::move(where)) {}
+  void rename(std::string where) { where_ = std::move(where); }
+  const std::string& where() const { return where_; }
+
+  std::optional<std::string> text(const char* key) const {
+    const toml::node* node = block_.get(key);
+    if (!node) return std::nullopt;
+    if (auto value = node->value<std::string>()) return *value;
+    throw InputError(fmt::format("{}: key '{}' must be a string", where_, key));
+  }
+  std::optional<double> number(const char* key) const {
+    const toml::node* node = block_.get(key);
+    if (!node) return std::nullopt;
+    auto value = node->value<double>();
+    if (!value || node->is_boolean()) {
+      throw InputError(fmt::format("{}: key '{}' must be a number", where_, key));
+    }
+    if (std::isnan(*value)) {
+      throw InputError(fmt::format("{}: key '{}' is NaN: a band needs a number", where_, key));
+    }
+    return *value;
+  }
+
+ private:
+  const toml::table& block_;
+  std::string where_;
+};
+
+void validate_check(const GateCheck& check, const std::string& where, const char* prefix) {
+  if (!check.min && !check.max && !check.equals) {
+    throw InputError(fmt::format("{}: give '{}min' and/or '{}max', or '{}equals'", where, prefix,
+                                 prefix, prefix));
+  }
+  if (check.equals && (check.min || check.max)) {
+    throw InputError(fmt::format("{}: '{}equals' cannot be combined with '{}min'/'{}max'", where,
+                                 prefix, prefix, prefix));
+  }
+  if (check.min && check.max && *check.min > *check.max) {
+    throw InputError(fmt::format("{}: {}min = {} is above {}max = {}", where, prefix, *check.min,
+                                 prefix, *check.max));
+  }
+}
+
+// "fig1_pendulum/summary.csv" → scene and table (the pre-scene `file` key of older gate files).
+void parse_legacy_file(const std::string& file, Gate& gate, const std::string& where) {
+  const fs::path path(file);
+  const auto parts = std::distance(path.begin(), path.end());
+  if (parts != 2 || path.extension() != ".csv") {
+    throw InputError(fmt::format(
+        "{}: 'file' must be '<scene>/<table>.csv' (got '{}'); prefer scene = \"...\" and "
+        "table = \"summary\"",
+        where, file));
+  }
+  gate.scene = path.begin()->string();
+  gate.table = path.stem().string();
+}
+
+// `# key: value` provenance lines at the top of a result CSV.
+std::map<std::string, std::string> provenance_of(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line) && !line.empty() && line[0] == '#') {
+    const auto colon = line.find(": ");
+    if (colon == std::string::npos || colon < 2) continue;
+    out[line.substr(2, colon - 2)] = line.substr(colon + 2);
+  }
+  return out;
+}
+
+ResultFile read_result_file(const fs::path& path) {
+  std::ifstream stream(path);
+  if (!stream) throw InputError(fmt::format("gate: cannot read result file '{}'", path.string()));
+  std::stringstream text;
+  text << stream.rdbuf();
+  ResultFile file;
+  file.path = path.string();
+  file.table = path.stem().string();
+  try {
+    file.rows = parse_csv(text.str());
+  } catch (const std::runtime_error& error) {
+    throw InputError(fmt::format("gate: result file '{}': {}", path.string(), error.what()));
+  }
+  const auto lines = provenance_of(text.str());
+  const auto scene = lines.find("scene");
+  const auto variant = lines.find("variant");
+  if (scene != lines.end() && !scene->second.empty()) {
+    file.scene = scene->second;
+    file.variant = variant != lines.end() ? variant->second : "full";
+  } else {
+    // Files written before the scene lines: results/<scene>[/quick]/<table>.csv.
+    const fs::path folder = fs::absolute(path).parent_path();
+    file.variant = folder.filename() == "quick" ? "quick" : "full";
+    file.scene = (file.variant == "quick" ? folder.parent_path() : folder).filename().string();
+  }
+  if (file.variant != "full" && file.variant != "quick") {
+    throw InputError(fmt::format("gate: result file '{}': unknown variant '{}' (full or quick)",
+                                 path.string(), file.variant));
+  }
+  if (file.scene.empty()) {
+    throw InputError(
+        fmt::format("gate: result file '{}': cannot tell its scene (no '# scene:' line)",
+                    path.string()));
+  }
+  return file;
+}
+
 }  // namespace
 
 std::vector<Gate> load_gates(const std::string& path) {
+  if (fs::is_directory(path)) {
+    throw InputError(fmt::format("gates file '{}' is a directory; give a GATES.toml file", path));
+  }
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -69,69 +191,98 @@ std::vector<Gate> load_gates(const std::string& path) {
   if (!blocks || blocks->empty()) {
     throw InputError(fmt::format("gates file '{}': no [[gate]] blocks", path));
   }
-  const std::set<std::string> allowed = {"name", "file", "where", "column", "min", "max", "equals"};
+  const std::set<std::string> allowed = {"name",   "scene", "table",  "variants",  "file",
+                                         "where",  "column", "min",   "max",       "equals",
+                                         "quick_min", "quick_max", "quick_equals"};
   std::vector<Gate> gates;
+  std::set<std::string> names;
   int index = 0;
   for (const toml::node& block_node : *blocks) {
     ++index;
-    const toml::table* block = block_node.as_table();
-    std::string where = fmt::format("gates file '{}', gate {}", path, index);
-    if (!block) throw InputError(where + ": must be a table ([[gate]])");
-    for (const auto& [key, node] : *block) {
+    const toml::table* table = block_node.as_table();
+    if (!table) {
+      throw InputError(
+          fmt::format("gates file '{}', gate {}: must be a table ([[gate]])", path, index));
+    }
+    GateBlock block(*table, fmt::format("gates file '{}', gate {}", path, index));
+    for (const auto& [key, node] : *table) {
       if (!allowed.count(std::string(key.str()))) {
-        throw InputError(fmt::format(
-            "{}: unknown key '{}' (allowed: name, file, where, column, min, max, equals)", where,
-            key.str()));
+        throw InputError(fmt::format("{}: unknown key '{}' (allowed: {})", block.where(),
+                                     key.str(), kAllowedKeys));
       }
     }
     Gate gate;
-    auto text = [&](const char* key, bool required) -> std::string {
-      const toml::node* node = block->get(key);
-      if (!node) {
-        if (required) throw InputError(fmt::format("{}: missing key '{}'", where, key));
-        return "";
+    const auto name = block.text("name");
+    if (!name) throw InputError(fmt::format("{}: missing key 'name'", block.where()));
+    gate.name = *name;
+    block.rename(fmt::format("gates file '{}', gate '{}'", path, gate.name));
+    if (!names.insert(gate.name).second) {
+      throw InputError(fmt::format("{}: name used twice", block.where()));
+    }
+    const auto column = block.text("column");
+    if (!column) throw InputError(fmt::format("{}: missing key 'column'", block.where()));
+    gate.column = *column;
+    if (const auto file = block.text("file")) {
+      if (table->get("scene") || table->get("table")) {
+        throw InputError(fmt::format("{}: give 'scene'/'table' or 'file', not both", block.where()));
       }
-      if (auto value = node->value<std::string>()) return *value;
-      throw InputError(fmt::format("{}: key '{}' must be a string", where, key));
-    };
-    auto number = [&](const char* key) -> std::optional<double> {
-      const toml::node* node = block->get(key);
-      if (!node) return std::nullopt;
-      if (auto value = node->value<double>()) return *value;
-      throw InputError(fmt::format("{}: key '{}' must be a number", where, key));
-    };
-    gate.name = text("name", true);
-    where = fmt::format("gates file '{}', gate '{}'", path, gate.name);
-    gate.file = text("file", false);
-    gate.column = text("column", true);
-    gate.min = number("min");
-    gate.max = number("max");
-    if (block->get("equals")) gate.equals = text("equals", true);
-    if (!gate.min && !gate.max && !gate.equals) {
-      throw InputError(where + ": give 'min' and/or 'max', or 'equals'");
+      parse_legacy_file(*file, gate, block.where());
     }
-    if (gate.equals && (gate.min || gate.max)) {
-      throw InputError(where + ": 'equals' cannot be combined with 'min'/'max'");
+    if (const auto scene = block.text("scene")) gate.scene = *scene;
+    if (const auto table_name = block.text("table")) gate.table = *table_name;
+    if (const toml::node* node = table->get("variants")) {
+      const toml::array* array = node->as_array();
+      gate.variants.clear();
+      if (array) {
+        for (const auto& item : *array) {
+          const auto value = item.value<std::string>();
+          if (!value || (*value != "full" && *value != "quick")) {
+            throw InputError(fmt::format(
+                "{}: 'variants' must list \"full\" and/or \"quick\"", block.where()));
+          }
+          gate.variants.push_back(*value);
+        }
+      }
+      if (!array || gate.variants.empty()) {
+        throw InputError(fmt::format("{}: 'variants' must be a non-empty array of \"full\", "
+                                     "\"quick\"",
+                                     block.where()));
+      }
     }
-    if (gate.min && gate.max && *gate.min > *gate.max) {
-      throw InputError(fmt::format("{}: min = {} is above max = {}", where, *gate.min, *gate.max));
+    gate.full.min = block.number("min");
+    gate.full.max = block.number("max");
+    gate.full.equals = block.text("equals");
+    validate_check(gate.full, block.where(), "");
+    const auto quick_min = block.number("quick_min");
+    const auto quick_max = block.number("quick_max");
+    const auto quick_equals = block.text("quick_equals");
+    if (quick_min || quick_max || quick_equals) {
+      GateCheck quick = gate.full;
+      if (quick_equals) quick = GateCheck{std::nullopt, std::nullopt, quick_equals};
+      if (quick_min || quick_max) quick.equals.reset();
+      if (quick_min) quick.min = quick_min;
+      if (quick_max) quick.max = quick_max;
+      validate_check(quick, block.where(), "quick_");
+      gate.quick = quick;
     }
-    if (const toml::node* node = block->get("where")) {
+    if (const toml::node* node = table->get("where")) {
       const toml::table* conditions = node->as_table();
       if (!conditions) {
-        throw InputError(where + ": 'where' must be an inline table, e.g. { method = \"rk4\" }");
+        throw InputError(block.where() +
+                         ": 'where' must be an inline table, e.g. { method = \"rk4\" }");
       }
       for (const auto& [key, value] : *conditions) {
-        const std::string column(key.str());
-        std::string expected = node_text(value, where);
-        if (is_spec_column(column)) {
+        const std::string where_column(key.str());
+        std::string expected = node_text(value, block.where());
+        if (is_spec_column(where_column)) {
           try {
-            expected = canonical_spec(column, expected);
+            expected = canonical_spec(where_column, expected);
           } catch (const InputError& error) {
-            throw InputError(fmt::format("{}: where.{}: {}", where, column, error.what()));
+            throw InputError(
+                fmt::format("{}: where.{}: {}", block.where(), where_column, error.what()));
           }
         }
-        gate.where.emplace_back(column, expected);
+        gate.where.emplace_back(where_column, expected);
       }
     }
     gates.push_back(std::move(gate));
@@ -140,17 +291,31 @@ std::vector<Gate> load_gates(const std::string& path) {
 }
 
 std::vector<ResultFile> load_result_files(const std::vector<std::string>& paths) {
-  if (paths.empty()) throw InputError("gate: give at least one result CSV file");
+  if (paths.empty()) throw InputError("gate: give at least one result CSV file or scene folder");
   std::vector<ResultFile> files;
   for (const auto& path : paths) {
-    std::ifstream stream(path);
-    if (!stream) throw InputError(fmt::format("gate: cannot read result file '{}'", path));
-    std::stringstream text;
-    text << stream.rdbuf();
-    try {
-      files.push_back({path, parse_csv(text.str())});
-    } catch (const std::runtime_error& error) {
-      throw InputError(fmt::format("gate: result file '{}': {}", path, error.what()));
+    std::error_code error;
+    const auto status = fs::status(path, error);
+    if (error || !fs::exists(status)) {
+      throw InputError(fmt::format("gate: result path '{}' does not exist", path));
+    }
+    if (fs::is_directory(status)) {
+      std::vector<fs::path> tables;
+      for (const auto& entry : fs::directory_iterator(path)) {
+        if (entry.is_regular_file() && entry.path().extension() == ".csv") {
+          tables.push_back(entry.path());
+        }
+      }
+      if (tables.empty()) {
+        throw InputError(fmt::format(
+            "gate: folder '{}' holds no result table (*.csv); give results/<scene> or "
+            "results/<scene>/quick after a sweep",
+            path));
+      }
+      std::sort(tables.begin(), tables.end());
+      for (const auto& table : tables) files.push_back(read_result_file(table));
+    } else {
+      files.push_back(read_result_file(path));
     }
   }
   return files;
@@ -179,12 +344,15 @@ std::vector<GateOutcome> check_gates(const std::vector<Gate>& gates,
     GateOutcome outcome;
     outcome.gate = &gate;
     outcome.passed = true;
+    outcome.applicable = false;
     for (const ResultFile& file : files) {
-      const bool file_matches =
-          gate.file.empty() || (file.path.size() >= gate.file.size() &&
-                                file.path.compare(file.path.size() - gate.file.size(),
-                                                  gate.file.size(), gate.file) == 0);
-      if (!file_matches) continue;
+      const bool of_scene = gate.scene.empty() || file.scene == gate.scene;
+      const bool of_variant =
+          std::find(gate.variants.begin(), gate.variants.end(), file.variant) != gate.variants.end();
+      if (!of_scene || !of_variant) continue;
+      outcome.applicable = true;
+      if (!gate.table.empty() && file.table != gate.table) continue;
+      const GateCheck& check = gate.check_for(file.variant);
       for (const Row& row : file.rows) {
         bool selected = true;
         for (const auto& [column, expected] : gate.where) {
@@ -196,33 +364,43 @@ std::vector<GateOutcome> check_gates(const std::vector<Gate>& gates,
         }
         if (!selected) continue;
         ++outcome.rows_checked;
-        const std::string label = fmt::format("{}: method={} problem={}{}", file.path,
-                                              row.count("method") ? row.at("method") : "-",
-                                              row.count("problem") ? row.at("problem") : "-",
-                                              row.count("dt") ? " dt=" + row.at("dt") : "");
+        const std::string label = fmt::format(
+            "{}{}: label={} method={} problem={}{}", file.path,
+            file.variant == "quick" ? " (quick)" : "", row.count("label") ? row.at("label") : "-",
+            row.count("method") ? row.at("method") : "-",
+            row.count("problem") ? row.at("problem") : "-",
+            row.count("dt") ? " dt=" + row.at("dt") : "");
         const auto actual = row_value(row, gate.column);
         bool ok = false;
         std::string verdict;
         if (!actual) {
           verdict = fmt::format("column '{}' is empty or absent", gate.column);
-        } else if (gate.equals) {
-          ok = *actual == *gate.equals;
-          verdict = fmt::format("{} = '{}' (required '{}')", gate.column, *actual, *gate.equals);
+        } else if (check.equals) {
+          ok = *actual == *check.equals;
+          verdict = fmt::format("{} = '{}' (required '{}')", gate.column, *actual, *check.equals);
         } else {
           const auto value = parse_number(*actual);
-          ok = value && !std::isnan(*value) && (!gate.min || *value >= *gate.min) &&
-               (!gate.max || *value <= *gate.max);
+          ok = value && !std::isnan(*value) && (!check.min || *value >= *check.min) &&
+               (!check.max || *value <= *check.max);
           verdict = fmt::format("{} = {} (required in [{}, {}])", gate.column, *actual,
-                                gate.min ? format_number(*gate.min) : "-inf",
-                                gate.max ? format_number(*gate.max) : "inf");
+                                check.min ? format_number(*check.min) : "-inf",
+                                check.max ? format_number(*check.max) : "inf");
         }
         outcome.passed = outcome.passed && ok;
         outcome.lines.push_back(fmt::format("{} {}: {}", ok ? "ok  " : "FAIL", label, verdict));
       }
     }
-    if (outcome.rows_checked == 0) {
+    if (!outcome.applicable) {
+      outcome.passed = true;
+      outcome.lines.push_back(fmt::format(
+          "not applicable: no result of scene '{}' ({}) was given", gate.scene,
+          fmt::join(gate.variants, "/")));
+    } else if (outcome.rows_checked == 0) {
       outcome.passed = false;
-      outcome.lines.push_back("FAIL no result row matches this gate's 'file' and 'where'");
+      outcome.lines.push_back(fmt::format(
+          "FAIL no row of table '{}' matches this gate's 'where' in the results given for scene "
+          "'{}'",
+          gate.table.empty() ? "*" : gate.table, gate.scene.empty() ? "*" : gate.scene));
     }
     outcomes.push_back(std::move(outcome));
   }

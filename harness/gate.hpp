@@ -1,5 +1,6 @@
-// Accuracy gates (DESIGN.md §4, `geomint gate GATES.toml RESULTS.csv...`): thresholds on the
-// columns of result CSVs, so a CI pipeline fails when a published number leaves its band.
+// Accuracy gates (DESIGN.md §4, `geomint gate GATES.toml RESULTS...`): thresholds on the columns
+// of result tables, selected by scene and table, so a CI pipeline fails when a published number
+// leaves its band — on the full scenes and on their CI-sized `--quick` variant alike.
 #pragma once
 
 #include <optional>
@@ -10,32 +11,55 @@
 
 namespace geomint {
 
-// One [[gate]] block. Every row that matches `where` must satisfy the check, and at least one
-// row must match (a gate that selects nothing fails: a renamed run must not pass silently).
-struct Gate {
-  std::string name;
-  std::string file;  // only rows from CSV files whose path ends with this ("" = any file)
-  std::vector<std::pair<std::string, std::string>> where;  // column = value
-  std::string column;
+// Bounds of a numeric gate, or the exact text of a text gate.
+struct GateCheck {
   std::optional<double> min, max;     // inclusive bounds on the numeric value of `column`
   std::optional<std::string> equals;  // exact text of `column` (e.g. status = "ok")
 };
 
+// One [[gate]] block. Every row of the selected tables that matches `where` must satisfy the
+// check, and at least one row must match when the gate applies (a gate that selects nothing
+// fails: a renamed run must not pass silently). A gate applies to the results given when their
+// scenes include `scene` (or it names no scene) in one of its `variants`; otherwise it is
+// reported as not applicable, so one gates file serves any subset of the scenes.
+struct Gate {
+  std::string name;
+  std::string scene;           // results/<scene>/ ("" = every scene given)
+  std::string table;           // "summary", "order", "stability", ... ("" = every table)
+  std::vector<std::string> variants = {"full", "quick"};  // which sweeps it gates
+  std::vector<std::pair<std::string, std::string>> where;  // column = value
+  std::string column;
+  GateCheck full;                  // min/max/equals
+  std::optional<GateCheck> quick;  // quick_min/quick_max/quick_equals, where the CI-sized run
+                                   // differs (unset keys fall back to the full bounds)
+  const GateCheck& check_for(const std::string& variant) const {
+    return variant == "quick" && quick ? *quick : full;
+  }
+};
+
 // Parses a gates file; InputError names the file, block and key for malformed input (unknown
-// or missing keys, wrong types, min > max, a gate with neither bounds nor `equals`).
+// or missing keys, wrong types, NaN bounds, min > max, a gate with neither bounds nor `equals`).
 std::vector<Gate> load_gates(const std::string& path);
 
-// A CSV file's rows with the file they came from.
+// A result table with where it came from. The scene and variant come from the `# scene:` and
+// `# variant:` provenance lines that `geomint sweep` writes; for older files, from the path
+// (results/<scene>/<table>.csv, results/<scene>/quick/<table>.csv).
 struct ResultFile {
   std::string path;
+  std::string scene;
+  std::string table;    // file name without .csv
+  std::string variant;  // "full" or "quick"
   std::vector<Row> rows;
 };
 
-// Reads result CSVs (InputError for a missing or unparsable file).
+// Reads result CSVs; a directory stands for the tables in it (summary.csv, order.csv,
+// stability.csv, ...; not series/). InputError for a missing, unreadable or unparsable path, a
+// directory without tables, or a file whose scene cannot be told.
 std::vector<ResultFile> load_result_files(const std::vector<std::string>& paths);
 
 struct GateOutcome {
   const Gate* gate = nullptr;
+  bool applicable = true;  // false: none of the given results is of the gate's scene/variant
   bool passed = false;
   int rows_checked = 0;
   std::vector<std::string> lines;  // one per checked row (value and verdict), or why none

@@ -96,16 +96,108 @@ equals = "ok"
   EXPECT_EQ(outcomes[1].rows_checked, 3);
 }
 
-TEST(Gate, FileFilterRestrictsRowsToMatchingPaths) {
+TEST(Gate, TableFilterRestrictsRowsToThatTable) {
   const auto outcomes = check(R"(
 [[gate]]
-name = "other file"
-file = "order.csv"
+name = "other table"
+table = "order"
 column = "status"
 equals = "ok"
 )");
+  EXPECT_TRUE(outcomes[0].applicable);
   EXPECT_FALSE(outcomes[0].passed);
   EXPECT_EQ(outcomes[0].rows_checked, 0);
+}
+
+// A scene folder as `geomint sweep` writes it: results/<scene>/ and results/<scene>/quick/.
+std::filesystem::path write_scene_tables(const std::string& scene, const std::string& variant,
+                                         const std::string& energy_err_max) {
+  const auto folder = std::filesystem::temp_directory_path() /
+                      ("geomint_gate_" + std::to_string(::getpid())) / "elsewhere" / variant;
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "summary.csv")
+      << "# geomint: provenance line\n# scene: " << scene << "\n# variant: " << variant
+      << "\nlabel,method,status,energy_err_max\nshort,stormer_verlet,ok," << energy_err_max
+      << "\n";
+  return folder;
+}
+
+const char* kSceneGates = R"(
+[[gate]]
+name = "sv full and quick"
+scene = "fig1"
+table = "summary"
+where = { method = "stormer_verlet" }
+column = "energy_err_max"
+max = 1e-3
+quick_max = 1e-2
+[[gate]]
+name = "full only"
+scene = "fig1"
+variants = ["full"]
+column = "status"
+equals = "ok"
+[[gate]]
+name = "another scene"
+scene = "momentum"
+column = "status"
+equals = "ok"
+)";
+
+TEST(Gate, ScenesAndVariantsComeFromProvenanceAndQuickBandsApplyToQuickRuns) {
+  static std::vector<Gate> gates;
+  gates = load_gates(write_temp("scene_gates.toml", kSceneGates));
+  // 5e-3: outside the full band, inside the quick one.
+  const auto quick = write_scene_tables("fig1", "quick", "5e-3");
+  auto outcomes = check_gates(gates, load_result_files({quick.string()}));
+  ASSERT_EQ(outcomes.size(), 3u);
+  EXPECT_TRUE(outcomes[0].applicable);
+  EXPECT_TRUE(outcomes[0].passed) << outcomes[0].lines.front();
+  EXPECT_FALSE(outcomes[1].applicable);  // full only
+  EXPECT_FALSE(outcomes[2].applicable);  // scene not given: not a failure
+  EXPECT_TRUE(outcomes[2].passed);
+  const auto full = write_scene_tables("fig1", "full", "5e-3");
+  outcomes = check_gates(gates, load_result_files({full.string()}));
+  EXPECT_FALSE(outcomes[0].passed);
+  EXPECT_TRUE(outcomes[1].applicable);
+  EXPECT_TRUE(outcomes[1].passed);
+  // A quick band that the value leaves fails the quick run too.
+  outcomes = check_gates(
+      gates, load_result_files({write_scene_tables("fig1", "quick", "0.05").string()}));
+  EXPECT_FALSE(outcomes[0].passed);
+}
+
+TEST(Gate, ScenesComeFromThePathWhenTheFileHasNoSceneLine) {
+  const auto root = std::filesystem::temp_directory_path() /
+                    ("geomint_gate_path_" + std::to_string(::getpid()));
+  for (const char* folder : {"order_basic", "order_basic/quick", "basic"}) {
+    std::filesystem::create_directories(root / folder);
+    std::ofstream(root / folder / "order.csv") << "label,method,order\npendulum,rk4,4.0\n";
+  }
+  const auto files = load_result_files({(root / "order_basic" / "order.csv").string(),
+                                        (root / "order_basic" / "quick").string()});
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].scene, "order_basic");
+  EXPECT_EQ(files[0].variant, "full");
+  EXPECT_EQ(files[0].table, "order");
+  EXPECT_EQ(files[1].scene, "order_basic");
+  EXPECT_EQ(files[1].variant, "quick");
+  // The legacy `file` key names a scene and a table: "basic/order.csv" is not
+  // "order_basic/order.csv" (a path-suffix match took it for one).
+  static std::vector<Gate> gates;
+  gates = load_gates(write_temp("legacy.toml", R"(
+[[gate]]
+name = "basic"
+file = "basic/order.csv"
+column = "order"
+min = 3.5
+)"));
+  auto outcomes = check_gates(gates, files);
+  EXPECT_FALSE(outcomes[0].applicable);
+  outcomes = check_gates(gates, load_result_files({(root / "basic").string()}));
+  EXPECT_TRUE(outcomes[0].applicable);
+  EXPECT_TRUE(outcomes[0].passed);
+  EXPECT_EQ(outcomes[0].rows_checked, 1);
 }
 
 TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
@@ -118,6 +210,13 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
       {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nwhere = { method = \"rk5\" }\n", "rk5"},
       {"[[gate]\n", "gates file"},
       {"title = \"x\"\n", "title"},
+      {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmin = nan\n", "NaN"},
+      {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nquick_min = 2\n", "quick_min"},
+      {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nvariants = [\"ci\"]\n", "variants"},
+      {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nfile = \"order.csv\"\n", "scene"},
+      {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\n[[gate]]\nname = \"a\"\ncolumn = "
+       "\"x\"\nmax = 1\n",
+       "twice"},
   };
   for (const auto& [text, needle] : cases) {
     try {
@@ -129,24 +228,34 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
     }
   }
   EXPECT_THROW(load_result_files({"/nonexistent/summary.csv"}), InputError);
+  // A folder without tables is an input error naming it, not a gate that "selects no row".
+  const auto empty = std::filesystem::temp_directory_path() /
+                     ("geomint_gate_empty_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(empty);
+  EXPECT_THROW(load_result_files({empty.string()}), InputError);
+  EXPECT_THROW(load_gates(empty.string()), InputError);
 }
 
 TEST(Gate, RepositoryGatesPassOnTheCommittedResults) {
   const std::filesystem::path root = GEOMINT_SOURCE_DIR;
-  std::vector<std::string> files;
+  std::vector<std::string> folders;
   for (const auto& entry : std::filesystem::directory_iterator(root / "results")) {
-    for (const char* name : {"summary.csv", "order.csv", "stability.csv"}) {
-      if (std::filesystem::exists(entry.path() / name)) {
-        files.push_back((entry.path() / name).string());
-      }
+    if (std::filesystem::exists(entry.path() / "scene.toml")) {
+      folders.push_back(entry.path().string());
     }
   }
   const auto gates = load_gates((root / "results" / "gates.toml").string());
-  for (const auto& outcome : check_gates(gates, load_result_files(files))) {
+  int applicable = 0;
+  for (const auto& outcome : check_gates(gates, load_result_files(folders))) {
     std::string detail;
     for (const auto& line : outcome.lines) detail += "\n  " + line;
     EXPECT_TRUE(outcome.passed) << outcome.gate->name << detail;
+    applicable += outcome.applicable;
   }
+  // Every gate gates the committed (full) tables, except those written for the quick runs only.
+  int quick_only = 0;
+  for (const auto& gate : gates) quick_only += gate.variants == std::vector<std::string>{"quick"};
+  EXPECT_EQ(applicable + quick_only, static_cast<int>(gates.size()));
 }
 
 }  // namespace

@@ -122,7 +122,9 @@ int main(int argc, char** argv) {
   auto* gate = app.add_subcommand(
       "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
   gate->add_option("gates", gates_path, "GATES.toml with [[gate]] blocks")->required();
-  gate->add_option("results", gate_results, "result CSV files (summary.csv, order.csv, ...)")
+  gate->add_option("results", gate_results,
+                   "result CSV files (summary.csv, order.csv, ...) or scene folders "
+                   "(results/<scene>, results/<scene>/quick)")
       ->required();
 
   try {
@@ -212,14 +214,23 @@ int main(int argc, char** argv) {
     if (*gate) {
       const std::vector<Gate> gates = load_gates(gates_path);
       const auto outcomes = check_gates(gates, load_result_files(gate_results));
-      int failed = 0;
+      int failed = 0, applicable = 0;
       for (const auto& outcome : outcomes) {
+        if (!outcome.applicable) continue;
+        ++applicable;
         failed += outcome.passed ? 0 : 1;
         fmt::print("{} {} ({} row(s))\n", outcome.passed ? "PASS" : "FAIL", outcome.gate->name,
                    outcome.rows_checked);
         for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
       }
-      fmt::print("{} of {} gate(s) passed\n", outcomes.size() - failed, outcomes.size());
+      if (applicable == 0) {
+        throw InputError(fmt::format(
+            "gate: none of the {} gate(s) in '{}' applies to the results given (their scenes "
+            "and variants differ); nothing was checked",
+            outcomes.size(), gates_path));
+      }
+      fmt::print("{} of {} gate(s) passed ({} not applicable to the scenes given)\n",
+                 applicable - failed, applicable, outcomes.size() - applicable);
       return failed == 0 ? 0 : kExitFailed;
     }
     if (*sweep) {
@@ -231,6 +242,10 @@ int main(int argc, char** argv) {
       options.out_dir = !sweep_out.empty() ? sweep_out
                         : quick            ? (folder / "quick").string()
                                            : folder.string();
+      // Gates select tables by scene and variant (harness/gate.hpp): the scene is the folder
+      // that holds scene.toml, whatever --out says.
+      options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
+      options.variant = quick ? "quick" : "full";
       const int failed = run_sweep(scene, options);
       fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
                  scene.title, failed, options.out_dir);

@@ -453,7 +453,9 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     progress.tick();
   }
 
-  const auto lines = provenance(options.command_line);
+  auto lines = provenance(options.command_line);
+  if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
+  lines.emplace_back("variant", options.variant);
   int failed = 0;
   std::vector<Row> summary_rows, order_rows, order_point_rows;
   for (const auto& job : jobs) {

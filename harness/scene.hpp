@@ -46,6 +46,9 @@ struct SweepOptions {
   int jobs = 1;
   std::string out_dir;  // where outputs go
   std::string command_line;
+  // Written as `# scene:` and `# variant:` provenance lines, which `geomint gate` selects by.
+  std::string scene_name;
+  std::string variant = "full";  // "full" or "quick"
   bool progress = true;  // progress on stderr when it is a terminal
 };
 

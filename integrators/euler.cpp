@@ -134,11 +134,10 @@ class ImplicitEuler final : public Integrator {
     }
     const int n = problem.dof();
     // Central differences with the step that balances truncation (δ²) and round-off (ε/δ).
-    const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
     std::vector<Eigen::Triplet<double>> triplets;
     Vec v_shift = v, force_plus, force_minus;
     for (int j = 0; j < n; ++j) {
-      const double delta = relative_step * std::max(1.0, std::abs(v[j]));
+      const double delta = central_difference_step(v, j);
       v_shift[j] = v[j] + delta;
       q_shift_ = q_start + h * v_shift;
       eval_force(problem, q_shift_, v_shift, t_next, force_plus);

@@ -425,6 +425,28 @@ TEST(EnergyLaw, ImplicitEulerDividesByOnePlusOmegaSquared) {
   EXPECT_NEAR(oscillator_energy(state, omega) / (e0 * decay), 1.0, 1e-13);
 }
 
+// The same law far into the decay, stiff and with a non-unit mass: hω = 10 over 100 steps takes
+// the energy down by 101^100 = 1e200. Every step must still be solved relative to the state; a
+// Newton test with an absolute floor stops iterating once ‖p‖ < tol (after about 2 steps here)
+// and the state stalls near 1e-15 instead.
+TEST(EnergyLaw, ImplicitEulerKeepsDecayingAtEveryScale) {
+  const double mass = 0.25, omega = 100.0, h = 0.1;
+  const Oscillator problem({.mass = mass, .stiffness = mass * omega * omega, .p0 = 0.0});
+  auto integrator = make_integrator("implicit_euler");
+  State state = problem.initial_state();
+  integrator->reset(problem, state, h);
+  const auto energy = [&](const State& s) {
+    return 0.5 * s.p[0] * s.p[0] / mass + 0.5 * mass * omega * omega * s.q[0] * s.q[0];
+  };
+  const double e0 = energy(state);
+  for (int k = 1; k <= 100; ++k) {
+    ASSERT_TRUE(integrator->step(problem, state, h).ok) << "step " << k;
+    const double expected = e0 * std::pow(1 + h * h * omega * omega, -k);
+    // Newton's relative tolerance 1e-12 per step, accumulated over k steps.
+    ASSERT_NEAR(energy(state) / expected, 1.0, 1e-10) << "step " << k;
+  }
+}
+
 // max over steps of |I(q_k, p_k) − I(q_0, p_0)| / |I(q_0, p_0)|.
 double invariant_error(const std::string& method, double omega, double h, int steps,
                        const std::function<double(double q, double p)>& invariant) {

@@ -89,15 +89,20 @@ bool all_finite(const SparseMatrix& J) {
 
 }  // namespace
 
+double central_difference_step(const Vec& x, Eigen::Index j) {
+  const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
+  const double size = std::max(std::abs(x[j]), x.size() ? x.cwiseAbs().maxCoeff() : 0.0);
+  return relative_step * (size > 0.0 && std::isfinite(size) ? size : 1.0);
+}
+
 SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, Vec& f)>& f,
                                          const Vec& x) {
   const Eigen::Index n = x.size();
-  const double relative_step = std::cbrt(std::numeric_limits<double>::epsilon());
   std::vector<Eigen::Triplet<double>> triplets;
   Vec shifted = x, plus, minus;
   Eigen::Index rows = 0;
   for (Eigen::Index j = 0; j < n; ++j) {
-    const double delta = relative_step * std::max(1.0, std::abs(x[j]));
+    const double delta = central_difference_step(x, j);
     shifted[j] = x[j] + delta;
     f(shifted, plus);
     shifted[j] = x[j] - delta;
@@ -125,7 +130,8 @@ std::string describe(const NewtonResult& result) {
 
 NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
   NewtonResult result;
-  result.threshold = options_.tolerance * std::max(1.0, residual_scale);
+  const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
+  result.threshold = relative_tolerance * residual_scale;
   Factorisation& f = *factorisation_;
 
   Vec residual;
@@ -149,7 +155,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   evaluate(x, residual);
   if (system.scale_after_first_residual) {
     result.threshold =
-        options_.tolerance * std::max(1.0, residual_scale + system.scale_after_first_residual());
+        relative_tolerance * (residual_scale + system.scale_after_first_residual());
   }
   result.residual_norm = residual.norm();
   if (options_.record_history) result.residual_history.push_back(result.residual_norm);

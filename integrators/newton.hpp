@@ -12,10 +12,17 @@
 
 namespace geomint {
 
+// Smallest relative residual the stopping test asks for: R sums a few terms, each rounded to
+// ε of its size, so ‖R‖ cannot reliably get below a small multiple of ε·residual_scale.
+inline constexpr double kRoundoffFloor = 16 * 2.220446049250313e-16;
+
 struct NewtonOptions {
-  // Converged when ‖R(x)‖₂ ≤ tolerance · max(1, residual_scale), where residual_scale (passed to
-  // solve()) is the size of the terms that R balances, e.g. ‖p_k‖ + h‖∇V‖ for a momentum
-  // residual: the test is then relative to the physics, not to an arbitrary initial guess.
+  // Converged when ‖R(x)‖₂ ≤ max(tolerance, kRoundoffFloor) · residual_scale, where
+  // residual_scale (passed to solve(), plus NewtonSystem::scale_after_first_residual) is the size
+  // of the terms that R balances, e.g. ‖p_k‖ + h‖∇V‖ for a momentum residual. The test is
+  // relative to the physics with no absolute floor, so a state of size 1e-100 or 1e+100 is solved
+  // to the same relative accuracy as one of size 1 (scale-free); kRoundoffFloor keeps a
+  // tolerance far below ε from asking for a residual below the rounding of its own terms.
   double tolerance = 1e-12;
   int max_iterations = 50;  // Newton updates (Jacobian factorisations) allowed per solve
   // Backtracking on the merit function (½‖R‖², or the system's objective when it has one).
@@ -90,7 +97,7 @@ struct NewtonResult {
   double last_shift = 0.0;       // μ of the last shifted iteration
   bool polished = false;         // the polishing correction was taken (NewtonOptions::polish)
   double residual_norm = 0.0;
-  double threshold = 0.0;                // tolerance · max(1, residual_scale)
+  double threshold = 0.0;                // max(tolerance, kRoundoffFloor) · residual_scale
   std::vector<double> residual_history;  // ‖R‖ at x₀, x₁, … when options.record_history
 };
 
@@ -98,9 +105,14 @@ struct NewtonResult {
 // 1e-12 (newton_max_iter)".
 std::string describe(const NewtonResult& result);
 
-// ∂f/∂x at x by central differences, one column per unknown, with the step δ_j =
-// ε^(1/3)·max(1, |x_j|) that balances truncation (δ²) and round-off (ε/δ). Dense columns and
-// 2·dim(x) evaluations of f: for Jacobian pieces a problem does not provide, on small systems.
+// Central-difference step for unknown j: δ_j = ε^(1/3)·max(|x_j|, ‖x‖∞), which balances
+// truncation (δ²) and round-off (ε/δ) relative to the size of x — scale-free, so a state of size
+// 1e-100 is not differenced with steps of 1e-5 — and ε^(1/3) when x is exactly zero.
+double central_difference_step(const Vec& x, Eigen::Index j);
+
+// ∂f/∂x at x by central differences, one column per unknown, with the steps above. Dense
+// columns and 2·dim(x) evaluations of f: for Jacobian pieces a problem does not provide, on
+// small systems.
 SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, Vec& f)>& f,
                                          const Vec& x);
 

@@ -123,8 +123,12 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
     }
     Vec f_plus, f_minus;
     Vec q_shift = q;
+    // Steps relative to the size of q (1 only when q = 0), so tiny and huge states are
+    // differenced alike.
+    const double q_size = n > 0 ? q.cwiseAbs().maxCoeff() : 0.0;
     for (int j = 0; j < n; ++j) {
-      const double delta = 1e-7 * std::max(1.0, std::abs(q[j]));
+      const double size = std::max(std::abs(q[j]), q_size);
+      const double delta = 1e-7 * (size > 0.0 && std::isfinite(size) ? size : 1.0);
       q_shift[j] = q[j] + delta;
       force(q_shift, v, t, f_plus);
       q_shift[j] = q[j] - delta;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates results/<scene>/ for each scene named: runs the sweep, then the scene's gnuplot
 # script (scripts/<scene>.gp, run inside the scene folder), then the results/README.md index.
-# QUICK=1 runs the CI-sized variant into results/<scene>/quick/ instead.
+# QUICK=1 runs the CI-sized variant into results/<scene>/quick/ instead; PLOTS=0 skips gnuplot.
 set -euo pipefail
 geomint=$(realpath "$1")
 shift
@@ -19,7 +19,7 @@ for scene in "$@"; do
     (cd "$root" && "$geomint" sweep "results/$scene/scene.toml" --jobs "$jobs")
     out="$folder"
   fi
-  if [ -f "$root/scripts/$scene.gp" ]; then
+  if [ "${PLOTS:-1}" = 1 ] && [ -f "$root/scripts/$scene.gp" ]; then
     (cd "$out" && gnuplot -e "scripts='$root/scripts'" "$root/scripts/$scene.gp")
   fi
   echo "== $scene: $(( $(date +%s) - scene_start )) s" >&2

@@ -59,6 +59,55 @@ void expect_declared_order(const std::string& method, const Ladder& ladder) {
 TEST_P(EveryMethod, DeclaredOrderOnPendulum) { expect_declared_order(GetParam(), kPendulumLadder); }
 TEST_P(EveryMethod, DeclaredOrderOnKepler) { expect_declared_order(GetParam(), kKeplerLadder); }
 
+// Non-unit masses: a method that forgets M⁻¹ somewhere (Newmark's initial acceleration, say) is
+// exact for m = 1 and loses its order for any other mass, so every order test above would pass.
+// Linear problems with exact solutions, heavy and light: harmonic with m = 4, and a fixed-end
+// chain of four 2.5-kg masses.
+constexpr Ladder kHeavyHarmonicLadder{"harmonic:mass=4,omega=2", 0.1, 7, 5.0};
+constexpr Ladder kHeavyChainLadder{"spring_chain:n=4,mass=2.5,stiffness=3", 0.1, 7, 5.0};
+TEST_P(EveryMethod, DeclaredOrderWithNonUnitMass) {
+  expect_declared_order(GetParam(), kHeavyHarmonicLadder);
+  expect_declared_order(GetParam(), kHeavyChainLadder);
+}
+
+// Scale invariance: on a linear problem the discrete map of every fixed-step method commutes
+// with scaling the state, Φ(s·y) = s·Φ(y), so the trajectory from s·y₀ is s times the one from
+// y₀ — provided every solver test is relative to the state. An absolute floor in a Newton
+// tolerance (‖R‖ ≤ tol·max(1, scale)) stops iterating at s = 1e-100 and fails this.
+double scaled_trajectory_defect(const std::string& method, const std::string& problem_spec,
+                                double scale, double h, int steps) {
+  const auto problem = make_problem(problem_spec);
+  const State start = problem->initial_state();
+  State unit = start, scaled = start;
+  scaled.q *= scale;
+  scaled.p *= scale;
+  auto unit_integrator = make_integrator(method);
+  auto scaled_integrator = make_integrator(method);
+  unit_integrator->reset(*problem, unit, h);
+  scaled_integrator->reset(*problem, scaled, h);
+  double defect = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    if (!unit_integrator->step(*problem, unit, h).ok) return INFINITY;
+    if (!scaled_integrator->step(*problem, scaled, h).ok) return INFINITY;
+    const double size = std::sqrt(unit.q.squaredNorm() + unit.p.squaredNorm());
+    const double difference = std::sqrt((scaled.q / scale - unit.q).squaredNorm() +
+                                        (scaled.p / scale - unit.p).squaredNorm());
+    defect = std::max(defect, difference / size);
+  }
+  return defect;
+}
+
+TEST_P(EveryMethod, LinearProblemsAreSolvedScaleFree) {
+  // 40 steps; the two trajectories differ by rounding only (≈ steps·ε relative, times the
+  // stages), far below the 1e-12 Newton tolerance at which an absolute floor shows.
+  for (const char* problem : {"harmonic:mass=4,omega=3", "spring_chain:n=4,mass=2.5"}) {
+    for (double scale : {1e-100, 1e100}) {
+      EXPECT_LT(scaled_trajectory_defect(GetParam(), problem, scale, 0.1, 40), 1e-12)
+          << GetParam() << " on " << problem << " scaled by " << scale;
+    }
+  }
+}
+
 // Bounded energy error with no drift: over 1e5 steps the least-squares trend of the per-window
 // maxima, times the horizon, must stay below 10% of the maximum error itself. A drifting method
 // (explicit Euler, RK4) has trend × T ≈ err_max.
