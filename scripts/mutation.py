@@ -373,6 +373,8 @@ def run_gates(geomint: Path, src: Path, gates_file: str, mode: str, stage: Path,
         return {}
     arguments = stage_gate_inputs(stage, mode, outputs)
     outcome = run([str(geomint), "gate", gates_file, *arguments], src, timeout, log_path)
+    if outcome.code == 2 and "applies to the results given" in outcome.output:
+        return {}  # no gate covers these scenes
     if outcome.code is None or outcome.code not in (0, 1):
         return None  # timeout, crash or malformed gates file
     return gate_results(outcome.output)
