@@ -26,8 +26,10 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
 
+# Everything: all suites (slow ones included) and the whole mutation list (make mutation).
 test-all: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@$(MAKE) --no-print-directory mutation
 
 # Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
 reproduce-figures: build
