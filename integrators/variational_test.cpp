@@ -337,8 +337,8 @@ TEST(ForceSlots, MidpointDriftFollowsTheSignedImpulseTorqueOfItsSlot) {
   const int steps = 500;
   for (const char* base : {"del:", "hp:", "hp:solver=newton,"}) {
     for (const double sign : {-1.0, 1.0}) {
-      const std::string method = std::string(base) + "force_at=midpoint,force_slot=" +
-                                 (sign < 0 ? "minus" : "plus");
+      const std::string method =
+          std::string(base) + "force_at=midpoint,force_slot=" + (sign < 0 ? "minus" : "plus");
       const auto path = trajectory(method, *problem, problem->initial_state(), h, steps);
       ASSERT_EQ(path.size(), static_cast<size_t>(steps + 1)) << method;
       double predicted = 0, measured = 0, scale = 0;
@@ -359,8 +359,8 @@ TEST(ForceSlots, MidpointDriftFollowsTheSignedImpulseTorqueOfItsSlot) {
       // The accumulated change is well above round-off of L ≈ 323 (≈ 1e-13 a step) and has the
       // predicted sign; solver tolerance and round-off leave < 1e-6 of it.
       ASSERT_GT(scale, 1e-6) << method;
-      EXPECT_GT(measured * predicted, 0.0) << method << ": measured " << measured << ", predicted "
-                                           << predicted;
+      EXPECT_GT(measured * predicted, 0.0)
+          << method << ": measured " << measured << ", predicted " << predicted;
       EXPECT_NEAR(measured, predicted, 1e-6 * scale) << method;
     }
   }
