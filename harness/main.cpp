@@ -1,8 +1,11 @@
-// geomint command line (DESIGN.md §4): list, run, order, sweep. Exit codes: 0 ok, 1 a run
-// failed, 2 bad input (the message names the offending option, key or value).
+// geomint command line (DESIGN.md §4): list, run, order, sweep, reference, gate. Exit codes:
+// 0 ok, 1 a run or gate failed, 2 bad input (the message names the offending option, key or
+// value; checked before any computing, outputs included), 3 an internal error (a defect, or an
+// I/O failure after the up-front checks, e.g. a full disk).
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -19,6 +22,30 @@ namespace {
 
 constexpr int kExitFailed = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitInternal = 3;
+
+const std::vector<std::string> kCommands = {"list", "run", "order", "sweep", "reference", "gate"};
+
+// CLI11 says "A subcommand is required" for a missing or unknown verb; say which verbs exist.
+// Returns false (message printed) when argv[1] is not an option and not a command.
+bool check_command(int argc, char** argv) {
+  const std::string commands = fmt::format("{}", fmt::join(kCommands, ", "));
+  if (argc < 2) {
+    fmt::print(stderr, "geomint: error: a command is required ({}); see geomint --help\n",
+               commands);
+    return false;
+  }
+  const std::string first = argv[1];
+  if (first.empty() || first[0] != '-') {
+    if (std::find(kCommands.begin(), kCommands.end(), first) == kCommands.end()) {
+      fmt::print(stderr,
+                 "geomint: error: unknown command '{}' (commands: {}); see geomint --help\n", first,
+                 commands);
+      return false;
+    }
+  }
+  return true;
+}
 
 std::string joined_command_line(int argc, char** argv) {
   std::string out = "geomint";
@@ -72,8 +99,13 @@ int main(int argc, char** argv) {
   std::string problem_spec, method_spec, out_path, series_path;
   double dt = 0, t_end = 0;
   long every = 1;
-  int timing_repeats = 3;
+  long timing_repeats = 3;
+  double diverge_factor = kDefaultDivergeFactor;
   bool series_state = false;
+  const std::string diverge_help = fmt::format(
+      "stop a conservative run as 'diverged' when its relative energy error exceeds this "
+      "(default {:g}; 0 or inf: never)",
+      kDefaultDivergeFactor);
   auto* run = app.add_subcommand("run", "Run one problem with one method and print a CSV row");
   run->add_option("--problem", problem_spec, "problem spec, e.g. pendulum:theta0=1.5")->required();
   run->add_option("--method", method_spec, "method spec, e.g. stormer_verlet")->required();
@@ -83,17 +115,22 @@ int main(int argc, char** argv) {
   run->add_option("--series", series_path, "write a time series CSV here");
   run->add_option("--every", every, "series: every N-th step point (the last is always written)");
   run->add_flag("--state", series_state, "series: include q and p even for > 64 dof");
-  run->add_option("--timing-repeats", timing_repeats, "timing pass repeats (0 = none)");
+  run->add_option("--timing-repeats", timing_repeats,
+                  fmt::format("timing pass repeats (0 = none, at most {})", kMaxTimingRepeats));
+  run->add_option("--diverge-factor", diverge_factor, diverge_help);
 
   double dt0 = 0;
-  int levels = 6;
+  long levels = 6;
   auto* order = app.add_subcommand("order", "Fit the convergence order over a dt ladder");
   order->add_option("--problem", problem_spec, "problem spec")->required();
   order->add_option("--method", method_spec, "method spec")->required();
   order->add_option("--dt", dt0, "largest step dt0 (ladder dt0*2^-k)")->required();
-  order->add_option("--levels", levels, "number of ladder levels (>= 3)");
+  order->add_option(
+      "--levels", levels,
+      fmt::format("number of ladder levels ({}..{})", kMinOrderLevels, kMaxOrderLevels));
   order->add_option("--t-end", t_end, "horizon")->required();
   order->add_option("--out", out_path, "write the ladder runs as CSV");
+  order->add_option("--diverge-factor", diverge_factor, diverge_help);
 
   std::string scene_path, sweep_out;
   int jobs = 1;
@@ -114,7 +151,7 @@ int main(int argc, char** argv) {
   reference->add_option("--t-end", t_end, "horizon (> 0)")->required();
   reference->add_option("--dt", dt, "step (default: the problem's default dt / 8)");
   reference->add_option("--every", reference_every,
-                        "spacing of the written rows (default: t-end/100; must divide t-end)");
+                        "spacing of the written rows (> 0; default: t-end/100; must divide t-end)");
   reference->add_option("--out", out_path, "output file (default: results/references/...)");
 
   std::string gates_path;
@@ -122,11 +159,14 @@ int main(int argc, char** argv) {
   auto* gate = app.add_subcommand(
       "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
   gate->add_option("gates", gates_path, "GATES.toml with [[gate]] blocks")->required();
+  bool gate_verbose = false;
+  gate->add_flag("--verbose", gate_verbose, "print every checked row, not only the failing ones");
   gate->add_option("results", gate_results,
                    "result CSV files (summary.csv, order.csv, ...) or scene folders "
                    "(results/<scene>, results/<scene>/quick)")
       ->required();
 
+  if (!check_command(argc, argv)) return kExitBadInput;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -148,14 +188,27 @@ int main(int argc, char** argv) {
     }
     if (*run) {
       const auto problem = make_problem(problem_spec);
+      if (timing_repeats < 0 || timing_repeats > kMaxTimingRepeats) {
+        throw InputError(fmt::format("--timing-repeats must be in 0..{} (got {})",
+                                     kMaxTimingRepeats, timing_repeats));
+      }
       RunConfig config;
       config.dt = run->count("--dt") ? dt : problem->default_dt();
       config.t_end = run->count("--t-end") ? t_end : problem->default_t_end();
       config.series_path = series_path;
       config.series_every = every;
       config.series_state = series_state;
-      config.timing_repeats = timing_repeats;
+      config.timing_repeats = static_cast<int>(timing_repeats);
+      config.diverge_factor = diverge_factor;
       config.command_line = command_line;
+      // Outputs are checked before anything is computed.
+      if (!out_path.empty()) check_output_file(out_path, "--out");
+      if (!series_path.empty() && !out_path.empty() && same_file_path(series_path, out_path)) {
+        throw InputError(
+            fmt::format("--series and --out name the same file '{}' (the summary would overwrite "
+                        "the series)",
+                        out_path));
+      }
       const RunResult result = run_one(problem_spec, method_spec, config);
       const std::vector<Row> rows = {result.row};
       const std::string csv =
@@ -172,7 +225,10 @@ int main(int argc, char** argv) {
       return result.ok ? 0 : kExitFailed;
     }
     if (*order) {
-      const OrderStudy study = order_study(problem_spec, method_spec, dt0, levels, t_end);
+      validate_order_study(problem_spec, method_spec, dt0, levels, t_end);
+      if (!out_path.empty()) check_output_file(out_path, "--out");
+      const OrderStudy study = order_study(problem_spec, method_spec, dt0, static_cast<int>(levels),
+                                           t_end, diverge_factor);
       for (const auto& run_result : study.runs) {
         const auto& row = run_result.row;
         fmt::print(stderr, "dt={:<12} status={:<8} error_final={}\n", row.at("dt"),
@@ -195,6 +251,14 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*reference) {
+      if (reference->count("--every") && !(reference_every > 0)) {
+        throw InputError(fmt::format("--every must be > 0 (got {}); leave it out for t-end/100",
+                                     reference_every));
+      }
+      if (reference->count("--dt") && !(dt > 0)) {
+        throw InputError(
+            fmt::format("--dt must be > 0 (got {}); leave it out for the default", dt));
+      }
       ReferenceOptions options;
       options.problem_spec = problem_spec;
       options.t_end = t_end;
@@ -221,7 +285,9 @@ int main(int argc, char** argv) {
         failed += outcome.passed ? 0 : 1;
         fmt::print("{} {} ({} row(s))\n", outcome.passed ? "PASS" : "FAIL", outcome.gate->name,
                    outcome.rows_checked);
-        for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
+        if (!outcome.passed || gate_verbose) {
+          for (const auto& line : outcome.lines) fmt::print("    {}\n", line);
+        }
       }
       if (applicable == 0) {
         throw InputError(fmt::format(
@@ -246,6 +312,7 @@ int main(int argc, char** argv) {
       // that holds scene.toml, whatever --out says.
       options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
       options.variant = quick ? "quick" : "full";
+      check_output_dir(options.out_dir, sweep_out.empty() ? "output folder" : "--out");
       const int failed = run_sweep(scene, options);
       fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
                  scene.title, failed, options.out_dir);
@@ -256,7 +323,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   } catch (const std::exception& error) {
     fmt::print(stderr, "geomint: internal error: {}\n", error.what());
-    return 3;
+    return kExitInternal;
   }
   return 0;
 }

@@ -90,10 +90,26 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
   return fit;
 }
 
+void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
+                          double dt0, long levels, double t_end) {
+  if (levels < kMinOrderLevels || levels > kMaxOrderLevels) {
+    throw InputError(fmt::format("--levels must be in {}..{} (got {})", kMinOrderLevels,
+                                 kMaxOrderLevels, levels));
+  }
+  if (!(dt0 > 0 && std::isfinite(dt0))) {
+    throw InputError(fmt::format("--dt must be a finite number > 0 (got {})", dt0));
+  }
+  make_problem(problem_spec);
+  const bool adaptive = make_integrator(method_spec)->info().flags & kAdaptive;
+  RunConfig finest;
+  finest.dt = dt0 * std::ldexp(1.0, -static_cast<int>(levels - 1));
+  finest.t_end = t_end;
+  validate_run_config(finest, adaptive);
+}
+
 OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
-                       int levels, double t_end) {
-  if (levels < 3) throw InputError(fmt::format("--levels must be >= 3 (got {})", levels));
-  if (!(dt0 > 0)) throw InputError(fmt::format("--dt must be > 0 (got {})", dt0));
+                       int levels, double t_end, double diverge_factor) {
+  validate_order_study(problem_spec, method_spec, dt0, levels, t_end);
   OrderStudy study;
   std::vector<double> dts, errors;
   bool exact = true;
@@ -102,6 +118,7 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     config.dt = dt0 * std::ldexp(1.0, -k);
     config.t_end = t_end;
     config.timing_repeats = 0;
+    config.diverge_factor = diverge_factor;
     RunResult result = run_one(problem_spec, method_spec, config);
     exact = result.metrics.count("error_final") > 0;
     dts.push_back(config.dt);

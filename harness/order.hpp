@@ -27,9 +27,20 @@ struct OrderStudy {
   Row row;                      // problem, method, order, declared_order, points_used, ...
 };
 
+// Ladder length: at least 3 points for a fit, at most kMaxOrderLevels (dt0·2⁻²⁹ is already far
+// below any useful step).
+constexpr int kMinOrderLevels = 3;
+constexpr int kMaxOrderLevels = 30;
+
+// Checks levels, dt0 and t_end, and t_end/dt of the finest level against kMaxFixedSteps
+// (InputError naming the option) — everything a study needs before its first run.
+void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
+                          double dt0, long levels, double t_end);
+
 // Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing, and fits error_final (or, for
 // problems without an exact solution, the difference to the finest level — noted in the row).
+// Validates everything first (validate_order_study), so bad input throws before any run.
 OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
-                       int levels, double t_end);
+                       int levels, double t_end, double diverge_factor = kDefaultDivergeFactor);
 
 }  // namespace geomint

@@ -193,12 +193,12 @@ ReferenceSummary generate_reference(const ReferenceOptions& options) {
   const double every = options.output_every > 0 ? options.output_every : options.t_end / 100;
   const double ratio = options.t_end / every;
   const long outputs = std::lround(ratio);
-  if (!(options.output_every >= 0) || outputs < 1 ||
+  if (!(options.output_every >= 0) || !(ratio <= kMaxReferenceRows) || outputs < 1 ||
       std::abs(ratio - static_cast<double>(outputs)) > 1e-9 * ratio) {
     throw InputError(
-        fmt::format("--every must divide --t-end into a whole number of outputs "
+        fmt::format("--every must divide --t-end into a whole number of outputs, at most {:g} "
                     "(got --every {} for --t-end {})",
-                    every, options.t_end));
+                    kMaxReferenceRows, every, options.t_end));
   }
   // An even number of steps per output, so the check run at 2·dt lands on the same times.
   long steps_per_output = static_cast<long>(std::ceil(every / dt_wanted - 1e-9));
@@ -208,8 +208,11 @@ ReferenceSummary generate_reference(const ReferenceOptions& options) {
                                  static_cast<double>(steps_per_output) * outputs));
   }
 
-  const auto start = std::chrono::steady_clock::now();
   ReferenceSummary summary;
+  summary.path = options.out_path.empty() ? reference_path(kReferenceDir, options.problem_spec)
+                                          : options.out_path;
+  check_output_file(summary.path, options.out_path.empty() ? "reference file" : "--out");
+  const auto start = std::chrono::steady_clock::now();
   long check_steps = 0;
   const std::vector<VecL> fine =
       run_gauss(*problem, every, outputs, steps_per_output, summary.steps);
@@ -258,8 +261,6 @@ ReferenceSummary generate_reference(const ReferenceOptions& options) {
   lines.emplace_back("estimated_error_definition",
                      "2-norm of (q, p) between the run at dt and the check run at 2*dt (an upper "
                      "estimate: the order-6 error at dt is ~1/64 of it), max over the rows");
-  summary.path = options.out_path.empty() ? reference_path(kReferenceDir, options.problem_spec)
-                                          : options.out_path;
   write_file_atomic(summary.path, to_csv(rows, columns, lines));
   return summary;
 }

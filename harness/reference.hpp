@@ -12,6 +12,9 @@
 
 namespace geomint {
 
+// Rows of one reference file (all are held in memory until written).
+constexpr double kMaxReferenceRows = 1e6;
+
 struct ReferenceOptions {
   std::string problem_spec;
   double t_end = 0;          // horizon (> 0) from the problem's initial time

@@ -14,18 +14,21 @@
 namespace geomint {
 namespace {
 
-// A conservative run whose relative energy error passes this has blown up; further steps
-// would only overflow. Forced problems use the state size instead.
-constexpr double kDivergedEnergyError = 1e8;
+// A forced run whose state passes this has blown up (the energy rule is
+// RunConfig::diverge_factor; both are off when the factor is 0 or inf).
 constexpr double kDivergedStateNorm = 1e100;
+
+bool divergence_rule_on(double factor) { return factor > 0 && std::isfinite(factor); }
 
 bool finite(const State& state) { return state.q.allFinite() && state.p.allFinite(); }
 
-// Time series writer: t, energy, invariants, problem extras, then q and p.
+// Time series writer: t, energy, invariants, problem extras, then q and p. Rows are streamed to
+// a temporary file as they are produced (a long series is never held in memory) and the file is
+// renamed onto the series path by commit(); an abandoned writer removes its temporary file.
 class SeriesWriter {
  public:
   SeriesWriter(const Problem& problem, const RunConfig& config, const std::string& method_spec)
-      : config_(config) {
+      : config_(config), file_(config.series_path), out_(file_.stream()) {
     with_state_ = problem.dof() <= 64 || config.series_state;
     std::vector<std::string> columns = {"t", "energy"};
     if (problem.has(kLinearMomentum)) {
@@ -46,44 +49,47 @@ class SeriesWriter {
       for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("p_{}", i));
     }
     for (const auto& [key, value] : provenance(config.command_line)) {
-      text_ += fmt::format("# {}: {}\n", key, value);
+      out_ << fmt::format("# {}: {}\n", key, value);
     }
-    text_ += fmt::format("# problem: {}\n# method: {}\n# dt: {}\n", problem.spec(), method_spec,
-                         format_number(config.dt));
-    text_ += fmt::format("{}\n", fmt::join(columns, ","));
+    out_ << fmt::format("# problem: {}\n# method: {}\n# dt: {}\n", problem.spec(), method_spec,
+                        format_number(config.dt));
+    out_ << fmt::format("{}\n", fmt::join(columns, ","));
   }
 
   void observe(const Problem& problem, const State& state, bool last) {
     if (count_++ % config_.series_every != 0 && !last) return;
-    std::string line =
-        format_number(state.t) + "," + format_number(problem.energy(state.q, state.p));
-    auto append = [&line](const Vec& values) {
-      for (double v : values) line += "," + format_number(v);
+    line_ = format_number(state.t) + "," + format_number(problem.energy(state.q, state.p));
+    auto append = [this](const Vec& values) {
+      for (double v : values) line_ += "," + format_number(v);
     };
     if (problem.has(kLinearMomentum)) append(problem.linear_momentum(state.q, state.p));
     if (problem.has(kAngularMomentum)) append(problem.angular_momentum(state.q, state.p));
     problem.series_values(state.q, state.p, extras_);
-    for (double v : extras_) line += "," + format_number(v);
+    for (double v : extras_) line_ += "," + format_number(v);
     if (with_state_) {
       append(state.q);
       append(state.p);
     }
-    text_ += line + "\n";
+    line_ += '\n';
+    out_ << line_;
   }
 
-  void write() const { write_file_atomic(config_.series_path, text_); }
+  void commit() { file_.commit(); }
 
  private:
   const RunConfig& config_;
+  AtomicFileWriter file_;
+  std::ostream& out_;
   bool with_state_ = true;
   long count_ = 0;
-  std::string text_;
+  std::string line_;
   std::vector<double> extras_;
 };
 
 struct LoopOutcome {
   StepStatus status;
   long steps = 0;
+  double t_reached = 0;  // time of the last step point that passed the checks
 };
 
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
@@ -99,14 +105,17 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   const double energy0 = problem.energy(state.q, state.p);
   const double energy_scale = std::max(std::abs(energy0), 1e-300);
   const bool conservative = !problem.has(kForce);
+  const bool divergence = divergence_rule_on(config.diverge_factor);
+  outcome.t_reached = t0;
   auto check = [&](const State& s) -> StepStatus {
     if (!checked) return StepStatus::success();
     if (!finite(s)) return StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
+    if (!divergence) return StepStatus::success();
     if (conservative) {
-      if (std::abs(problem.energy(s.q, s.p) - energy0) > kDivergedEnergyError * energy_scale) {
-        return StepStatus::failure(
-            "diverged",
-            fmt::format("relative energy error above {:g} at t={:.6g}", kDivergedEnergyError, s.t));
+      if (std::abs(problem.energy(s.q, s.p) - energy0) > config.diverge_factor * energy_scale) {
+        return StepStatus::failure("diverged",
+                                   fmt::format("relative energy error above {:g} at t={:.6g}",
+                                               config.diverge_factor, s.t));
       }
     } else if (std::max(s.q.lpNorm<Eigen::Infinity>(), s.p.lpNorm<Eigen::Infinity>()) >
                kDivergedStateNorm) {
@@ -125,6 +134,7 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
         return outcome;
       }
       ++outcome.steps;
+      outcome.t_reached = state.t;
       visit(state, state.t >= t_end);
     }
     return outcome;
@@ -144,6 +154,7 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
       return outcome;
     }
     ++outcome.steps;
+    outcome.t_reached = state.t;
     visit(state, k == n);
   }
   return outcome;
@@ -167,14 +178,26 @@ void validate_run_config(const RunConfig& config, bool adaptive) {
   if (!(config.t_end > 0 && std::isfinite(config.t_end))) {
     throw InputError(fmt::format("--t-end must be a finite number > 0 (got {})", config.t_end));
   }
-  if (!adaptive && config.t_end / config.dt > 1e10) {
-    throw InputError(fmt::format("--t-end/--dt = {:g} steps is more than the allowed 1e10",
-                                 config.t_end / config.dt));
+  if (!adaptive && config.t_end / config.dt > kMaxFixedSteps) {
+    throw InputError(fmt::format("--t-end/--dt = {:g} steps is more than the allowed {:g}",
+                                 config.t_end / config.dt, kMaxFixedSteps));
   }
   if (config.series_every < 1) {
     throw InputError(fmt::format("--every must be >= 1 (got {})", config.series_every));
   }
-  if (config.timing_repeats < 0) throw InputError("timing repeats must be >= 0");
+  if (config.timing_repeats < 0 || config.timing_repeats > kMaxTimingRepeats) {
+    throw InputError(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
+                                 config.timing_repeats));
+  }
+  if (!(config.diverge_factor >= 0)) {
+    throw InputError(
+        fmt::format("--diverge-factor must be >= 0 (0 or inf: no divergence rule; got {})",
+                    config.diverge_factor));
+  }
+}
+
+void check_run_outputs(const RunConfig& config) {
+  if (!config.series_path.empty()) check_output_file(config.series_path, "--series");
 }
 
 double time_run(const std::string& problem_spec, const std::string& method_spec,
@@ -202,6 +225,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   const MethodInfo info = integrator->info();
   const bool adaptive = (info.flags & kAdaptive) != 0;
   validate_run_config(config, adaptive);
+  check_run_outputs(config);
   if ((info.flags & kNeedsHessian) && !problem->has(kHessian)) {
     throw InputError(fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
                                  info.name, problem->name()));
@@ -245,12 +269,12 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   row["status"] = outcome.status.ok ? "ok" : outcome.status.reason;
   if (!outcome.status.ok) {
     row["message"] = outcome.status.message;
-    row["t_reached"] = format_number(state.t);
+    row["t_reached"] = format_number(outcome.t_reached);
   }
   row["steps"] = std::to_string(outcome.steps);
   for (const auto& [key, value] : result.metrics) row[key] = format_number(value);
   add_counters(row, integrator->counters());
-  if (series) series->write();
+  if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
     row["wall_s"] =

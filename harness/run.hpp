@@ -11,20 +11,34 @@
 
 namespace geomint {
 
+// A conservative run is stopped with status `diverged` when its relative energy error
+// |H − H₀|/|H₀| exceeds this factor (forced problems: when max(|q|∞, |p|∞) exceeds 1e100);
+// `--diverge-factor` / scene key `diverge_factor`. 0 or +inf turns the rule off (non-finite
+// states still end the run with status `nan`).
+constexpr double kDefaultDivergeFactor = 1e8;
+// Caps on counts that would otherwise let one option request unbounded work.
+constexpr int kMaxTimingRepeats = 100;
+constexpr double kMaxFixedSteps = 1e10;  // t_end/dt of one fixed-step run
+
 struct RunConfig {
   double dt = 0.0;            // fixed step (> 0); adaptive methods ignore it
   double t_end = 0.0;         // horizon (> 0)
   std::string series_path;    // time series CSV, empty = none
   long series_every = 1;      // write every N-th step point (the last point always)
   bool series_state = false;  // force q, p columns for problems with > 64 dof
-  int timing_repeats = 3;     // separate timed runs without observers; 0 = no wall_s
-  std::string command_line;   // for the series provenance
+  int timing_repeats = 3;     // separate timed runs without observers (0..kMaxTimingRepeats)
+  double diverge_factor = kDefaultDivergeFactor;  // see kDefaultDivergeFactor; 0/inf = off
+  std::string command_line;                       // for the series provenance
   // Problems without an exact solution: error_final/error_max against the reference file
   // <reference_dir>/<problem>.csv when it exists and has a row at t_end (harness/reference.hpp);
   // the row's column `reference` names the file.
   std::string reference_dir = "results/references";
 };
 
+// t_reached (failure rows only) is, for every kind of method, the time of the last step point
+// that passed the checks: the state the metrics end with. The run failed in the step after it
+// (fixed-step methods: the step ending at t_reached + dt, named in the message; adaptive ones:
+// the solver's next internal step).
 struct RunResult {
   Row row;  // CSV row: identifiers, status, metrics, counters, wall_s
   bool ok = true;
@@ -41,7 +55,12 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
 double time_run(const std::string& problem_spec, const std::string& method_spec,
                 const RunConfig& config, int repeats);
 
-// Checks dt and t_end (InputError naming the offending option).
+// Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
+// --timing-repeats and --diverge-factor (InputError naming the offending option).
 void validate_run_config(const RunConfig& config, bool adaptive);
+
+// Checks the run's output paths before anything is computed (InputError naming the option):
+// --series must be writable.
+void check_run_outputs(const RunConfig& config);
 
 }  // namespace geomint

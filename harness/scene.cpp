@@ -8,7 +8,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -39,13 +41,23 @@ class BlockReader {
     if (auto value = node->value<double>()) return *value;
     throw InputError(fmt::format("{}: key '{}' must be a number", where_, key));
   }
-  long integer(const std::string& key, bool required, long fallback = 0) {
+  // An integer in [min_value, max_value]: TOML integers are 64-bit, and a value outside the
+  // range is an error, never a silent truncation to int.
+  long integer(const std::string& key, bool required, long fallback, long min_value,
+               long max_value) {
     seen_.insert(key);
     const toml::node* node = table_.get(key);
     if (!node) return require(key, required), fallback;
-    if (auto value = node->as_integer()) return value->get();
-    throw InputError(fmt::format("{}: key '{}' must be an integer", where_, key));
+    const auto* value = node->as_integer();
+    if (!value) throw InputError(fmt::format("{}: key '{}' must be an integer", where_, key));
+    const std::int64_t number = value->get();
+    if (number < min_value || number > max_value) {
+      throw InputError(fmt::format("{}: key '{}' must be in {}..{} (got {})", where_, key,
+                                   min_value, max_value, number));
+    }
+    return static_cast<long>(number);
   }
+  bool has(const std::string& key) const { return table_.get(key) != nullptr; }
   bool boolean(const std::string& key, bool fallback) {
     seen_.insert(key);
     const toml::node* node = table_.get(key);
@@ -141,11 +153,60 @@ void validate_specs(const std::vector<std::string>& problems,
     for (const auto& spec : problems) make_problem(spec);
     *all_adaptive = true;
     for (const auto& spec : methods) {
-      *all_adaptive = *all_adaptive && (make_integrator(spec)->info().flags & kAdaptive);
+      // Every spec is constructed (a `&&` here once skipped the specs after the first
+      // fixed-step method, and a typo then aborted the sweep in a worker thread).
+      const bool adaptive = (make_integrator(spec)->info().flags & kAdaptive) != 0;
+      *all_adaptive = *all_adaptive && adaptive;
     }
   } catch (const InputError& error) {
     throw InputError(fmt::format("{}: {}", where, error.what()));
   }
+}
+
+// Labels name folders (series/<label>/) and rows: letters, digits, '_', '-' and '.', at most
+// 64 characters, no "..", so every path derived from a label stays inside the output folder.
+void check_label(const std::string& label, const std::string& where) {
+  bool ok = !label.empty() && label.size() <= 64 && label.find("..") == std::string::npos &&
+            label != "." && label.front() != '-';
+  for (char c : label) {
+    ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.');
+  }
+  if (!ok) {
+    throw InputError(fmt::format(
+        "{}: label '{}' is not allowed: use 1 to 64 letters, digits, '_', '-' or '.', no '..' "
+        "and no path separator (labels name folders inside the output folder)",
+        where, label));
+  }
+}
+
+void check_diverge_factor(double factor, const std::string& where) {
+  if (!(factor >= 0)) {
+    throw InputError(fmt::format(
+        "{}: 'diverge_factor' must be >= 0 (0 or inf: no divergence rule; got {})", where, factor));
+  }
+}
+
+// The fixed-step methods of a block run t_end/dt steps; more than kMaxFixedSteps is an error at
+// load, not an exception in a worker thread.
+void check_step_count(double t_end, double dt, const std::string& where, const char* dt_key) {
+  if (t_end / dt > kMaxFixedSteps) {
+    throw InputError(
+        fmt::format("{}: t_end/{} = {:g}/{:g} = {:g} steps is more than the allowed {:g}", where,
+                    dt_key, t_end, dt, t_end / dt, kMaxFixedSteps));
+  }
+}
+
+// An optional quick_* override: when present it must be a finite number > 0, also when --quick
+// is not given (a typo there would otherwise surface only in CI).
+bool quick_number(BlockReader& reader, const std::string& key, const std::string& where,
+                  double* value) {
+  if (!reader.has(key)) {
+    reader.known(key);
+    return false;
+  }
+  *value = reader.number(key, true);
+  check_positive(*value, where, key);
+  return true;
 }
 
 }  // namespace
@@ -165,6 +226,12 @@ std::string sanitize_for_path(const std::string& text) {
 }
 
 Scene load_scene(const std::string& path, bool quick) {
+  std::error_code filesystem_error;
+  if (std::filesystem::is_directory(path, filesystem_error)) {
+    throw InputError(fmt::format(
+        "scene '{}' is a directory, not a scene file (expected e.g. results/<scene>/scene.toml)",
+        path));
+  }
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -194,34 +261,45 @@ Scene load_scene(const std::string& path, bool quick) {
     RunBlock block;
     block.label = reader.string("label", true);
     const std::string where = fmt::format("{}: [[runs]] '{}'", path, block.label);
+    check_label(block.label, where);
     block.problems = reader.strings("problems", true);
     block.methods = reader.strings("methods", true);
     block.dts = reader.numbers("dt", false);
     block.t_end = reader.number("t_end", true);
-    block.series_every = reader.integer("series_every", false, 0);
+    block.series_every = reader.integer("series_every", false, 0, 0, 1000000000000L);
     block.series_state = reader.boolean("series_state", false);
-    block.timing_repeats = static_cast<int>(reader.integer("timing_repeats", false, 3));
+    block.timing_repeats =
+        static_cast<int>(reader.integer("timing_repeats", false, 3, 0, kMaxTimingRepeats));
+    block.diverge_factor = reader.number("diverge_factor", false, kDefaultDivergeFactor);
     const auto quick_dts = reader.numbers("quick_dt", false);
-    const double quick_t_end = reader.number("quick_t_end", false, 0);
+    double quick_t_end = 0;
+    const bool has_quick_t_end = quick_number(reader, "quick_t_end", where, &quick_t_end);
     const auto quick_problems = reader.strings("quick_problems", false);
     reader.finish();
-    if (quick) {
-      if (!quick_dts.empty()) block.dts = quick_dts;
-      if (quick_t_end > 0) block.t_end = quick_t_end;
-      if (!quick_problems.empty()) block.problems = quick_problems;
+    check_diverge_factor(block.diverge_factor, where);
+    for (double dt : quick_dts) check_positive(dt, where, "quick_dt");
+    // Both the full and the quick configuration are checked, whichever runs now.
+    RunBlock quick_block = block;
+    if (!quick_dts.empty()) quick_block.dts = quick_dts;
+    if (has_quick_t_end) quick_block.t_end = quick_t_end;
+    if (!quick_problems.empty()) quick_block.problems = quick_problems;
+    for (const RunBlock* candidate : {&block, &quick_block}) {
+      const char* prefix = candidate == &block ? "" : "quick_";
+      bool all_adaptive = false;
+      validate_specs(candidate->problems, candidate->methods, where, &all_adaptive);
+      if (candidate->dts.empty() && !all_adaptive) {
+        throw InputError(
+            fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
+      }
+      for (double dt : candidate->dts) check_positive(dt, where, std::string(prefix) + "dt");
+      check_positive(candidate->t_end, where, std::string(prefix) + "t_end");
+      if (!all_adaptive) {
+        for (double dt : candidate->dts) {
+          check_step_count(candidate->t_end, dt, where, candidate == &block ? "dt" : "quick_dt");
+        }
+      }
     }
-    bool all_adaptive = false;
-    validate_specs(block.problems, block.methods, where, &all_adaptive);
-    if (block.dts.empty() && !all_adaptive) {
-      throw InputError(
-          fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
-    }
-    for (double dt : block.dts) check_positive(dt, where, "dt");
-    check_positive(block.t_end, where, "t_end");
-    if (block.series_every < 0)
-      throw InputError(fmt::format("{}: 'series_every' must be >= 0", where));
-    if (block.timing_repeats < 0)
-      throw InputError(fmt::format("{}: 'timing_repeats' must be >= 0", where));
+    if (quick) block = quick_block;
     if (!labels.insert(block.label).second)
       throw InputError(fmt::format("{}: label used twice", where));
     scene.runs.push_back(block);
@@ -231,22 +309,32 @@ Scene load_scene(const std::string& path, bool quick) {
     OrderBlock block;
     block.label = reader.string("label", true);
     const std::string where = fmt::format("{}: [[orders]] '{}'", path, block.label);
+    check_label(block.label, where);
     block.problems = reader.strings("problems", true);
     block.methods = reader.strings("methods", true);
     block.dt0 = reader.number("dt0", true);
-    block.levels = static_cast<int>(reader.integer("levels", true));
+    block.levels =
+        static_cast<int>(reader.integer("levels", true, 0, kMinOrderLevels, kMaxOrderLevels));
     block.t_end = reader.number("t_end", true);
-    const long quick_levels = reader.integer("quick_levels", false, 0);
-    const double quick_t_end = reader.number("quick_t_end", false, 0);
+    block.diverge_factor = reader.number("diverge_factor", false, kDefaultDivergeFactor);
+    const long quick_levels =
+        reader.integer("quick_levels", false, block.levels, kMinOrderLevels, kMaxOrderLevels);
+    double quick_t_end = block.t_end;
+    quick_number(reader, "quick_t_end", where, &quick_t_end);
     reader.finish();
-    if (quick && quick_levels > 0) block.levels = static_cast<int>(quick_levels);
-    if (quick && quick_t_end > 0) block.t_end = quick_t_end;
+    check_diverge_factor(block.diverge_factor, where);
     bool all_adaptive = false;
     validate_specs(block.problems, block.methods, where, &all_adaptive);
     check_positive(block.dt0, where, "dt0");
     check_positive(block.t_end, where, "t_end");
-    if (block.levels < 3 || block.levels > 30) {
-      throw InputError(fmt::format("{}: 'levels' must be in 3..30 (got {})", where, block.levels));
+    // The finest level of either configuration must respect the step limit.
+    check_step_count(block.t_end, block.dt0 * std::ldexp(1.0, -(block.levels - 1)), where,
+                     "(dt0*2^-(levels-1))");
+    check_step_count(quick_t_end, block.dt0 * std::ldexp(1.0, -static_cast<int>(quick_levels - 1)),
+                     where, "(dt0*2^-(quick_levels-1))");
+    if (quick) {
+      block.levels = static_cast<int>(quick_levels);
+      block.t_end = quick_t_end;
     }
     if (!labels.insert(block.label).second)
       throw InputError(fmt::format("{}: label used twice", where));
@@ -257,6 +345,7 @@ Scene load_scene(const std::string& path, bool quick) {
     StabilityBlock block;
     block.label = reader.string("label", true);
     const std::string where = fmt::format("{}: [[stability]] '{}'", path, block.label);
+    check_label(block.label, where);
     block.problems = reader.strings("problems", true);
     block.methods = reader.strings("methods", true);
     StabilityOptions& options = block.options;
@@ -266,21 +355,27 @@ Scene load_scene(const std::string& path, bool quick) {
     options.h_max = reader.number("h_max", false, 0);
     options.periods = reader.number("periods", false, options.periods);
     options.t_end = reader.number("t_end", false, 0);
-    options.min_steps = reader.integer("min_steps", false, options.min_steps);
+    options.min_steps =
+        reader.integer("min_steps", false, options.min_steps, 1, kMaxStabilityStepsPerRun);
     options.growth = reader.number("growth", false, options.growth);
     options.scan_points_per_decade = static_cast<int>(
-        reader.integer("scan_points_per_decade", false, options.scan_points_per_decade));
+        reader.integer("scan_points_per_decade", false, options.scan_points_per_decade, 1, 100));
     options.rel_tol = reader.number("rel_tol", false, options.rel_tol);
-    const double quick_periods = reader.number("quick_periods", false, 0);
-    const long quick_min_steps = reader.integer("quick_min_steps", false, 0);
-    const double quick_rel_tol = reader.number("quick_rel_tol", false, 0);
+    StabilityOptions quick_options = options;
+    quick_number(reader, "quick_periods", where, &quick_options.periods);
+    quick_options.min_steps =
+        reader.integer("quick_min_steps", false, options.min_steps, 1, kMaxStabilityStepsPerRun);
+    quick_number(reader, "quick_rel_tol", where, &quick_options.rel_tol);
     reader.finish();
-    if (quick && quick_periods > 0) options.periods = quick_periods;
-    if (quick && quick_min_steps > 0) options.min_steps = quick_min_steps;
-    if (quick && quick_rel_tol > 0) options.rel_tol = quick_rel_tol;
-    validate_stability_options(options, where);
     bool all_adaptive = false;
     validate_specs(block.problems, block.methods, where, &all_adaptive);
+    for (const StabilityOptions* candidate : {&options, &quick_options}) {
+      validate_stability_options(*candidate, where);
+      for (const auto& problem : block.problems) {
+        check_stability_budget(problem, *candidate, where);
+      }
+    }
+    if (quick) options = quick_options;
     for (const auto& method : block.methods) {
       if (make_integrator(method)->info().flags & kAdaptive) {
         throw InputError(
@@ -329,17 +424,37 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-// Runs fn(i) for i in [0, n) on `jobs` threads.
+// Runs fn(i) for i in [0, n) on `jobs` threads. The callers turn every exception of a run into
+// a row; should one still escape fn, the workers stop taking new items and the first exception
+// is rethrown here after every thread has joined (an exception leaving a std::thread would call
+// std::terminate: SIGABRT, rc 134).
 template <typename Fn>
 void parallel_for(size_t n, int jobs, Fn&& fn) {
   std::atomic<size_t> next{0};
+  std::mutex mutex;
+  std::exception_ptr first_error;
   auto worker = [&] {
-    for (size_t i = next++; i < n; i = next++) fn(i);
+    for (size_t i = next++; i < n; i = next++) {
+      try {
+        fn(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!first_error) first_error = std::current_exception();
+        next = n;
+      }
+    }
   };
   std::vector<std::thread> threads;
   for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
   worker();
   for (auto& thread : threads) thread.join();
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+// The row of a run that threw instead of returning a status (a defect or an input the scene
+// check missed): it is reported like any failure, never crashes the sweep.
+Row error_row(const std::string& problem, const std::string& method, const std::string& what) {
+  return {{"problem", problem}, {"method", method}, {"status", "error"}, {"message", what}};
 }
 
 std::string series_name(const RunBlock& block, const std::string& problem,
@@ -354,6 +469,8 @@ std::string series_name(const RunBlock& block, const std::string& problem,
 
 int run_sweep(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
+  check_output_dir(options.out_dir, "output folder");
+  std::set<std::string> series_paths;
   std::vector<Job> jobs;
   for (const auto& block : scene.runs) {
     const std::vector<double> dts = block.dts.empty() ? std::vector<double>{0.0} : block.dts;
@@ -364,13 +481,28 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
           job.config.dt = dt;
           job.config.t_end = block.t_end;
           job.config.timing_repeats = 0;
+          job.config.diverge_factor = block.diverge_factor;
           job.config.command_line = options.command_line;
           if (block.series_every > 0) {
             job.config.series_every = block.series_every;
             job.config.series_state = block.series_state;
-            job.config.series_path = (fs::path(options.out_dir) / "series" / block.label /
-                                      series_name(block, problem, method, dt))
-                                         .string();
+            // Labels are plain names (load_scene) and series names sanitized specs, so the
+            // path stays inside out_dir; checked again here, with duplicates.
+            const fs::path relative =
+                fs::path("series") / block.label / series_name(block, problem, method, dt);
+            const fs::path normal = relative.lexically_normal();
+            if (normal.is_absolute() || normal.empty() || *normal.begin() != "series") {
+              throw InputError(
+                  fmt::format("[[runs]] '{}': series path '{}' leaves the output folder",
+                              block.label, relative.string()));
+            }
+            if (!series_paths.insert(normal.string()).second) {
+              throw InputError(fmt::format(
+                  "[[runs]] '{}': two runs would write the same series file '{}' (give the "
+                  "methods or problems distinct specs)",
+                  block.label, normal.string()));
+            }
+            job.config.series_path = (fs::path(options.out_dir) / normal).string();
           }
           jobs.push_back(std::move(job));
         }
@@ -412,14 +544,24 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   parallel_for(jobs.size() + order_jobs.size(), options.jobs, [&](size_t i) {
     if (i < jobs.size()) {
       Job& job = jobs[i];
-      RunResult result = run_one(job.problem, job.method, job.config);
-      job.row = std::move(result.row);
-      job.ok = result.ok;
+      try {
+        RunResult result = run_one(job.problem, job.method, job.config);
+        job.row = std::move(result.row);
+        job.ok = result.ok;
+      } catch (const std::exception& error) {
+        job.row = error_row(job.problem, job.method, error.what());
+        job.ok = false;
+      }
       job.row["label"] = job.label;
     } else {
       OrderJob& job = order_jobs[i - jobs.size()];
-      job.study =
-          order_study(job.problem, job.method, job.block->dt0, job.block->levels, job.block->t_end);
+      try {
+        job.study = order_study(job.problem, job.method, job.block->dt0, job.block->levels,
+                                job.block->t_end, job.block->diverge_factor);
+      } catch (const std::exception& error) {
+        job.study = OrderStudy{};
+        job.study.row = error_row(job.problem, job.method, error.what());
+      }
     }
     progress.tick();
   });
@@ -448,7 +590,11 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         }
         return 3;
       }();
-      job.row["wall_s"] = format_number(time_run(job.problem, job.method, job.config, repeats));
+      try {
+        job.row["wall_s"] = format_number(time_run(job.problem, job.method, job.config, repeats));
+      } catch (const std::exception& error) {
+        job.row["message"] = fmt::format("timing pass failed: {}", error.what());
+      }
     }
     progress.tick();
   }
@@ -464,6 +610,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   }
   for (auto& job : order_jobs) {
     Row row = job.study.row;
+    failed += row.count("status") && row.at("status") == "error";
     row["label"] = job.label;
     order_rows.push_back(row);
     for (auto point : job.study.runs) {

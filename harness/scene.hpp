@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/run.hpp"
 #include "harness/stability.hpp"
 
 namespace geomint {
@@ -18,7 +19,8 @@ struct RunBlock {
   double t_end = 0;
   long series_every = 0;  // 0 = no series
   bool series_state = false;
-  int timing_repeats = 3;  // 0 = no timing pass
+  int timing_repeats = 3;                         // 0 = no timing pass
+  double diverge_factor = kDefaultDivergeFactor;  // RunConfig::diverge_factor; 0 or inf = off
 };
 
 struct OrderBlock {
@@ -27,6 +29,7 @@ struct OrderBlock {
   double dt0 = 0;
   int levels = 0;
   double t_end = 0;
+  double diverge_factor = kDefaultDivergeFactor;  // RunConfig::diverge_factor; 0 or inf = off
 };
 
 struct Scene {
@@ -38,8 +41,11 @@ struct Scene {
   std::vector<StabilityBlock> stability;  // [[stability]]: largest stable h*omega per method
 };
 
-// Parses and validates a scene file: unknown or missing keys, wrong types, bad specs and bad
-// numbers throw InputError naming the file, block and key. `quick` applies the quick_* keys.
+// Parses and validates a scene file: unknown or missing keys, wrong types, integers out of range,
+// bad specs, bad numbers, labels that are not plain names, more than 1e10 steps in a run and
+// stability searches over their budget throw InputError naming the file, block and key — so a
+// sweep that starts never stops on its input. `quick` applies the quick_* keys; both the full
+// and the quick configuration are validated either way.
 Scene load_scene(const std::string& path, bool quick);
 
 struct SweepOptions {
@@ -53,6 +59,9 @@ struct SweepOptions {
 };
 
 // Runs the scene; returns the number of failed runs (failure rows are results, not errors).
+// Throws InputError before any computing when the output folder cannot be written or two runs
+// would write the same series file. No exception escapes a worker thread: a run that throws
+// becomes a row with status `error` and the exception's text as message.
 int run_sweep(const Scene& scene, const SweepOptions& options);
 
 // File-name-safe form of a spec ("hp:alpha=0.5" → "hp_alpha_0.5").

@@ -147,17 +147,48 @@ void validate_stability_options(const StabilityOptions& options, const std::stri
   positive(options.growth, "growth");
   if (!(options.growth > 1))
     throw InputError(fmt::format("{}: 'growth' must be > 1 (got {})", where, options.growth));
-  if (options.min_steps < 1 || options.min_steps > 100000000)
-    throw InputError(fmt::format("{}: 'min_steps' must be in 1..1e8", where));
+  if (options.min_steps < 1 || options.min_steps > kMaxStabilityStepsPerRun)
+    throw InputError(
+        fmt::format("{}: 'min_steps' must be in 1..{}", where, kMaxStabilityStepsPerRun));
   if (options.scan_points_per_decade < 1 || options.scan_points_per_decade > 100)
     throw InputError(fmt::format("{}: 'scan_points_per_decade' must be in 1..100", where));
   if (!(options.rel_tol > 0 && options.rel_tol < 1))
     throw InputError(fmt::format("{}: 'rel_tol' must be in (0, 1)", where));
 }
 
+void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
+                            const std::string& where) {
+  const auto problem = make_problem(problem_spec);
+  double horizon = 0, h_lo = 0, h_hi = 0;
+  try {
+    resolve(*problem, options, &horizon, &h_lo, &h_hi);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("{}: {}", where, error.what()));
+  }
+  const bool in_h = options.h_min > 0;
+  const double steps = std::max(static_cast<double>(options.min_steps), horizon / h_lo);
+  if (!(steps <= static_cast<double>(kMaxStabilityStepsPerRun))) {
+    throw InputError(fmt::format(
+        "{}: problem '{}': {} = {:g} with a horizon of {:g} gives {:g} steps per run, more than "
+        "the allowed {}: raise {} or shorten {}",
+        where, problem_spec, in_h ? "h_min" : "homega_min",
+        in_h ? options.h_min : options.homega_min, horizon, steps, kMaxStabilityStepsPerRun,
+        in_h ? "h_min" : "homega_min", options.t_end > 0 ? "t_end" : "periods"));
+  }
+  const double points = std::log10(h_hi / h_lo) * options.scan_points_per_decade + 1;
+  if (!(points <= kMaxStabilityScanPoints)) {
+    throw InputError(fmt::format(
+        "{}: problem '{}': the scan from {} to {} at {} points per decade has {:g} points, more "
+        "than the allowed {}",
+        where, problem_spec, in_h ? "h_min" : "homega_min", in_h ? "h_max" : "homega_max",
+        options.scan_points_per_decade, std::ceil(points), kMaxStabilityScanPoints));
+  }
+}
+
 StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
                                  const StabilityOptions& options) {
   validate_stability_options(options, "stability");
+  check_stability_budget(problem_spec, options, "stability");
   const auto problem = make_problem(problem_spec);
   const auto integrator = make_integrator(method_spec);
   const MethodInfo info = integrator->info();

@@ -53,8 +53,19 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
 // no formula for the method.
 double predicted_homega_limit(const std::string& method_spec);
 
+// Caps on the work of one search: steps per run (at the bottom of the range, the longest run)
+// and points of the geometric scan.
+constexpr long kMaxStabilityStepsPerRun = 100000000;
+constexpr int kMaxStabilityScanPoints = 1000;
+
 // Checks a block's options (InputError naming the key).
 void validate_stability_options(const StabilityOptions& options, const std::string& where);
+
+// Resolves the range and horizon for `problem_spec` (InputError when the problem has no
+// omega_max and the block asks in h·ω or periods) and checks them against the caps above, so a
+// search that would run for days is rejected when the scene is loaded.
+void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
+                            const std::string& where);
 
 // Columns of stability.csv, in order.
 const std::vector<std::string>& stability_columns();

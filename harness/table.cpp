@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <atomic>
 #include <boost/version.hpp>
 #include <chrono>
 #include <cmath>
@@ -18,9 +19,15 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "problems/spec.hpp"
+
 namespace geomint {
 
-const char* version();
+// harness/build_info.cpp, generated at build time by scripts/build_info.cmake.
+const char* build_version();
+const char* build_git_sha();
+const char* build_compiler();
+const char* build_flags();
 
 namespace {
 
@@ -59,9 +66,9 @@ std::string shorten_number(const std::string& text, int digits) {
 std::vector<std::pair<std::string, std::string>> provenance(const std::string& command_line) {
   const auto now = std::chrono::system_clock::now();
   return {
-      {"geomint", fmt::format("{} ({})", version(), GEOMINT_GIT_SHA)},
-      {"compiler", GEOMINT_COMPILER},
-      {"flags", GEOMINT_CXX_FLAGS},
+      {"geomint", fmt::format("{} ({})", build_version(), build_git_sha())},
+      {"compiler", build_compiler()},
+      {"flags", build_flags()},
       {"libraries",
        fmt::format("Eigen {}.{}.{}, GSL {}, SUNDIALS {}, Boost {}.{}, fmt {}", EIGEN_WORLD_VERSION,
                    EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, GSL_VERSION, SUNDIALS_VERSION,
@@ -206,23 +213,109 @@ std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::str
   return out;
 }
 
-void write_file_atomic(const std::string& path, const std::string& text) {
+namespace {
+
+// <path>.<pid>.<n>.tmp: unique per process and per writer, so parallel writers never share one.
+std::string temporary_name(const std::string& path) {
+  static std::atomic<unsigned long> counter{0};
+  return fmt::format("{}.{}.{}.tmp", path, ::getpid(), counter++);
+}
+
+}  // namespace
+
+AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path) {
   const std::filesystem::path target(path);
   if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
-  const std::string temporary = fmt::format("{}.{}.tmp", path, ::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      throw std::runtime_error(fmt::format("cannot write '{}'", path));
+  temporary_ = temporary_name(path);
+  out_.open(temporary_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw std::runtime_error(fmt::format("cannot write '{}'", temporary_));
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (committed_) return;
+  out_.close();
+  std::remove(temporary_.c_str());
+}
+
+void AtomicFileWriter::commit() {
+  out_.flush();
+  const bool written = static_cast<bool>(out_);
+  out_.close();
+  if (!written || out_.fail()) {
+    std::remove(temporary_.c_str());
+    committed_ = true;
+    throw std::runtime_error(fmt::format("cannot write '{}'", path_));
+  }
+  if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    std::remove(temporary_.c_str());
+    committed_ = true;
+    throw std::runtime_error(fmt::format("cannot rename '{}' to '{}'", temporary_, path_));
+  }
+  committed_ = true;
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  AtomicFileWriter writer(path);
+  writer.stream() << text;
+  writer.commit();
+}
+
+namespace {
+
+// The nearest existing ancestor of `path` (the path itself when it exists) must be a writable,
+// searchable folder; every missing component below it is created later.
+void check_creatable_below(const std::filesystem::path& path, const std::string& option,
+                           const std::string& shown) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::path existing = path.empty() ? fs::path(".") : path;
+  while (!fs::exists(existing, error)) {
+    if (!existing.has_parent_path() || existing.parent_path() == existing) {
+      existing = ".";
+      break;
     }
+    existing = existing.parent_path();
   }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw std::runtime_error(fmt::format("cannot rename '{}' to '{}'", temporary, path));
+  if (!fs::is_directory(existing, error)) {
+    throw InputError(
+        fmt::format("{} '{}': '{}' is not a directory", option, shown, existing.string()));
   }
+  if (::access(existing.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(
+        fmt::format("{} '{}': folder '{}' is not writable", option, shown, existing.string()));
+  }
+}
+
+}  // namespace
+
+void check_output_file(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError(fmt::format("{}: empty file name", option));
+  const fs::path target(path);
+  std::error_code error;
+  if (fs::is_directory(target, error)) {
+    throw InputError(fmt::format("{} '{}' is a directory, not a file", option, path));
+  }
+  // Outputs are replaced by rename(2): a device or pipe (/dev/null) would be replaced, not
+  // written to.
+  if (fs::exists(target, error) && !fs::is_regular_file(target, error)) {
+    throw InputError(fmt::format("{} '{}' is not a regular file", option, path));
+  }
+  check_creatable_below(target.has_parent_path() ? target.parent_path() : fs::path("."), option,
+                        path);
+}
+
+void check_output_dir(const std::string& path, const std::string& option) {
+  check_creatable_below(std::filesystem::path(path.empty() ? "." : path), option, path);
+}
+
+bool same_file_path(const std::string& a, const std::string& b) {
+  std::error_code error;
+  const auto canonical_a = std::filesystem::weakly_canonical(a, error);
+  if (error) return a == b;
+  const auto canonical_b = std::filesystem::weakly_canonical(b, error);
+  if (error) return a == b;
+  return canonical_a == canonical_b;
 }
 
 }  // namespace geomint

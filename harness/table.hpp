@@ -3,6 +3,7 @@
 // Markdown tables for results/<scene>/table.md.
 #pragma once
 
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,6 +36,35 @@ std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::str
 // Writes `text` to `path` via a temporary file in the same directory and rename(2).
 // Creates the parent directory. Throws std::runtime_error on I/O failure.
 void write_file_atomic(const std::string& path, const std::string& text);
+
+// Streams text to `path` through a temporary file in the same folder (parent folders created),
+// renamed onto `path` by commit(). Destroyed without commit — an exception, a failed run that
+// is abandoned — it removes the temporary file, so no partial file is ever left under `path`.
+// Throws std::runtime_error on I/O failure.
+class AtomicFileWriter {
+ public:
+  explicit AtomicFileWriter(const std::string& path);
+  ~AtomicFileWriter();
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+  std::ostream& stream() { return out_; }
+  void commit();
+
+ private:
+  std::string path_, temporary_;
+  std::ofstream out_;
+  bool committed_ = false;
+};
+
+// Checks, before any computing, that a file can be written at `path`: it is not a directory and
+// its nearest existing ancestor is a writable folder (missing folders are created on writing).
+// Creates nothing. Throws InputError "<option> '<path>': <reason>".
+void check_output_file(const std::string& path, const std::string& option);
+// The same for a folder that will receive output files.
+void check_output_dir(const std::string& path, const std::string& option);
+// True when `a` and `b` name the same file (after resolving `.`, `..` and symbolic links of the
+// existing part).
+bool same_file_path(const std::string& a, const std::string& b);
 
 // The column order every geomint CSV uses.
 const std::vector<std::string>& standard_columns();

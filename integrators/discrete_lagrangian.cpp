@@ -167,15 +167,20 @@ class DiscreteLagrangianVI final : public Integrator {
         problem.force_jacobian_v(state.q, v, state.t, damping_);
         damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
       }
+      double inner_scale = 0.0;
       NewtonSystem system;
+      system.inner_term_scale = [&] { return inner_scale; };
       system.residual = [&](const Vec& x, Vec& residual) {
         implicit_terms(problem, x);
         residual = mass.cwiseProduct(x) + constant_ + implicit_term_;
       };
       system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
         jacobian = mass_matrix_;
+        inner_scale = 0.0;
         for (const Node& node : interior_) {
-          eval_hessian(problem, q0_ + (node.a * h) * x, hessian_);
+          const Vec q_node = q0_ + (node.a * h) * x;
+          eval_hessian(problem, q_node, hessian_);
+          inner_scale += std::abs(h * node.w) * gradient_term_scale(hessian_, q_node);
           jacobian += (h * h * node.w * node.a * (1 - node.a)) * hessian_;
         }
         if (minus > 0.0) add_impulse_jacobian(problem, x, jacobian);

@@ -82,8 +82,9 @@ class ImplicitEuler final : public Integrator {
     }
     const double residual_scale = state.p.norm() + std::abs(h) * end_force_norm_;
 
-    double latest_force_norm = 0.0;
+    double latest_force_norm = 0.0, inner_scale = 0.0;
     NewtonSystem system;
+    system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& v, Vec& residual) {
       q_next_ = state.q + h * v;
       eval_total_force(problem, q_next_, v, t_next, force_);
@@ -93,6 +94,7 @@ class ImplicitEuler final : public Integrator {
     system.jacobian = [&](const Vec& v, SparseMatrix& jacobian) {
       q_next_ = state.q + h * v;
       eval_hessian(problem, q_next_, hessian_);
+      inner_scale = std::abs(h) * gradient_term_scale(hessian_, q_next_);
       jacobian = (h * h) * hessian_ + mass_matrix_;
       if (problem.has(kForce)) add_force_jacobian(problem, state.q, v, t_next, h, jacobian);
     };

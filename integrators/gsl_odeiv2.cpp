@@ -48,8 +48,8 @@ double starting_step(const Vec& y, const Vec& ydot, double rtol, double atol) {
 
 class GslOdeiv2 final : public Integrator {
  public:
-  GslOdeiv2(GslMethod method, double rtol, double atol)
-      : method_(method), rtol_(rtol), atol_(atol) {}
+  GslOdeiv2(GslMethod method, double rtol, double atol, long max_steps)
+      : method_(method), rtol_(rtol), atol_(atol), max_steps_(max_steps) {}
 
   MethodInfo info() const override {
     switch (method_) {
@@ -127,6 +127,21 @@ class GslOdeiv2 final : public Integrator {
     if (!(t_stop > t_)) {
       return StepStatus::failure(
           "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
+    }
+    // The run-total step budget: at a tolerance below round-off GSL keeps accepting steps near
+    // the smallest representable size, and a huge horizon needs ever more steps; both end here.
+    if (counters_.steps >= max_steps_) {
+      return StepStatus::failure(
+          "max_steps", fmt::format("max_steps={} accepted steps taken before t={:.6g} (t_stop "
+                                   "{:.6g}); raise max_steps or loosen rtol/atol",
+                                   max_steps_, t_, t_stop));
+    }
+    // Tolerances below round-off: GSL would accept ever smaller steps near t = 0 until the
+    // budget above runs out; say so at once, as CVODE does.
+    if (const double ratio =
+            roundoff_tolerance_ratio(y_.data(), static_cast<long>(y_.size()), rtol_, atol_);
+        !(ratio <= 1.0)) {
+      return too_much_accuracy("too_much_accuracy", info().name, t_, rtol_, atol_, ratio);
     }
     // evolve_apply lands exactly on t1 only when the proposed step exceeds t1 − t (it then
     // stamps t = t1). A suggested step that would leave a sliver of less than 1% is stretched
@@ -209,6 +224,7 @@ class GslOdeiv2 final : public Integrator {
 
   GslMethod method_;
   double rtol_, atol_;
+  long max_steps_;
   const Problem* problem_ = nullptr;
   StepStatus setup_status_;
   std::string callback_error_;
@@ -227,7 +243,12 @@ std::unique_ptr<Integrator> make_gsl(Params& params, GslMethod method) {
       "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
   const double atol = params.real(
       "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
-  return std::make_unique<GslOdeiv2>(method, rtol, atol);
+  const long max_steps = params.integer(
+      "max_steps", 1000000,
+      "maximum number of accepted steps over the whole run (the run then fails with status "
+      "max_steps)",
+      1, 1000000000000L);
+  return std::make_unique<GslOdeiv2>(method, rtol, atol, max_steps);
 }
 
 }  // namespace

@@ -177,7 +177,9 @@ class HamiltonPontryagin final : public Integrator {
     }
     const bool exact_objective = minimize_ && (minus_ == 0.0 || linearised_);
 
+    double inner_scale = 0.0;
     NewtonSystem system;
+    system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& x, Vec& residual) {
       implicit_terms(problem, x);
       residual = mass.cwiseProduct(x) - b_ + implicit_term_;
@@ -185,7 +187,9 @@ class HamiltonPontryagin final : public Integrator {
     system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
       jacobian = mass_matrix_;
       if (coupled) {
-        eval_hessian(problem, q0_ + (alpha_ * h_) * x, hessian_);
+        const Vec q_alpha = q0_ + (alpha_ * h_) * x;
+        eval_hessian(problem, q_alpha, hessian_);
+        inner_scale = std::abs((1 - alpha_) * h_) * gradient_term_scale(hessian_, q_alpha);
         jacobian += (alpha_ * (1 - alpha_) * h_ * h_) * hessian_;
       }
       if (minus_ > 0.0) add_impulse_jacobian(problem, x, jacobian);

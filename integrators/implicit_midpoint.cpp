@@ -73,7 +73,9 @@ class ImplicitMidpoint final : public Integrator {
       }
       out *= h / 2;
     };
+    double inner_scale = 0.0;
     NewtonSystem system;
+    system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& x, Vec& residual) {
       impulse(x, impulse_);
       residual = mass.cwiseProduct(x) - state.p + impulse_;
@@ -81,6 +83,7 @@ class ImplicitMidpoint final : public Integrator {
     system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
       const Vec q_mid = state.q + (h / 2) * x;
       eval_hessian(problem, q_mid, hessian_);
+      inner_scale = std::abs(h / 2) * gradient_term_scale(hessian_, q_mid);
       jacobian = mass_matrix_ + (h * h / 4) * hessian_;
       if (!forced) return;
       if (problem.has(kForceJacobian)) {

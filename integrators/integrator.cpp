@@ -3,6 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+
 namespace geomint {
 
 #define GEOMINT_METHOD(name, factory, variants, summary) \
@@ -72,6 +75,27 @@ std::vector<std::string> flag_names(unsigned flags) {
     if (flags & bit) out.emplace_back(label);
   }
   return out;
+}
+
+double roundoff_tolerance_ratio(const double* y, long n, double rtol, double atol) {
+  long double sum = 0;
+  for (long i = 0; i < n; ++i) {
+    const long double tolerance = static_cast<long double>(rtol) * std::abs(y[i]) + atol;
+    if (!(tolerance > 0)) continue;
+    const long double scaled = y[i] / tolerance;
+    sum += scaled * scaled;
+  }
+  const long double norm = n > 0 ? std::sqrt(sum / static_cast<long double>(n)) : 0.0L;
+  return static_cast<double>(std::numeric_limits<double>::epsilon() / 2 * norm);
+}
+
+StepStatus too_much_accuracy(const std::string& reason, const std::string& method, double t,
+                             double rtol, double atol, double ratio) {
+  return StepStatus::failure(
+      reason, fmt::format("{}: too much accuracy requested at t={:.6g}: rtol={:g}, atol={:g} are "
+                          "below round-off (unit roundoff x weighted norm of y = {:g} > 1); "
+                          "loosen the tolerances",
+                          method, t, rtol, atol, ratio));
 }
 
 void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }

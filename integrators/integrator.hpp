@@ -88,6 +88,17 @@ class Integrator {
   std::string spec_;
 };
 
+// CVODE's "too much accuracy" test (tolsf, CVODE user guide §2.1): unit roundoff times the
+// weighted RMS norm of y with weights 1/(rtol|y_i| + atol). Above 1 the tolerances ask for less
+// than round-off, and an error-controlled solver can only crawl at the smallest representable
+// step. Computed in long double so that the weights of atol = 1e-300 do not overflow; components
+// with rtol|y_i| + atol = 0 are skipped.
+double roundoff_tolerance_ratio(const double* y, long n, double rtol, double atol);
+
+// The failure an adaptive wrapper reports when that ratio exceeds 1 (status `reason`).
+StepStatus too_much_accuracy(const std::string& reason, const std::string& method, double t,
+                             double rtol, double atol, double ratio);
+
 // Registry (integrators/registry.def). Throws InputError for unknown names/keys/values.
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
 

@@ -97,7 +97,9 @@ class Newmark final : public Integrator {
           f += force_;
         }
       };
+      double inner_scale = 0.0;
       NewtonSystem system;
+      system.inner_term_scale = [&] { return inner_scale; };
       system.residual = [&](const Vec& a, Vec& residual) {
         total_force(a, total_);
         residual = h * (mass.cwiseProduct(a) - total_);
@@ -107,6 +109,7 @@ class Newmark final : public Integrator {
         const Vec q1 = q_predict + (h * h * beta_) * a;
         if (beta_ != 0.0) {
           eval_hessian(problem, q1, hessian_);
+          inner_scale = std::abs(h) * gradient_term_scale(hessian_, q1);
           jacobian += (beta_ * h * h) * hessian_;
         }
         if (forced) {

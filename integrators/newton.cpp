@@ -119,7 +119,23 @@ SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, 
   return out;
 }
 
+double gradient_term_scale(const SparseMatrix& H, const Vec& q) {
+  Vec terms = Vec::Zero(H.rows());
+  for (int k = 0; k < H.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(H, k); it; ++it) {
+      terms[it.row()] += std::abs(it.value()) * std::abs(q[it.col()]);
+    }
+  }
+  return terms.norm();
+}
+
 std::string describe(const NewtonResult& result) {
+  if (result.converged && result.at_roundoff) {
+    return fmt::format(
+        "Newton converged at round-off in {} iterations: correction below {:.2g}*|x|, residual "
+        "{:.3g} (tolerance {:.3g})",
+        result.iterations, kRoundoffFloor, result.residual_norm, result.threshold);
+  }
   if (result.converged) {
     return fmt::format("Newton converged in {} iterations: residual {:.3g} <= {:.3g}",
                        result.iterations, result.residual_norm, result.threshold);
@@ -132,6 +148,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   NewtonResult result;
   const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
   result.threshold = relative_tolerance * residual_scale;
+  double scale = residual_scale;
   Factorisation& f = *factorisation_;
 
   Vec residual;
@@ -154,8 +171,8 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
 
   evaluate(x, residual);
   if (system.scale_after_first_residual) {
-    result.threshold =
-        relative_tolerance * (residual_scale + system.scale_after_first_residual());
+    scale = residual_scale + system.scale_after_first_residual();
+    result.threshold = relative_tolerance * scale;
   }
   result.residual_norm = residual.norm();
   if (options_.record_history) result.residual_history.push_back(result.residual_norm);
@@ -197,6 +214,12 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
                                          f.jacobian.rows(), f.jacobian.cols(), x.size()));
     }
     if (!all_finite(f.jacobian)) return fail("nan");
+    if (system.inner_term_scale) {
+      const double inner = system.inner_term_scale();
+      if (std::isfinite(inner)) {
+        result.threshold = std::max(relative_tolerance * scale, kRoundoffFloor * (scale + inner));
+      }
+    }
     ++result.linear_solves;
     const bool factorised =
         f.factorise(system.symmetric, options_.reuse_symbolic, result.symbolic_analyses);
@@ -227,6 +250,24 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     // A nearly singular matrix factorises without a zero pivot but yields inf/NaN here.
     if (!all_finite(direction)) return fail("linear_solve_failed");
     ++result.iterations;
+
+    // Round-off floor in x: a correction below kRoundoffFloor·‖x‖ changes x by no more than its
+    // own rounding, so the residual left is the rounding of R's terms — which can exceed
+    // tolerance·residual_scale when a term's inner magnitude (h·K·q of a stiff spring whose
+    // elongation is small) is far above its value. Take the correction and stop.
+    if (direction.norm() <= kRoundoffFloor * x.norm()) {
+      trial = x + direction;
+      evaluate(trial, trial_residual);
+      if (all_finite(trial_residual)) {
+        x.swap(trial);
+        residual.swap(trial_residual);
+        result.residual_norm = residual.norm();
+        if (options_.record_history) result.residual_history.push_back(result.residual_norm);
+        result.converged = true;
+        result.at_roundoff = true;
+        return result;
+      }
+    }
 
     // Directional derivative of the merit along the step. For ½‖R‖² it is Rᵀ J d = −‖R‖² for
     // the exact Newton step, whatever J is, so the step is always a descent direction.

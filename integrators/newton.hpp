@@ -13,7 +13,9 @@
 namespace geomint {
 
 // Smallest relative residual the stopping test asks for: R sums a few terms, each rounded to
-// ε of its size, so ‖R‖ cannot reliably get below a small multiple of ε·residual_scale.
+// ε of its size, so ‖R‖ cannot reliably get below a small multiple of ε·residual_scale. The
+// same factor bounds the relative Newton correction below which x counts as converged at
+// round-off (NewtonResult::at_roundoff).
 inline constexpr double kRoundoffFloor = 16 * 2.220446049250313e-16;
 
 struct NewtonOptions {
@@ -80,7 +82,18 @@ struct NewtonSystem {
   // caller's residual_scale. Without it, a stiff step (hω ≫ 1) can ask for a residual below the
   // round-off of its own terms and fail although the iteration has converged.
   std::function<double()> scale_after_first_residual;
+  // Optional: called after every jacobian() call, the size of the terms inside R's nonlinear
+  // part at that iterate, e.g. (1−α)h·gradient_term_scale(∇²V, q^α) for a residual with
+  // (1−α)h∇V(q^α). The rounding of R is about ε times that — not ε·residual_scale — when ∇V is
+  // computed from coordinate differences and a stiff part sits near its rest length (h·K·q with
+  // K = 1e8): the stopping test then asks for no less than kRoundoffFloor·(residual_scale +
+  // this), instead of failing on noise.
+  std::function<double()> inner_term_scale;
 };
+
+// ‖ |H|·|q| ‖₂ for a Hessian H = ∇²V(q): the size of the terms a gradient ∇V(q) sums when V is
+// built from coordinate differences (springs, elements), so ε·‖|H||q|‖ estimates its rounding.
+double gradient_term_scale(const SparseMatrix& H, const Vec& q);
 
 struct NewtonResult {
   bool converged = false;
@@ -96,8 +109,14 @@ struct NewtonResult {
   int shift_factorisations = 0;  // extra numeric factorisations spent on the shift
   double last_shift = 0.0;       // μ of the last shifted iteration
   bool polished = false;         // the polishing correction was taken (NewtonOptions::polish)
+  // Converged because the Newton correction fell below kRoundoffFloor·‖x‖: x cannot be resolved
+  // further in double precision, so the remaining ‖R‖ is the rounding of its terms (a stiff
+  // term h·K·q whose own rounding ε·h·‖K‖‖q‖ exceeds tolerance·residual_scale), not an error.
+  bool at_roundoff = false;
   double residual_norm = 0.0;
-  double threshold = 0.0;                // max(tolerance, kRoundoffFloor) · residual_scale
+  // max(tolerance · residual_scale, kRoundoffFloor · (residual_scale + inner_term_scale)), as
+  // last used
+  double threshold = 0.0;
   std::vector<double> residual_history;  // ‖R‖ at x₀, x₁, … when options.record_history
 };
 

@@ -53,6 +53,7 @@ double starting_step(const Vec& y, const Vec& ydot, double rtol, double atol) {
 struct Tolerances {
   double rtol = 1e-8;
   double atol = 1e-10;
+  long max_steps = 1000000;  // accepted steps over the whole run
 };
 
 Tolerances read_tolerances(Params& params) {
@@ -61,6 +62,11 @@ Tolerances read_tolerances(Params& params) {
       "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
   tolerances.atol = params.real(
       "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
+  tolerances.max_steps = params.integer(
+      "max_steps", 1000000,
+      "maximum number of accepted steps over the whole run (the run then fails with status "
+      "max_steps)",
+      1, 1000000000000L);
   return tolerances;
 }
 
@@ -86,6 +92,24 @@ class OdeintAdaptive : public Integrator {
     if (!(t_stop > t_)) {
       return StepStatus::failure(
           "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
+    }
+    // The run-total step budget: below round-off tolerances the controller keeps accepting
+    // steps near the smallest representable size, and a huge horizon needs ever more steps.
+    if (counters_.steps >= tolerances_.max_steps) {
+      return StepStatus::failure(
+          "max_steps", fmt::format("max_steps={} accepted steps taken before t={:.6g} (t_stop "
+                                   "{:.6g}); raise max_steps or loosen rtol/atol",
+                                   tolerances_.max_steps, t_, t_stop));
+    }
+    // Tolerances below round-off: the controller would accept ever smaller steps near t = 0
+    // until the budget above runs out; say so at once, as CVODE does.
+    y_buffer_.resize(2 * state.q.size());
+    y_buffer_ << state.q, state.p;
+    if (const double ratio = roundoff_tolerance_ratio(y_buffer_.data(), y_buffer_.size(),
+                                                      tolerances_.rtol, tolerances_.atol);
+        !(ratio <= 1.0)) {
+      return too_much_accuracy("too_much_accuracy", info().name, t_, tolerances_.rtol,
+                               tolerances_.atol, ratio);
     }
     // Odeint's own integrate functions give up after 500 failed attempts; so do we.
     constexpr int kMaxAttempts = 500;

@@ -530,6 +530,15 @@ class Ida final : public SundialsIntegrator {
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
     StepStatus status;
     if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    // IDA's own too-much-accuracy test (unit roundoff times the weighted RMS norm of y above 1)
+    // comes after its initial-step estimate, which overflows first at such tolerances and then
+    // reports "tstop is behind current t". The same test here names the real cause.
+    const double tolsf =
+        roundoff_tolerance_ratio(N_VGetArrayPointer(y_.get()), n_, settings_.rtol, settings_.atol);
+    if (!(tolsf <= 1.0)) {
+      return too_much_accuracy("ida_flag_-2", "ida (IDA_TOO_MUCH_ACC)", t_, settings_.rtol,
+                               settings_.atol, tolsf);
+    }
     void* ida = memory_.get();
     int flag = IDASetStopTime(ida, t_stop);
     double t_returned = t_;

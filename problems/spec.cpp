@@ -90,6 +90,10 @@ double Params::real(const std::string& key, double default_value, const std::str
           fmt::format("{}: parameter {}='{}' is not a finite number", context_, key, *text));
     }
   }
+  if (!(std::abs(value) <= kMaxParameterMagnitude)) {
+    throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: |{}| <= {:g})",
+                                 context_, key, format_number(value), key, kMaxParameterMagnitude));
+  }
   if (ok && !ok(value)) {
     throw InputError(fmt::format("{}: parameter {}={} is out of range (allowed: {})", context_, key,
                                  format_number(value), valid.empty() ? "see list" : valid));

@@ -34,6 +34,9 @@ struct ParamDoc {
   std::string help;
 };
 
+// Bound on the magnitude of every real parameter (Params::real).
+inline constexpr double kMaxParameterMagnitude = 1e15;
+
 // Reads typed parameters from a Spec. Each getter records the key (with its default and help)
 // so that finish() can reject unknown keys by listing the valid ones, and canonical() can
 // print every parameter. `context` ("method 'hp'") prefixes every message.
@@ -42,6 +45,8 @@ class Params {
   Params(const Spec& spec, std::string context);
 
   // Real parameter; `valid` describes the allowed range for the message ("> 0", "in [0, 1]").
+  // Every real parameter must also satisfy |x| <= kMaxParameterMagnitude: larger values square
+  // or multiply into overflow (ω², k·x²) or leave no digits for a step (θ + hω at θ = 1e308).
   double real(const std::string& key, double default_value, const std::string& help,
               const std::function<bool(double)>& ok = nullptr, const std::string& valid = "");
   // Integer parameter, bounds inclusive.

@@ -1,4 +1,0 @@
-// Build provenance strings.
-namespace geomint {
-const char* version() { return GEOMINT_VERSION; }
-}  // namespace geomint
