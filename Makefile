@@ -5,7 +5,8 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
-.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench format clean
+.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
+        format clean mutation mutation-check
 
 all: build
 
@@ -25,8 +26,10 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
 
+# Everything: all suites (slow ones included) and the whole mutation list (make mutation).
 test-all: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@$(MAKE) --no-print-directory mutation
 
 # Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
 reproduce-figures: build
@@ -47,6 +50,18 @@ gates: build
 gate-quick: build
 	@QUICK=1 PLOTS=0 bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
 	@$(BUILD_DIR)/geomint gate $(GATES) $(addsuffix /quick,$(addprefix results/,$(SCENES)))
+
+# Mutation testing (README.md, "Mutation testing"): applies each seeded bug of
+# tests/mutation/mutants.toml to a scratch copy of the tracked sources in build-mutation/ (never to
+# the working tree), rebuilds incrementally, runs the affected tests and quick scenes + gates, and
+# fails unless every mutant is killed. MUTATION_ONLY=id,id, MUTATION_SHARD=i/N or
+# MUTATION_BUDGET_MIN=M (rotating by commit) run a subset; the default is the whole list.
+mutation: deps
+	@/usr/bin/python3 scripts/mutation.py --jobs $(JOBS)
+
+# Only checks that every mutant's `find` text still occurs exactly once (seconds, no build).
+mutation-check:
+	@/usr/bin/python3 scripts/mutation.py --check
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done

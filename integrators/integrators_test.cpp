@@ -239,6 +239,38 @@ TEST(NewtonSolver, MaxIterationsOneGivesNewtonMaxIter) {
   EXPECT_NE(describe(result).find("newton_max_iter"), std::string::npos);
 }
 
+// The stopping contract, observed where quadratic convergence would hide a loose test: with a
+// Jacobian twice too large the iteration contracts the residual by exactly ½ per update, so it
+// passes through every decade above the threshold. The solver must stop at the first residual
+// at or below result.threshold — not earlier (a looser test), not later — and without polishing
+// the reported residual is that iterate's.
+TEST(NewtonSolver, StopsAtTheFirstResidualBelowItsThreshold) {
+  NewtonSystem system;
+  system.symmetric = true;
+  system.residual = [](const Vec& x, Vec& r) { r = x; };
+  system.jacobian = [](const Vec& x, SparseMatrix& J) {
+    J = sparse_from(Eigen::MatrixXd::Identity(x.size(), x.size()) * 2.0);
+  };
+  NewtonOptions options;
+  options.line_search = false;
+  options.record_history = true;
+  options.max_iterations = 200;
+  for (const double start : {1.0, 1e3, 1e-3}) {
+    Vec x = Vec::Constant(3, start);
+    const NewtonResult result = NewtonSolver(options).solve(system, x, 1.0);
+    ASSERT_TRUE(result.converged) << describe(result);
+    const auto& history = result.residual_history;
+    ASSERT_EQ(history.size(), static_cast<size_t>(result.iterations + 1));
+    EXPECT_LE(result.residual_norm, result.threshold) << "start " << start;
+    EXPECT_EQ(result.residual_norm, history.back());
+    for (size_t k = 0; k + 1 < history.size(); ++k) {
+      EXPECT_GT(history[k], result.threshold) << "start " << start << ": stopped late at " << k;
+    }
+    // ½ per update: the first residual below the threshold is within a factor 2 of it.
+    EXPECT_GT(result.residual_norm, 0.5 * result.threshold * (1 - 1e-12)) << "start " << start;
+  }
+}
+
 TEST(NewtonSolver, NonFiniteResidualIsNan) {
   NewtonSystem system;
   system.residual = [](const Vec& x, Vec& r) { r = (x.array().log() - 1).matrix(); };

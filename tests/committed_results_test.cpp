@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -102,7 +103,15 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
   EXPECT_GT(checked, 0) << "no row of " << path << " is cheap enough to re-run";
 }
 
-INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_with_summary()));
+// Named by scene (Results/CommittedScene.CheapRowsReproduce/fig1_pendulum), so a filter can pick
+// one scene and a failure says which.
+INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_with_summary()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name;
+                           for (char c : info.param)
+                             name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return name;
+                         });
 
 }  // namespace
 }  // namespace geomint

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include "harness/observers.hpp"
 #include "harness/order.hpp"
+#include "harness/run.hpp"
 #include "harness/scene.hpp"
 #include "harness/table.hpp"
 
@@ -101,6 +103,26 @@ TEST(Table, ParseCsvRoundTripsToCsv) {
   const auto columns = column_union(rows, standard_columns());
   EXPECT_EQ(parse_csv(to_csv(rows, columns, {{"geomint", "test"}})), rows);
   EXPECT_THROW(parse_csv("a,b\n1,2,3\n"), std::runtime_error);
+}
+
+// DESIGN.md §5: numbers are written with enough digits to round-trip. Every metric of a run row,
+// read back as text, must give the very double the observers computed (a fixed 6- or 15-digit
+// format would lose bits of energy_err_max, error_final, ... and of every gate built on them).
+TEST(Table, RunRowMetricsRoundTripExactly) {
+  RunConfig config;
+  config.dt = 0.0123;
+  config.t_end = 3.7;
+  config.timing_repeats = 0;
+  const RunResult result = run_one("kepler:e=0.6", "stormer_verlet", config);
+  ASSERT_TRUE(result.ok);
+  ASSERT_GE(result.metrics.size(), 5u);
+  for (const auto& [column, value] : result.metrics) {
+    ASSERT_TRUE(result.row.count(column)) << column;
+    const std::string& text = result.row.at(column);
+    EXPECT_EQ(std::strtod(text.c_str(), nullptr), value) << column << " written as " << text;
+  }
+  EXPECT_EQ(std::strtod(result.row.at("dt").c_str(), nullptr), config.dt);
+  EXPECT_EQ(std::strtod(result.row.at("t_end").c_str(), nullptr), config.t_end);
 }
 
 TEST(Table, AtomicWriteLeavesNoTemporaryFile) {

@@ -199,6 +199,31 @@ TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
   EXPECT_GT(result.metrics.at("angular_momentum_err_max"), 1e-10);
 }
 
+// L → cL (masses and potential scaled by the same c) leaves the equations of motion unchanged, so
+// every fixed-step method must give the same positions and c times the momenta: a method that
+// forgets M⁻¹ somewhere (e.g. in a starting acceleration) passes every check on unit masses and
+// fails here. Nonlinear FPU-β chain, c = 4 (masses, k and β), 50 steps of h = 0.1 (hω ≈ 0.2).
+TEST_P(EveryMethod, ScalingMassesAndPotentialTogetherKeepsTheMotion) {
+  const auto unit = make_problem("spring_chain:n=4,model=fpu_beta");
+  const auto heavy = make_problem("spring_chain:n=4,model=fpu_beta,mass=4,stiffness=4,beta=4");
+  auto unit_method = make_integrator(GetParam());
+  auto heavy_method = make_integrator(GetParam());
+  State a = unit->initial_state(), b = heavy->initial_state();
+  ASSERT_EQ((b.p - 4 * a.p).norm(), 0.0);
+  const double h = 0.1;
+  unit_method->reset(*unit, a, h);
+  heavy_method->reset(*heavy, b, h);
+  for (int k = 0; k < 50; ++k) {
+    ASSERT_TRUE(unit_method->step(*unit, a, h).ok) << k;
+    ASSERT_TRUE(heavy_method->step(*heavy, b, h).ok) << k;
+  }
+  // Implicit solves stop at a relative residual of 1e-12 (then polish): 1e-10 leaves room for
+  // 50 steps of that; the bug class this targets is an O(h) or O(h²) difference (> 1e-4 here).
+  const double q_scale = a.q.norm(), p_scale = a.p.norm();
+  EXPECT_LE((b.q - a.q).norm(), 1e-10 * q_scale) << GetParam();
+  EXPECT_LE((b.p - 4 * a.p).norm(), 4e-10 * p_scale) << GetParam();
+}
+
 INSTANTIATE_TEST_SUITE_P(Registry, EveryMethod, testing::ValuesIn(fixed_step_methods()), test_name);
 
 }  // namespace
