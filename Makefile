@@ -5,7 +5,8 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
-.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates bench format clean
+.PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates bench format clean \
+        sanitize-build test-sanitize fuzz
 
 all: build
 
@@ -23,8 +24,32 @@ build: configure
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 
+# Everything: slow tests too, then the sanitizer suite and the fuzzers (FUZZ_SECONDS each).
 test-all: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@$(MAKE) --no-print-directory test-sanitize
+	@$(MAKE) --no-print-directory fuzz
+
+# Sanitizer build (README "Sanitizers and fuzzing"): clang, -fsanitize=address,undefined with
+# UB fatal, in its own directory; it also builds the libFuzzer targets of fuzz/. No benchmarks.
+SAN_DIR ?= build-asan
+SAN_CXX ?= clang++
+SAN_ENV = ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
+          UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+sanitize-build: deps
+	@mkdir -p $(SAN_DIR) && cmake -S . -B $(SAN_DIR) -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
+	  > $(SAN_DIR)/configure.log 2>&1 || (cat $(SAN_DIR)/configure.log; exit 1)
+	@$(SAN_ENV) cmake --build $(SAN_DIR) -j $(JOBS)
+
+# The fast suite under ASan + UBSan (what `.ci/run` runs after `make test`): any report fails.
+test-sanitize: sanitize-build
+	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE slow
+
+# Each fuzzer for FUZZ_SECONDS on its committed corpus (fuzz/corpus/<target>/); fails on a finding.
+FUZZ_SECONDS ?= 60
+fuzz: sanitize-build
+	@$(SAN_ENV) bash scripts/fuzz.sh $(SAN_DIR) $(FUZZ_SECONDS)
 
 # Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
 reproduce-figures: build
