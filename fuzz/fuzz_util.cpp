@@ -1,6 +1,7 @@
 // Temporary files for the file-based fuzz targets (fuzz_util.hpp).
 #include "fuzz/fuzz_util.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -38,6 +39,28 @@ std::string write_temp_file(const std::string& name, const uint8_t* data, size_t
     std::abort();
   }
   return path;
+}
+
+bool requests_large_problem(const std::string& text) {
+  auto is_word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  double product = 1;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '=') continue;
+    size_t key_end = i;
+    while (key_end > 0 && text[key_end - 1] == ' ') --key_end;
+    size_t key_begin = key_end;
+    while (key_begin > 0 && is_word(text[key_begin - 1])) --key_begin;
+    const std::string key = text.substr(key_begin, key_end - key_begin);
+    if (key != "n" && key != "m" && key != "nx" && key != "ny" && key != "nz") continue;
+    size_t j = i + 1;
+    while (j < text.size() && (text[j] == ' ' || text[j] == '+')) ++j;
+    double value = 0;
+    for (; j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])); ++j) {
+      value = 10 * value + (text[j] - '0');
+    }
+    if (value > 1) product *= value;
+  }
+  return product > kMaxFuzzProblemSize;
 }
 
 }  // namespace geomint::fuzz

@@ -11,6 +11,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size > 16384) return -1;
+  if (geomint::fuzz::requests_large_problem(
+          std::string(reinterpret_cast<const char*>(data), size))) {
+    return -1;  // a legal but large problem: over the fuzz time budget (fuzz_util.hpp)
+  }
   const std::string path = geomint::fuzz::write_temp_file("scene.toml", data, size);
   for (bool quick : {false, true}) {
     try {

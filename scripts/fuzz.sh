@@ -33,7 +33,7 @@ for target in "${targets[@]}"; do
   fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | cut -d' ' -f2)
-  corpus=$(find "$work" "$root/fuzz/corpus/$target" -type f | wc -l)
+  corpus=$(grep -o 'corp: [0-9]*/[0-9a-zA-Z]*' "$log" | tail -n 1 | cut -d' ' -f2)
   echo "fuzz: $target: ${runs:-?} executions in $(( $(date +%s) - start )) s, coverage ${cov:-?}" \
-       "edges, $corpus corpus files, 0 findings"
+       "edges, corpus ${corpus:-?} (inputs/bytes), 0 findings"
 done
