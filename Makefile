@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
-        format clean mutation mutation-check
+        format clean mutation mutation-check sanitize-build test-sanitize fuzz
 
 all: build
 
@@ -26,10 +26,42 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
 
-# Everything: all suites (slow ones included) and the whole mutation list (make mutation).
+# Everything: slow tests too, the sanitizer suite, the fuzzers (FUZZ_SECONDS each) and the whole
+# mutation list.
 test-all: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@$(MAKE) --no-print-directory test-sanitize
+	@$(MAKE) --no-print-directory fuzz
 	@$(MAKE) --no-print-directory mutation
+
+# Sanitizer build (README "Sanitizers and fuzzing"): clang, -fsanitize=address,undefined with
+# UB fatal, in its own directory; it also builds the libFuzzer targets of fuzz/. No benchmarks.
+SAN_DIR ?= build-asan
+SAN_CXX ?= clang++
+SAN_ENV = ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
+          UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+sanitize-build: deps
+	@mkdir -p $(SAN_DIR) && cmake -S . -B $(SAN_DIR) -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
+	  > $(SAN_DIR)/configure.log 2>&1 || (cat $(SAN_DIR)/configure.log; exit 1)
+	@$(SAN_ENV) cmake --build $(SAN_DIR) -j $(JOBS)
+
+# The fast suite under ASan + UBSan (what `.ci/run` runs after `make test`): any report fails.
+# Left out (SAN_EXCLUDE): four long-horizon repetitions that take 3-6 minutes each under the
+# sanitizers (a quarter of the suite's time) and run no code that the other tests of the same
+# method, problem or scene do not run: 10^4 spring-net steps of lobatto3ab:s=4 and gauss:s=3
+# (their order, energy, reversibility and Kepler tests stay), the committed work_precision rows
+# (every method is re-run by the other scenes' rows) and kepler:e=0.99 against an RK4 reference
+# (the other Kepler eccentricities stay). `make test-sanitize SAN_EXCLUDE=` runs everything.
+SAN_EXCLUDE ?= KeepsSpringNetMomentaOver10000Steps/(lobatto3ab_s_4|gauss_s_3)( |$$)|CheapRowsReproduce/"work_precision"|ExactMatchesIndependentRk4/kepler_e_0p99( |$$)
+test-sanitize: sanitize-build
+	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE slow \
+	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
+
+# Each fuzzer for FUZZ_SECONDS on its committed corpus (fuzz/corpus/<target>/); fails on a finding.
+FUZZ_SECONDS ?= 60
+fuzz: sanitize-build
+	@$(SAN_ENV) bash scripts/fuzz.sh $(SAN_DIR) $(FUZZ_SECONDS)
 
 # Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
 reproduce-figures: build
