@@ -60,7 +60,8 @@ const char* const kAllowedKeys =
 // Reads one [[gate]] block's keys (typed, with messages naming the gate and the key).
 class GateBlock {
  public:
-  GateBlock(const toml::table& block, std::string where) : block_(block), where_(std::move(where)) {}
+  GateBlock(const toml::table& block, std::string where)
+      : block_(block), where_(std::move(where)) {}
   void rename(std::string where) { where_ = std::move(where); }
   const std::string& where() const { return where_; }
 
@@ -160,9 +161,8 @@ ResultFile read_result_file(const fs::path& path) {
                                  path.string(), file.variant));
   }
   if (file.scene.empty()) {
-    throw InputError(
-        fmt::format("gate: result file '{}': cannot tell its scene (no '# scene:' line)",
-                    path.string()));
+    throw InputError(fmt::format(
+        "gate: result file '{}': cannot tell its scene (no '# scene:' line)", path.string()));
   }
   return file;
 }
@@ -191,9 +191,9 @@ std::vector<Gate> load_gates(const std::string& path) {
   if (!blocks || blocks->empty()) {
     throw InputError(fmt::format("gates file '{}': no [[gate]] blocks", path));
   }
-  const std::set<std::string> allowed = {"name",   "scene", "table",  "variants",  "file",
-                                         "where",  "column", "min",   "max",       "equals",
-                                         "quick_min", "quick_max", "quick_equals"};
+  const std::set<std::string> allowed = {
+      "name", "scene", "table",  "variants",  "file",      "where",       "column",
+      "min",  "max",   "equals", "quick_min", "quick_max", "quick_equals"};
   std::vector<Gate> gates;
   std::set<std::string> names;
   int index = 0;
@@ -207,8 +207,8 @@ std::vector<Gate> load_gates(const std::string& path) {
     GateBlock block(*table, fmt::format("gates file '{}', gate {}", path, index));
     for (const auto& [key, node] : *table) {
       if (!allowed.count(std::string(key.str()))) {
-        throw InputError(fmt::format("{}: unknown key '{}' (allowed: {})", block.where(),
-                                     key.str(), kAllowedKeys));
+        throw InputError(fmt::format("{}: unknown key '{}' (allowed: {})", block.where(), key.str(),
+                                     kAllowedKeys));
       }
     }
     Gate gate;
@@ -224,7 +224,8 @@ std::vector<Gate> load_gates(const std::string& path) {
     gate.column = *column;
     if (const auto file = block.text("file")) {
       if (table->get("scene") || table->get("table")) {
-        throw InputError(fmt::format("{}: give 'scene'/'table' or 'file', not both", block.where()));
+        throw InputError(
+            fmt::format("{}: give 'scene'/'table' or 'file', not both", block.where()));
       }
       parse_legacy_file(*file, gate, block.where());
     }
@@ -237,16 +238,17 @@ std::vector<Gate> load_gates(const std::string& path) {
         for (const auto& item : *array) {
           const auto value = item.value<std::string>();
           if (!value || (*value != "full" && *value != "quick")) {
-            throw InputError(fmt::format(
-                "{}: 'variants' must list \"full\" and/or \"quick\"", block.where()));
+            throw InputError(
+                fmt::format("{}: 'variants' must list \"full\" and/or \"quick\"", block.where()));
           }
           gate.variants.push_back(*value);
         }
       }
       if (!array || gate.variants.empty()) {
-        throw InputError(fmt::format("{}: 'variants' must be a non-empty array of \"full\", "
-                                     "\"quick\"",
-                                     block.where()));
+        throw InputError(
+            fmt::format("{}: 'variants' must be a non-empty array of \"full\", "
+                        "\"quick\"",
+                        block.where()));
       }
     }
     gate.full.min = block.number("min");
@@ -307,10 +309,10 @@ std::vector<ResultFile> load_result_files(const std::vector<std::string>& paths)
         }
       }
       if (tables.empty()) {
-        throw InputError(fmt::format(
-            "gate: folder '{}' holds no result table (*.csv); give results/<scene> or "
-            "results/<scene>/quick after a sweep",
-            path));
+        throw InputError(
+            fmt::format("gate: folder '{}' holds no result table (*.csv); give results/<scene> or "
+                        "results/<scene>/quick after a sweep",
+                        path));
       }
       std::sort(tables.begin(), tables.end());
       for (const auto& table : tables) files.push_back(read_result_file(table));
@@ -347,8 +349,8 @@ std::vector<GateOutcome> check_gates(const std::vector<Gate>& gates,
     outcome.applicable = false;
     for (const ResultFile& file : files) {
       const bool of_scene = gate.scene.empty() || file.scene == gate.scene;
-      const bool of_variant =
-          std::find(gate.variants.begin(), gate.variants.end(), file.variant) != gate.variants.end();
+      const bool of_variant = std::find(gate.variants.begin(), gate.variants.end(), file.variant) !=
+                              gate.variants.end();
       if (!of_scene || !of_variant) continue;
       outcome.applicable = true;
       if (!gate.table.empty() && file.table != gate.table) continue;
@@ -364,12 +366,12 @@ std::vector<GateOutcome> check_gates(const std::vector<Gate>& gates,
         }
         if (!selected) continue;
         ++outcome.rows_checked;
-        const std::string label = fmt::format(
-            "{}{}: label={} method={} problem={}{}", file.path,
-            file.variant == "quick" ? " (quick)" : "", row.count("label") ? row.at("label") : "-",
-            row.count("method") ? row.at("method") : "-",
-            row.count("problem") ? row.at("problem") : "-",
-            row.count("dt") ? " dt=" + row.at("dt") : "");
+        const std::string label = fmt::format("{}{}: label={} method={} problem={}{}", file.path,
+                                              file.variant == "quick" ? " (quick)" : "",
+                                              row.count("label") ? row.at("label") : "-",
+                                              row.count("method") ? row.at("method") : "-",
+                                              row.count("problem") ? row.at("problem") : "-",
+                                              row.count("dt") ? " dt=" + row.at("dt") : "");
         const auto actual = row_value(row, gate.column);
         bool ok = false;
         std::string verdict;
@@ -392,9 +394,8 @@ std::vector<GateOutcome> check_gates(const std::vector<Gate>& gates,
     }
     if (!outcome.applicable) {
       outcome.passed = true;
-      outcome.lines.push_back(fmt::format(
-          "not applicable: no result of scene '{}' ({}) was given", gate.scene,
-          fmt::join(gate.variants, "/")));
+      outcome.lines.push_back(fmt::format("not applicable: no result of scene '{}' ({}) was given",
+                                          gate.scene, fmt::join(gate.variants, "/")));
     } else if (outcome.rows_checked == 0) {
       outcome.passed = false;
       outcome.lines.push_back(fmt::format(

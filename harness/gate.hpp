@@ -24,9 +24,9 @@ struct GateCheck {
 // reported as not applicable, so one gates file serves any subset of the scenes.
 struct Gate {
   std::string name;
-  std::string scene;           // results/<scene>/ ("" = every scene given)
-  std::string table;           // "summary", "order", "stability", ... ("" = every table)
-  std::vector<std::string> variants = {"full", "quick"};  // which sweeps it gates
+  std::string scene;  // results/<scene>/ ("" = every scene given)
+  std::string table;  // "summary", "order", "stability", ... ("" = every table)
+  std::vector<std::string> variants = {"full", "quick"};   // which sweeps it gates
   std::vector<std::pair<std::string, std::string>> where;  // column = value
   std::string column;
   GateCheck full;                  // min/max/equals

@@ -117,8 +117,7 @@ std::filesystem::path write_scene_tables(const std::string& scene, const std::st
   std::filesystem::create_directories(folder);
   std::ofstream(folder / "summary.csv")
       << "# geomint: provenance line\n# scene: " << scene << "\n# variant: " << variant
-      << "\nlabel,method,status,energy_err_max\nshort,stormer_verlet,ok," << energy_err_max
-      << "\n";
+      << "\nlabel,method,status,energy_err_max\nshort,stormer_verlet,ok," << energy_err_max << "\n";
   return folder;
 }
 
@@ -162,20 +161,20 @@ TEST(Gate, ScenesAndVariantsComeFromProvenanceAndQuickBandsApplyToQuickRuns) {
   EXPECT_TRUE(outcomes[1].applicable);
   EXPECT_TRUE(outcomes[1].passed);
   // A quick band that the value leaves fails the quick run too.
-  outcomes = check_gates(
-      gates, load_result_files({write_scene_tables("fig1", "quick", "0.05").string()}));
+  outcomes =
+      check_gates(gates, load_result_files({write_scene_tables("fig1", "quick", "0.05").string()}));
   EXPECT_FALSE(outcomes[0].passed);
 }
 
 TEST(Gate, ScenesComeFromThePathWhenTheFileHasNoSceneLine) {
-  const auto root = std::filesystem::temp_directory_path() /
-                    ("geomint_gate_path_" + std::to_string(::getpid()));
+  const auto root =
+      std::filesystem::temp_directory_path() / ("geomint_gate_path_" + std::to_string(::getpid()));
   for (const char* folder : {"order_basic", "order_basic/quick", "basic"}) {
     std::filesystem::create_directories(root / folder);
     std::ofstream(root / folder / "order.csv") << "label,method,order\npendulum,rk4,4.0\n";
   }
-  const auto files = load_result_files({(root / "order_basic" / "order.csv").string(),
-                                        (root / "order_basic" / "quick").string()});
+  const auto files = load_result_files(
+      {(root / "order_basic" / "order.csv").string(), (root / "order_basic" / "quick").string()});
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(files[0].scene, "order_basic");
   EXPECT_EQ(files[0].variant, "full");
@@ -229,8 +228,8 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
   }
   EXPECT_THROW(load_result_files({"/nonexistent/summary.csv"}), InputError);
   // A folder without tables is an input error naming it, not a gate that "selects no row".
-  const auto empty = std::filesystem::temp_directory_path() /
-                     ("geomint_gate_empty_" + std::to_string(::getpid()));
+  const auto empty =
+      std::filesystem::temp_directory_path() / ("geomint_gate_empty_" + std::to_string(::getpid()));
   std::filesystem::create_directories(empty);
   EXPECT_THROW(load_result_files({empty.string()}), InputError);
   EXPECT_THROW(load_gates(empty.string()), InputError);

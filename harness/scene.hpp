@@ -55,7 +55,7 @@ struct SweepOptions {
   // Written as `# scene:` and `# variant:` provenance lines, which `geomint gate` selects by.
   std::string scene_name;
   std::string variant = "full";  // "full" or "quick"
-  bool progress = true;  // progress on stderr when it is a terminal
+  bool progress = true;          // progress on stderr when it is a terminal
 };
 
 // Runs the scene; returns the number of failed runs (failure rows are results, not errors).
