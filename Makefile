@@ -1,4 +1,4 @@
-# Thin wrapper around CMake/CTest (DESIGN.md §1). `make reproduce-figures` and `make test` each
+# Thin wrapper around CMake/CTest (docs/DESIGN.md §1). `make reproduce-figures` and `make test` each
 # work as the very first command on a fresh Debian 12 machine: they install missing packages
 # through scripts/install-deps.sh when run as root, and otherwise stop with the command to run.
 BUILD_DIR ?= build

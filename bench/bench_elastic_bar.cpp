@@ -1,7 +1,7 @@
-// Throughput of the elastic bar's FEM kernels (PAPER.md §6): gradient (Σ vol P D_m⁻ᵀ) and sparse
-// Hessian assembly (Σ vol Bᵀ (dP/dF) B) at ~10³, 10⁴, 10⁵ linear tetrahedra, in elements/s, with
-// the precomputed mesh data and the Hessian's non-zeros as memory counters; and one step of the
-// HP midpoint minimiser (Kharevych et al. 2006) at 10⁴ and 10⁵ tetrahedra far beyond the
+// Throughput of the elastic bar's FEM kernels (docs/METHOD.md §6): gradient (Σ vol P D_m⁻ᵀ) and
+// sparse Hessian assembly (Σ vol Bᵀ (dP/dF) B) at ~10³, 10⁴, 10⁵ linear tetrahedra, in elements/s,
+// with the precomputed mesh data and the Hessian's non-zeros as memory counters; and one step of
+// the HP midpoint minimiser (Kharevych et al. 2006) at 10⁴ and 10⁵ tetrahedra far beyond the
 // explicit limit h = 2/ω_max, with Newton iterations per step as a counter.
 #include <benchmark/benchmark.h>
 

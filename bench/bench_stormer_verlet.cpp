@@ -1,6 +1,6 @@
-// Cost of the Integrator interface (DESIGN.md §2): a Störmer–Verlet step (GNI §I.1.4) on Kepler
-// and on a 128-dof spring net through Problem/Integrator, against hand-written loops doing the
-// same kick–drift–kick arithmetic with one gradient per step (first same as last).
+// Cost of the Integrator interface (docs/DESIGN.md §2): a Störmer–Verlet step (GNI §I.1.4) on
+// Kepler and on a 128-dof spring net through Problem/Integrator, against hand-written loops doing
+// the same kick–drift–kick arithmetic with one gradient per step (first same as last).
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>

@@ -1,7 +1,7 @@
-// libFuzzer target: spec strings (problems/spec.*, DESIGN.md §2) through the problem and method
-// registries, make_problem and make_integrator. Contract: arbitrary text either yields an object
-// or throws InputError; any other exception, crash, UB report, leak or hang is a finding. For
-// accepted specs the canonical spec must be a fixed point (re-parsing it gives the same text),
+// libFuzzer target: spec strings (problems/spec.*, docs/DESIGN.md §2) through the problem and
+// method registries, make_problem and make_integrator. Contract: arbitrary text either yields an
+// object or throws InputError; any other exception, crash, UB report, leak or hang is a finding.
+// For accepted specs the canonical spec must be a fixed point (re-parsing it gives the same text),
 // and the problem's initial state must have dof() entries; nothing is integrated. Problems
 // larger than the fuzz budget are not built (fuzz_util.hpp, requests_large_problem).
 #include <cstdint>

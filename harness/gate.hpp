@@ -1,6 +1,6 @@
-// Accuracy gates (DESIGN.md §4, `geomint gate GATES.toml RESULTS...`): thresholds on the columns
-// of result tables, selected by scene and table, so a CI pipeline fails when a published number
-// leaves its band — on the full scenes and on their CI-sized `--quick` variant alike.
+// Accuracy gates (docs/DESIGN.md §4, `geomint gate GATES.toml RESULTS...`): thresholds on the
+// columns of result tables, selected by scene and table, so a CI pipeline fails when a published
+// number leaves its band — on the full scenes and on their CI-sized `--quick` variant alike.
 #pragma once
 
 #include <optional>

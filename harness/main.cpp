@@ -1,4 +1,4 @@
-// geomint command line (DESIGN.md §4): list, run, order, sweep, reference, gate. Exit codes:
+// geomint command line (docs/DESIGN.md §4): list, run, order, sweep, reference, gate. Exit codes:
 // 0 ok, 1 a run or gate failed, 2 bad input (the message names the offending option, key or
 // value; checked before any computing, outputs included), 3 an internal error (a defect, or an
 // I/O failure after the up-front checks, e.g. a full disk).

@@ -1,4 +1,4 @@
-// Metric observers (DESIGN.md §3): energy error and drift, momentum maps, error against the
+// Metric observers (docs/DESIGN.md §3): energy error and drift, momentum maps, error against the
 // exact solution.
 #include "harness/observers.hpp"
 

@@ -1,4 +1,4 @@
-// Step-point observers that turn a trajectory into the metrics of DESIGN.md §3. Each observer
+// Step-point observers that turn a trajectory into the metrics of docs/DESIGN.md §3. Each observer
 // applies only when the problem has what it needs (an invariant, an exact solution), so
 // inapplicable metrics never appear in the output.
 #pragma once

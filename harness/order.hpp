@@ -1,4 +1,4 @@
-// Convergence order (DESIGN.md §3): least-squares slope of log(error) against log(dt) over a
+// Convergence order (docs/DESIGN.md §3): least-squares slope of log(error) against log(dt) over a
 // dt ladder dt0·2⁻ᵏ, after dropping failed points, the round-off plateau and pre-asymptotic
 // points; at least 3 points, reported with the points used.
 #pragma once

@@ -1,5 +1,5 @@
 // One run = (problem spec, method spec, dt, t_end): the step loop with observers at step points,
-// the metrics of DESIGN.md §3 that apply to the problem, failure rows, optional time series,
+// the metrics of docs/DESIGN.md §3 that apply to the problem, failure rows, optional time series,
 // and a separate timing pass without observers (median of repeats) for wall_s.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Scenes (DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs (problems ×
+// Scenes (docs/DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs (problems ×
 // methods × dt), of order studies and of stability searches; `sweep` runs them (accuracy runs in
 // parallel, timing runs one at a time) and writes summary.csv, order.csv, stability.csv, series/
 // and table.md into the folder.

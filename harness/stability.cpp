@@ -1,4 +1,4 @@
-// Linear-stability search and the predicted limits (see stability.hpp; PAPER.md §7).
+// Linear-stability search and the predicted limits (see stability.hpp; docs/METHOD.md §7).
 #include "harness/stability.hpp"
 
 #include <fmt/format.h>
@@ -20,7 +20,7 @@ double value_of(const Spec& spec, const std::string& key) {
   return it == spec.values.end() ? kNaN : std::stod(it->second);
 }
 
-// The α-rule is Newmark with γ = ½, β = α(1 − α) on linear forces (PAPER.md §1), and
+// The α-rule is Newmark with γ = ½, β = α(1 − α) on linear forces (docs/METHOD.md §1), and
 // ¼ − α(1 − α) = (½ − α)², so the Newmark bound below gives hω < 1/|½ − α|.
 double alpha_rule_limit(double alpha) { return alpha == 0.5 ? kInf : 1.0 / std::abs(0.5 - alpha); }
 

@@ -1,6 +1,6 @@
-// Linear-stability search (PAPER.md §7): the largest step h·ω for which a fixed-step method keeps
-// the energy of an oscillator bounded, found by a geometric scan and bisection on h, next to the
-// limit the linear theory predicts for the method (Hairer–Lubich–Wanner GNI §I.5 and §XIII;
+// Linear-stability search (docs/METHOD.md §7): the largest step h·ω for which a fixed-step method
+// keeps the energy of an oscillator bounded, found by a geometric scan and bisection on h, next to
+// the limit the linear theory predicts for the method (Hairer–Lubich–Wanner GNI §I.5 and §XIII;
 // Hughes, The Finite Element Method, 2000, §9.1 for Newmark).
 #pragma once
 

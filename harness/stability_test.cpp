@@ -1,5 +1,5 @@
 // Tests of the linear-stability search (harness/stability.hpp) against the known limits of
-// PAPER.md §7 on the harmonic oscillator.
+// docs/METHOD.md §7 on the harmonic oscillator.
 #include "harness/stability.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Result rows and their writers: CSV with `# key: value` provenance lines (DESIGN.md §5),
+// Result rows and their writers: CSV with `# key: value` provenance lines (docs/DESIGN.md §5),
 // written to a temporary file and renamed so a crash never leaves a half-written table, and
 // Markdown tables for results/<scene>/table.md.
 #pragma once

@@ -1,6 +1,7 @@
-// Variational integrators generated from a quadrature discrete Lagrangian (PAPER.md §1–2; Marsden &
-// West 2001, §1.6, §2.3 and §3.2 (forced DEL); Kharevych et al. 2006, §3): the forced discrete
-// Euler–Lagrange map p_k = −D₁L_d − F_d⁻, p_{k+1} = D₂L_d + F_d⁺, derived once for every rule.
+// Variational integrators generated from a quadrature discrete Lagrangian (docs/METHOD.md §1–2;
+// Marsden & West 2001, §1.6, §2.3 and §3.2 (forced DEL); Kharevych et al. 2006, §3): the forced
+// discrete Euler–Lagrange map p_k = −D₁L_d − F_d⁻, p_{k+1} = D₂L_d + F_d⁺, derived once for every
+// rule.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -48,9 +49,9 @@ struct Node {
 enum class ForceSlot { kMinus, kPlus, kSplit };
 enum class ForceAt { kNode, kMidpoint };
 
-// Discrete Lagrange–d'Alembert impulses of one step (PAPER.md §2): the step's impulse h·F is put
-// into F_d⁻ (minus), F_d⁺ (plus) or half into each (split); each part is evaluated with the step
-// velocity v at its own node (q_k for F_d⁻, q_{k+1} for F_d⁺) or, force_at=midpoint, at
+// Discrete Lagrange–d'Alembert impulses of one step (docs/METHOD.md §2): the step's impulse h·F is
+// put into F_d⁻ (minus), F_d⁺ (plus) or half into each (split); each part is evaluated with the
+// step velocity v at its own node (q_k for F_d⁻, q_{k+1} for F_d⁺) or, force_at=midpoint, at
 // q_{k+½} = q_k + (h/2)v. Forced discrete Noether: the change of a momentum map J over a step is
 // the sum of the impulses' torques about the points where they act, so for a frame-invariant
 // force (zero net force and torque about its own evaluation point, e.g. spring_net's damping)
@@ -59,10 +60,10 @@ enum class ForceAt { kNode, kMidpoint };
 // q_{k+1} = q_{k+½} + (h/2)v (plus): each step changes the angular momentum by ∓(h²/2) Σ_i v_i ×
 // F_i = O(h²), i.e. O(h) over a time interval. split applies equal halves at both ends, whose
 // torques cancel exactly, so it keeps angular momentum at the midpoint too. Linear momentum is kept
-// in every case (Σ_i F_i = 0). PAPER.md §2 reports drift for the minus slot only; measured here
-// (results/dissipation, integrators/variational_test.cpp) minus and plus drift alike, with
+// in every case (Σ_i F_i = 0). docs/METHOD.md §2 reports drift for the minus slot only; measured
+// here (results/dissipation, integrators/variational_test.cpp) minus and plus drift alike, with
 // opposite signs, at the midpoint and neither drifts at the node. Default: split at the midpoint,
-// PAPER.md's "typical" F_d⁻ = F_d⁺ = (h/2)F(q_{k+½}, v) — second order, momenta kept, and on
+// docs/METHOD.md's "typical" F_d⁻ = F_d⁺ = (h/2)F(q_{k+½}, v) — second order, momenta kept, and on
 // forced problems the same map as implicit_midpoint.
 struct Forcing {
   ForceSlot slot = ForceSlot::kSplit;
@@ -75,7 +76,8 @@ struct Forcing {
   }
 };
 
-// The force_slot and force_at options (PAPER.md §2); hamilton_pontryagin.cpp reads the same keys.
+// The force_slot and force_at options (docs/METHOD.md §2); hamilton_pontryagin.cpp reads the same
+// keys.
 Forcing read_forcing(Params& params) {
   Forcing forcing;
   const std::string slot =
@@ -121,7 +123,7 @@ class DiscreteLagrangianVI final : public Integrator {
     if (symmetric_) flags |= kSymmetric;
     return {"del", order_, flags,
             fmt::format("discrete Euler-Lagrange, quadrature L_d ({}), Marsden-West 2001 §2.3, "
-                        "§3.2; Kharevych et al. 2006 §3; PAPER.md §1-2",
+                        "§3.2; Kharevych et al. 2006 §3; docs/METHOD.md §1-2",
                         rule_)};
   }
 

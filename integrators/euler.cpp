@@ -1,6 +1,6 @@
 // Explicit (forward) and implicit (backward) Euler on M q̈ = −∇V(q) + F(q, q̇, t): the
-// first-order, non-symplectic references of PAPER.md §7 (Hairer, Nørsett & Wanner, "Solving ODEs
-// I", §I.7; Hairer & Wanner, "Solving ODEs II", §IV.3).
+// first-order, non-symplectic references of docs/METHOD.md §7 (Hairer, Nørsett & Wanner, "Solving
+// ODEs I", §I.7; Hairer & Wanner, "Solving ODEs II", §IV.3).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -18,7 +18,7 @@ class ExplicitEuler final : public Integrator {
  public:
   MethodInfo info() const override {
     return {"explicit_euler", 1, kExplicit,
-            "forward Euler, Hairer-Norsett-Wanner Solving ODEs I §I.7; PAPER.md §7"};
+            "forward Euler, Hairer-Norsett-Wanner Solving ODEs I §I.7; docs/METHOD.md §7"};
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
@@ -54,7 +54,7 @@ class ImplicitEuler final : public Integrator {
 
   MethodInfo info() const override {
     return {"implicit_euler", 1, kImplicit | kNeedsHessian,
-            "backward Euler, Hairer-Wanner Solving ODEs II §IV.3; PAPER.md §7"};
+            "backward Euler, Hairer-Wanner Solving ODEs II §IV.3; docs/METHOD.md §7"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

@@ -1,6 +1,7 @@
 // Discrete Hamilton–Pontryagin integrator in (q, v, p) and its update as the minimisation of
-// E_k(v) = ½vᵀMv − p_kᵀv + ((1−α)/α)V(q_k + αhv) (PAPER.md §4; Kharevych et al. 2006, §4), with the
-// discrete Lagrange–d'Alembert force impulses of PAPER.md §2 (Marsden & West 2001, §3.2).
+// E_k(v) = ½vᵀMv − p_kᵀv + ((1−α)/α)V(q_k + αhv) (docs/METHOD.md §4; Kharevych et al. 2006, §4),
+// with the discrete Lagrange–d'Alembert force impulses of docs/METHOD.md §2 (Marsden & West 2001,
+// §3.2).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -84,7 +85,7 @@ class HamiltonPontryagin final : public Integrator {
     if (alpha_ == 0.5) flags |= kSymmetric;
     return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
             "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
-            "§4; PAPER.md §4"};
+            "§4; docs/METHOD.md §4"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

@@ -1,6 +1,6 @@
 // Implicit midpoint rule y₁ = y₀ + h f((y₀ + y₁)/2) on y = (q, p) with forces (Hairer, Lubich &
-// Wanner, GNI §II.1 and §VI.3; PAPER.md §1: for constant M it is the variational midpoint rule
-// L_d = h L((q_k + q_{k+1})/2, v) and HP with α = ½; Marsden & West 2001, §2.6).
+// Wanner, GNI §II.1 and §VI.3; docs/METHOD.md §1: for constant M it is the variational midpoint
+// rule L_d = h L((q_k + q_{k+1})/2, v) and HP with α = ½; Marsden & West 2001, §2.6).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -33,7 +33,7 @@ class ImplicitMidpoint final : public Integrator {
   MethodInfo info() const override {
     return {"implicit_midpoint", 2,
             kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
-            "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; PAPER.md §1"};
+            "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

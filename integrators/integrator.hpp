@@ -1,4 +1,4 @@
-// The Integrator interface (DESIGN.md §2): a one-step map on State = (t, q, p) with declared
+// The Integrator interface (docs/DESIGN.md §2): a one-step map on State = (t, q, p) with declared
 // order and properties (flags) that the test suite checks, work counters, and failure statuses.
 // Adaptive library solvers implement advance_to() instead of fixed steps.
 #pragma once

@@ -1,6 +1,6 @@
 // Unit tests for the Newton solver and the basic one-step methods (Euler family, symplectic Euler,
-// Störmer–Verlet, RK4): hand-computed steps and the exact discrete invariants of PAPER.md §7 on
-// local test problems, work counters, failure statuses and factory validation.
+// Störmer–Verlet, RK4): hand-computed steps and the exact discrete invariants of docs/METHOD.md §7
+// on local test problems, work counters, failure statuses and factory validation.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -434,7 +434,7 @@ TEST(OneStep, MatchesHandFormulaUndampedDampedAndFiniteDifferenceJacobian) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Exact discrete energy laws on H = ½p² + ½ω²q² (PAPER.md §7, Ω = hω).
+// Exact discrete energy laws on H = ½p² + ½ω²q² (docs/METHOD.md §7, Ω = hω).
 
 TEST(EnergyLaw, ExplicitEulerMultipliesByOnePlusOmegaSquared) {
   const double omega = 2.0, h = 0.05;

@@ -1,4 +1,4 @@
-// Newmark family (Kane, Marsden, Ortiz & West, IJNME 2000; PAPER.md §1 and §7):
+// Newmark family (Kane, Marsden, Ortiz & West, IJNME 2000; docs/METHOD.md §1 and §7):
 //   q₁ = q₀ + h v₀ + h²[(½−β)a₀ + βa₁],   v₁ = v₀ + h[(1−γ)a₀ + γa₁],   M a = −∇V(q) + F(q, v, t).
 // β = 0, γ = ½ is Störmer–Verlet; β > 0 is symplectic only for a non-canonical form (not declared).
 #include <fmt/format.h>
@@ -46,7 +46,7 @@ class Newmark final : public Integrator {
       if (second_order) flags |= kSymmetric;
     }
     return {"newmark", second_order ? 2 : 1, flags,
-            "Newmark, Kane-Marsden-Ortiz-West IJNME 2000; PAPER.md §1, §7"};
+            "Newmark, Kane-Marsden-Ortiz-West IJNME 2000; docs/METHOD.md §1, §7"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

@@ -1,6 +1,6 @@
 // Sparse Newton solver shared by the implicit methods (implicit Euler, Newmark, discrete-Lagrangian
-// VIs, the Hamilton–Pontryagin minimiser of PAPER.md §4, Gauss collocation): damped Newton with
-// Armijo backtracking (Nocedal & Wright, "Numerical Optimization", 2nd ed., §3.1 and §11.1).
+// VIs, the Hamilton–Pontryagin minimiser of docs/METHOD.md §4, Gauss collocation): damped Newton
+// with Armijo backtracking (Nocedal & Wright, "Numerical Optimization", 2nd ed., §3.1 and §11.1).
 #pragma once
 
 #include <functional>
@@ -40,7 +40,8 @@ struct NewtonOptions {
   // Jacobian, one back-substitution and one residual evaluation), kept only if it lowers ‖R‖.
   // Quadratic convergence makes it take ‖R‖ from just below the tolerance to its round-off floor,
   // which invariants that are exact only for the exact solve (angular momentum of a variational
-  // integrator, PAPER.md §4) need over 10⁵ steps; the tolerance alone allows a 1e-12 error a step.
+  // integrator, docs/METHOD.md §4) need over 10⁵ steps; the tolerance alone allows a 1e-12 error a
+  // step.
   bool polish = false;
   // Schedule of the SPD safeguard (NewtonSystem::spd_shift): μ = spd_shift_initial (or the last
   // successful μ of the solve / spd_shift_growth, if larger), ·spd_shift_growth, … at most
@@ -60,7 +61,7 @@ struct NewtonSystem {
   // Declares J symmetric: factorised with SimplicialLDLT (reads the lower triangle only),
   // otherwise with SparseLU.
   bool symmetric = false;
-  // Optional scalar E(x) with ∇E = R (minimisation form, PAPER.md §4). When present the line
+  // Optional scalar E(x) with ∇E = R (minimisation form, docs/METHOD.md §4). When present the line
   // search enforces Armijo decrease of E instead of ½‖R‖², so the iteration is a globalised
   // minimisation; a Newton direction that is not a descent direction of E (J not positive
   // definite) fails with reason "not_descent" unless the SPD safeguard below is enabled.

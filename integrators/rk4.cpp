@@ -1,6 +1,6 @@
 // Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
 // F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
-// Not symplectic: the negative control of PAPER.md §7.
+// Not symplectic: the negative control of docs/METHOD.md §7.
 #include "integrators/integrator.hpp"
 
 namespace geomint {

@@ -1,5 +1,5 @@
 // Störmer–Verlet, kick–drift–kick (velocity Verlet): the VI of L_d = (h/2)[L(q_k, v) +
-// L(q_{k+1}, v)] (PAPER.md §1; Hairer, Lubich & Wanner, GNI §I.1.4 and §VI.3, eq. (3.4)).
+// L(q_{k+1}, v)] (docs/METHOD.md §1; Hairer, Lubich & Wanner, GNI §I.1.4 and §VI.3, eq. (3.4)).
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -21,7 +21,7 @@ class StormerVerlet final : public Integrator {
  public:
   MethodInfo info() const override {
     return {"stormer_verlet", 2, kExplicit | kSymplectic | kSymmetric | kVariational,
-            "Stormer-Verlet (velocity Verlet), GNI §I.1.4, §VI.3; PAPER.md §1"};
+            "Stormer-Verlet (velocity Verlet), GNI §I.1.4, §VI.3; docs/METHOD.md §1"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

@@ -1,6 +1,6 @@
 // Symplectic Euler, kick first (L_d = h L(q_k, v)) and drift first (L_d = h L(q_{k+1}, v)):
-// PAPER.md §1 table; Hairer, Lubich & Wanner, GNI §VI.3, Theorem 3.3 and its adjoint. Forces enter
-// as discrete Lagrange–d'Alembert impulses h·F (PAPER.md §2).
+// docs/METHOD.md §1 table; Hairer, Lubich & Wanner, GNI §VI.3, Theorem 3.3 and its adjoint. Forces
+// enter as discrete Lagrange–d'Alembert impulses h·F (docs/METHOD.md §2).
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -13,7 +13,7 @@ class SymplecticEulerA final : public Integrator {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_a", 1, kExplicit | kSymplectic | kVariational,
-            "symplectic Euler (kick first), GNI §VI.3 Thm 3.3; PAPER.md §1"};
+            "symplectic Euler (kick first), GNI §VI.3 Thm 3.3; docs/METHOD.md §1"};
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
@@ -37,7 +37,7 @@ class SymplecticEulerB final : public Integrator {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_b", 1, kExplicit | kSymplectic | kVariational,
-            "symplectic Euler (drift first), adjoint of GNI §VI.3 Thm 3.3; PAPER.md §1"};
+            "symplectic Euler (drift first), adjoint of GNI §VI.3 Thm 3.3; docs/METHOD.md §1"};
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {

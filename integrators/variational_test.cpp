@@ -1,7 +1,7 @@
-// Tests of the variational integrators (del, hp), Newmark and the implicit midpoint rule (PAPER.md
-// §1, §2, §4; Marsden & West 2001; Kane et al. 2000; Kharevych et al. 2006): equivalences between
-// the forms, symplecticity of one step, discrete Noether with and without forcing, the energy
-// decay under damping, the two HP solvers, failures and parameter validation.
+// Tests of the variational integrators (del, hp), Newmark and the implicit midpoint rule
+// (docs/METHOD.md §1, §2, §4; Marsden & West 2001; Kane et al. 2000; Kharevych et al. 2006):
+// equivalences between the forms, symplecticity of one step, discrete Noether with and without
+// forcing, the energy decay under damping, the two HP solvers, failures and parameter validation.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -56,7 +56,7 @@ double max_distance(const std::vector<State>& a, const std::vector<State>& b) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The generic forms reproduce the known schemes (PAPER.md §1 table, §4).
+// The generic forms reproduce the known schemes (docs/METHOD.md §1 table, §4).
 
 TEST(Equivalence, DelAndHpReproduceTheKnownSchemesOnKepler) {
   const auto problem = make_problem("kepler:e=0.6");
@@ -106,7 +106,7 @@ TEST(Equivalence, DelAlphaRuleIsHpWithTheSameAlpha) {
 }
 
 // For a linear force the α-rule and Newmark (γ = ½, β = α(1 − α)) share the two-step recurrence
-// M(q_{k+1} − 2q_k + q_{k−1})/h² = −K[βq_{k−1} + (1 − 2β)q_k + βq_{k+1}] (PAPER.md §1).
+// M(q_{k+1} − 2q_k + q_{k−1})/h² = −K[βq_{k−1} + (1 − 2β)q_k + βq_{k+1}] (docs/METHOD.md §1).
 TEST(Equivalence, NewmarkAndAlphaRuleShareTheRecurrenceForLinearForces) {
   const double omega = 1.7, h = 0.3;
   const auto problem = make_problem("harmonic:omega=1.7,q0=0.8,v0=0.4");
@@ -215,7 +215,7 @@ TEST(NegativeControl, SymplecticityDefectIsLargeForNonSymplecticMethods) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Discrete Noether on a free spring network (PAPER.md claim 1).
+// Discrete Noether on a free spring network (docs/METHOD.md claim 1).
 
 struct MomentumErrors {
   bool ok = false;
@@ -271,7 +271,7 @@ INSTANTIATE_TEST_SUITE_P(Registry, VariationalMethod, testing::ValuesIn(variatio
                          test_name);
 
 TEST(NegativeControl, NewmarkDoesNotKeepSpringNetAngularMomentum) {
-  // Newmark β > 0 is not the α-rule VI for nonlinear forces (PAPER.md §1): linear momentum is
+  // Newmark β > 0 is not the α-rule VI for nonlinear forces (docs/METHOD.md §1): linear momentum is
   // kept (pairwise forces), angular momentum is not.
   const MomentumErrors errors =
       momentum_errors("newmark:beta=0.25,gamma=0.5", "spring_net:nx=4,ny=4", 0.01, 10000);
@@ -281,7 +281,7 @@ TEST(NegativeControl, NewmarkDoesNotKeepSpringNetAngularMomentum) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Forced discrete Noether on the damped spring network (PAPER.md §2). Predicted: each impulse
+// Forced discrete Noether on the damped spring network (docs/METHOD.md §2). Predicted: each impulse
 // evaluated at its own node is torque-free about the point where it acts, so every slot keeps
 // both momenta; evaluated at q_{k+½} the minus (plus) impulse has torque −(h/2)Σv×F (+(h/2)Σv×F)
 // about q_k (q_{k+1}): O(h²) a step, O(h) over [0, T], opposite signs; split cancels.
@@ -367,7 +367,7 @@ TEST(ForceSlots, MidpointDriftFollowsTheSignedImpulseTorqueOfItsSlot) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Energy decay of the damped oscillator q̈ + 2ζωq̇ + ω²q = 0 (PAPER.md §2, Fig. 1).
+// Energy decay of the damped oscillator q̈ + 2ζωq̇ + ω²q = 0 (docs/METHOD.md §2, Fig. 1).
 
 // Largest |H(q_k, p_k) − H(exact(t_k))| over t ∈ [0, 20], and its signed value at t = 20.
 std::pair<double, double> energy_decay_error(const std::string& method, double h) {
@@ -416,7 +416,7 @@ TEST(DampedOscillator, EulerMethodsAddAndRemoveNumericalDamping) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The two HP solvers (PAPER.md §4).
+// The two HP solvers (docs/METHOD.md §4).
 
 TEST(HpSolvers, ReturnTheSameStepWhereBothConverge) {
   struct Case {

@@ -1,4 +1,4 @@
-// Damped oscillator q̈ + 2ζω q̇ + ω² q = 0, unit mass (PAPER.md §2): exact underdamped solution
+// Damped oscillator q̈ + 2ζω q̇ + ω² q = 0, unit mass (docs/METHOD.md §2): exact underdamped solution
 // q = e^{−ζωt}(A cos ω_d t + B sin ω_d t), ω_d = ω√(1 − ζ²); the energy H = ½p² + ½ω²q² decays
 // at exactly dH/dt = −2ζω v², the rate a forced variational integrator should reproduce.
 #include <cmath>

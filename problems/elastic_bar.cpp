@@ -1,6 +1,7 @@
-// Nonlinear elastic bar (PAPER.md §6, Kharevych et al. 2006 §5): linear tetrahedra, lumped masses,
-// F = D_s D_m⁻¹, St Venant–Kirchhoff or neo-Hookean W with P(F) and dP/dF from Sifakis & Barbič,
-// "FEM simulation of 3D deformable solids" (2012); strain-rate damping after Kharevych §5.2.
+// Nonlinear elastic bar (docs/METHOD.md §6, Kharevych et al. 2006 §5): linear tetrahedra, lumped
+// masses, F = D_s D_m⁻¹, St Venant–Kirchhoff or neo-Hookean W with P(F) and dP/dF from Sifakis &
+// Barbič, "FEM simulation of 3D deformable solids" (2012); strain-rate damping after Kharevych
+// §5.2.
 #include <fmt/format.h>
 
 #include <Eigen/Core>
@@ -255,8 +256,8 @@ class ElasticBar final : public Problem {
   // deformation F_{k+1}F_k⁻¹ = I + h ḞF⁻¹ + O(h²) has Green strain h d + O(h²), d = F⁻ᵀĖF⁻¹, and
   // the quadratic part of W_el (the same μ, λ for both materials) turns (ν/h) W_el into
   // ν h vol (μ tr(d²) + (λ/2)(tr d)²), whose force −∂/∂q_{k+1} = −(1/h) ∂/∂v is this one with d
-  // in place of Ė: equal at small strain, and both are C = νK at rest (PAPER.md §6). Ė is used
-  // because it keeps D an exact quadratic form in v (a constant, PSD C) at any F.
+  // in place of Ė: equal at small strain, and both are C = νK at rest (docs/METHOD.md §6). Ė is
+  // used because it keeps D an exact quadratic form in v (a constant, PSD C) at any F.
   void force(const Vec& q, const Vec& v, double, Vec& f) const override {
     f.setZero(dof());
     const double nu = config_.damping;

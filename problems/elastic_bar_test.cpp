@@ -1,6 +1,7 @@
-// Checks of the elastic bar (PAPER.md §6) beyond the registry suite: P and dP/dF of both materials
-// against finite differences (deformed, compressed, inverted), frame invariance, the strain-rate
-// damping, the SPD projection, lumped masses, linear-regime frequencies against beam theory.
+// Checks of the elastic bar (docs/METHOD.md §6) beyond the registry suite: P and dP/dF of both
+// materials against finite differences (deformed, compressed, inverted), frame invariance, the
+// strain-rate damping, the SPD projection, lumped masses, linear-regime frequencies against beam
+// theory.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -273,8 +274,8 @@ TEST(ElasticBar, DampingIsFrameInvariantDissipativeAndLinear) {
   EXPECT_LE(inf_norm(f_rigid), 1e-12 * inf_norm(f_generic) / inf_norm(generic) * inf_norm(rigid));
 }
 
-// In the linear limit the strain-rate damping is stiffness-proportional, C = ν K (PAPER.md §6):
-// at rest both materials' Hessians are the linear-elastic stiffness, and so is C/ν.
+// In the linear limit the strain-rate damping is stiffness-proportional, C = ν K (docs/METHOD.md
+// §6): at rest both materials' Hessians are the linear-elastic stiffness, and so is C/ν.
 TEST(ElasticBar, DampingAtRestIsStiffnessProportional) {
   for (const std::string material : {"neohookean", "stvk"}) {
     const auto problem = make_problem("elastic_bar:nx=3,damping=0.01,material=" + material);

@@ -1,4 +1,4 @@
-// The Problem interface (DESIGN.md §2): a Lagrangian system L(q, v) = ½ vᵀMv − V(q) with a
+// The Problem interface (docs/DESIGN.md §2): a Lagrangian system L(q, v) = ½ vᵀMv − V(q) with a
 // constant diagonal (lumped) mass matrix, optional non-conservative force, exact solution and
 // momentum maps. Problems declare capabilities; the harness runs only what applies.
 #pragma once

@@ -1,4 +1,4 @@
-// Registry-driven checks of every problem (DESIGN.md §7): derivatives against finite
+// Registry-driven checks of every problem (docs/DESIGN.md §7): derivatives against finite
 // differences, the exact solution against the equations of motion and an independent RK4 run,
 // invariants along the exact solution, and validation of spec strings.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Spec strings "NAME" or "NAME:key=value,key=value" (DESIGN.md §2) and the typed, validated
+// Spec strings "NAME" or "NAME:key=value,key=value" (docs/DESIGN.md §2) and the typed, validated
 // parameter reader that every factory uses; the canonical spec (defaults filled in, keys
 // sorted) is what CSV files record. Bad input throws InputError (the CLI turns it into exit 2).
 #pragma once

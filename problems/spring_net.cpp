@@ -1,6 +1,6 @@
 // Free-floating 2D/3D spring lattice: springs φ(r) = ½k(r − L)² + ¼k₄(r − L)⁴, r = |q_j − q_i|,
 // optional damping along the springs. All forces depend on q_j − q_i only, so linear and angular
-// momentum are conserved (the discrete Noether check, PAPER.md claim 1 and §6).
+// momentum are conserved (the discrete Noether check, docs/METHOD.md claim 1 and §6).
 #include <fmt/format.h>
 
 #include <Eigen/Core>

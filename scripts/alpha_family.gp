@@ -1,4 +1,4 @@
-# The alpha family (PAPER.md §1, §4, §7): largest stable h*omega against 1/|1/2 - alpha|, and the
+# The alpha family (docs/METHOD.md §1, §4, §7): largest stable h*omega against 1/|1/2 - alpha|, and the
 # convergence of each alpha on the pendulum. Run inside results/alpha_family; reads stability.csv
 # and order_points.csv.
 load scripts."/common.gp"

@@ -1,4 +1,4 @@
-# Dissipation (PAPER.md §2): damped oscillator energy against the exact decay, the energy error
+# Dissipation (docs/METHOD.md §2): damped oscillator energy against the exact decay, the energy error
 # against h, and the angular-momentum drift of each force placement on the damped spring network.
 # Run inside results/dissipation; reads series/decay, series/slots and summary.csv.
 load scripts."/common.gp"

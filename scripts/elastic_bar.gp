@@ -1,4 +1,4 @@
-# Elastic bar scene (PAPER.md §6): energy of the clamped swing, damped energy at three steps,
+# Elastic bar scene (docs/METHOD.md §6): energy of the clamped swing, damped energy at three steps,
 # the free bar's momenta, and the deformed bar at a few times. Run inside results/elastic_bar;
 # reads series/{swing,swing_verlet,damped,spin,shapes}/*.csv.
 load scripts."/common.gp"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages geomint builds with (DESIGN.md §8). Idempotent: installs only
+# Installs the Debian 12 packages geomint builds with (docs/DESIGN.md §8). Idempotent: installs only
 # what is missing, waits for the dpkg lock, never pulls recommends. As non-root it prints the
 # exact command to run and exits 1.
 set -euo pipefail
@@ -9,6 +9,7 @@ PACKAGES=(
   libeigen3-dev libsundials-dev libgsl-dev libboost-dev
   gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev python3
 )
 
 missing=()

@@ -1,4 +1,4 @@
-# Minimisation vs root finding for the HP midpoint step (PAPER.md §4, claim 5): Newton iterations
+# Minimisation vs root finding for the HP midpoint step (docs/METHOD.md §4, claim 5): Newton iterations
 # and wall time per step against h*omega_max on the stiff spring network. Run inside
 # results/minimize_vs_newton; reads summary.csv.
 load scripts."/common.gp"

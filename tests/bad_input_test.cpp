@@ -1,6 +1,6 @@
-// The bad-input suite (issue 14; DESIGN.md §4, README "Exit codes"): a registry of command lines
-// and scene files, each with the exit code it must give, a word its message must contain and the
-// files it may leave behind (none, for bad input). Every case runs the built `geomint` under
+// The bad-input suite (issue 14; docs/DESIGN.md §4, README "Exit codes"): a registry of command
+// lines and scene files, each with the exit code it must give, a word its message must contain and
+// the files it may leave behind (none, for bad input). Every case runs the built `geomint` under
 // `timeout` (the hang guard): a case that runs past its limit fails as a hang, not by stalling
 // the suite. Each case runs in its own scratch folder; after it, the folder must hold exactly the
 // files the case wrote there beforehand plus the ones it expects, and the folder's parent

@@ -1,4 +1,4 @@
-// Command-line contract (DESIGN.md §4): good input works, a failed run is a row with exit 1,
+// Command-line contract (docs/DESIGN.md §4): good input works, a failed run is a row with exit 1,
 // series are streamed, the README's tables match `geomint list`. Bad input (exit 2, a message
 // naming what was wrong, no output file) is the registry of tests/bad_input_test.cpp.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The committed tables are regression data (DESIGN.md §5): every cheap row of every
+// The committed tables are regression data (docs/DESIGN.md §5): every cheap row of every
 // results/<scene>/summary.csv is re-run from its (problem, method, dt, t_end) and must reproduce
 // the committed status, counters and metrics, so a change that alters a published number fails
 // until the scene is regenerated with `make reproduce-figures`.

@@ -105,8 +105,8 @@ TEST(Table, ParseCsvRoundTripsToCsv) {
   EXPECT_THROW(parse_csv("a,b\n1,2,3\n"), std::runtime_error);
 }
 
-// DESIGN.md §5: numbers are written with enough digits to round-trip. Every metric of a run row,
-// read back as text, must give the very double the observers computed (a fixed 6- or 15-digit
+// docs/DESIGN.md §5: numbers are written with enough digits to round-trip. Every metric of a run
+// row, read back as text, must give the very double the observers computed (a fixed 6- or 15-digit
 // format would lose bits of energy_err_max, error_final, ... and of every gate built on them).
 TEST(Table, RunRowMetricsRoundTripExactly) {
   RunConfig config;

@@ -1,4 +1,4 @@
-// Registry-driven method checks (DESIGN.md §7): every registered method's declared order and
+// Registry-driven method checks (docs/DESIGN.md §7): every registered method's declared order and
 // every declared flag is verified, not only declared, so a new method is checked the day it is
 // added. Negative controls make sure the checks can fail.
 #include <gtest/gtest.h>
@@ -51,7 +51,7 @@ void expect_declared_order(const std::string& method, const Ladder& ladder) {
   const OrderStudy study = order_study(ladder.problem, method, dt0, levels, ladder.t_end);
   ASSERT_TRUE(std::isfinite(study.fit.order))
       << method << " on " << ladder.problem << ": " << study.fit.note;
-  // ±0.3: the tolerance of DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
+  // ±0.3: the tolerance of docs/DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
   EXPECT_NEAR(study.fit.order, declared, 0.3)
       << method << " on " << ladder.problem << " (points " << study.row.at("points_used") << ")";
 }

@@ -1,6 +1,6 @@
-// Harness-level checks of the variational integrators (PAPER.md §1, §4; Kharevych et al. 2006):
-// the convergence orders and the momentum metrics exactly as `geomint order` and `geomint run`
-// report them, with the tighter ±0.15 order tolerance of the method's acceptance criteria.
+// Harness-level checks of the variational integrators (docs/METHOD.md §1, §4; Kharevych et al.
+// 2006): the convergence orders and the momentum metrics exactly as `geomint order` and `geomint
+// run` report them, with the tighter ±0.15 order tolerance of the method's acceptance criteria.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -45,7 +45,7 @@ TEST(VariationalMomenta, HpKeepsSpringNetMomentaNewmarkLosesAngularMomentum) {
        {"hp:alpha=0.5,solver=minimize", "hp:alpha=0.5,solver=newton", "del", "implicit_midpoint"}) {
     const RunResult result = run_spring_net(method);
     ASSERT_TRUE(result.ok) << method << ": " << result.row.at("message");
-    // Absolute metrics (DESIGN.md §3); |L₀| ≈ 19 and |J₀| ≈ 320 here, so 1e-10 is a relative
+    // Absolute metrics (docs/DESIGN.md §3); |L₀| ≈ 19 and |J₀| ≈ 320 here, so 1e-10 is a relative
     // 5e-12 or less: polished Newton solves leave round-off only (measured ≈ 4e-13).
     EXPECT_LT(result.metrics.at("momentum_err_max"), 1e-10) << method;
     EXPECT_LT(result.metrics.at("angular_momentum_err_max"), 1e-10) << method;
