@@ -88,7 +88,9 @@ std::map<std::string, fs::path> outputs(const fs::path& folder) {
 }
 
 fs::path sweep(const std::string& name, int jobs) {
-  const fs::path folder = fs::temp_directory_path() / "geomint_bit_identical_test" / name;
+  // Every copy sits in a folder named like the scene ("rerun"), so the `# scene:` provenance
+  // line — the scene's folder name — is compared too, not excused.
+  const fs::path folder = fs::temp_directory_path() / "geomint_bit_identical_test" / name / "rerun";
   fs::remove_all(folder);
   fs::create_directories(folder);
   fs::copy_file(fs::path(GEOMINT_SOURCE_DIR) / "tests/scenes/rerun/scene.toml",
