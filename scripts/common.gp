@@ -1,18 +1,54 @@
-# Shared gnuplot settings for geomint figures: CSV input with `# ` provenance lines and a
-# header row, names with underscores printed literally.
+# Shared gnuplot settings for geomint figures (README "Figures"): CSV input with `# ` provenance
+# lines and a header row, names with underscores printed literally, and one fixed style per method.
 set datafile separator comma
 set datafile columnheaders
 set key noenhanced
 set termoption noenhanced
 set grid lw 0.5 lc rgb "#dddddd"
-set style line 1 lw 2 lc rgb "#d62728"
-set style line 2 lw 2 lc rgb "#1f77b4"
-set style line 3 lw 2 lc rgb "#2ca02c"
-set style line 4 lw 2 lc rgb "#9467bd"
-set style line 5 lw 2 lc rgb "#ff7f0e"
-set style line 6 lw 2 lc rgb "#8c564b"
-set style line 7 lw 2 lc rgb "#e377c2"
-set style line 8 lw 2 lc rgb "#7f7f7f"
+
+# One colour, marker and dash per method in every figure of every scene. A method is found by
+# the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
+# ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not
+# be prefixes of one another. Line style i is the i-th key; 30 is any method not listed.
+method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3"
+method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3"
+method_index(name) = sum [i=1:words(method_keys)] (strstrt(name, word(method_keys, i)) == 1 ? i : 0)
+ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 30)
+mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(method_titles, method_found) : name)
+set style line 1  lw 2 lc rgb "#d62728" pt 5  ps 1.1          # explicit_euler: red, filled square
+set style line 2  lw 2 lc rgb "#1f77b4" pt 6  ps 1.6          # implicit_euler: blue, large open circle
+set style line 3  lw 2 lc rgb "#2ca02c" pt 9  ps 1.2          # symplectic_euler_a: green, filled triangle
+set style line 4  lw 2 lc rgb "#6b8e23" pt 11 ps 1.2          # symplectic_euler_b: olive, filled triangle down
+set style line 5  lw 2 lc rgb "#ff7f0e" pt 7  ps 1.1          # stormer_verlet: orange, filled circle
+set style line 6  lw 2 lc rgb "#9467bd" pt 13 ps 1.3          # rk4: purple, filled diamond
+set style line 7  lw 2 lc rgb "#000000" pt 4  ps 1.4          # del: black, open square
+set style line 8  lw 2 lc rgb "#e7298a" pt 12 ps 2.0 dt (6,4) # hp: magenta, open diamond, dashed (shows on top of del)
+set style line 9  lw 2 lc rgb "#8c564b" pt 8  ps 1.4          # newmark: brown, open triangle
+set style line 10 lw 2 lc rgb "#17becf" pt 10 ps 1.4          # implicit_midpoint: cyan, open triangle down
+set style line 11 lw 2 lc rgb "#7f7f7f" pt 1  ps 1.5          # cvode_bdf: grey, plus
+set style line 12 lw 2 lc rgb "#393b79" pt 2  ps 1.3          # cvode_adams: indigo, cross
+set style line 13 lw 2 lc rgb "#b8860b" pt 3  ps 1.4          # odeint_dopri5: dark gold, star
+set style line 14 lw 2 lc rgb "#843c39" pt 14 ps 1.4          # odeint_mclachlan4: dark red, open pentagon
+set style line 15 lw 2 lc rgb "#00a087" pt 15 ps 1.3          # gsl_rk8pd: teal, filled pentagon
+set style line 16 lw 2 lc rgb "#a55194" pt 7  ps 0.8 dt (2,2) # composition_yoshida4: plum, small dot, dotted
+set style line 17 lw 2 lc rgb "#5b2c6f" pt 5  ps 0.8 dt (2,2) # composition_kahan_li8: dark plum, small square, dotted
+set style line 18 lw 2 lc rgb "#637939" pt 4  ps 1.0 dt (8,3) # gauss_s2: dark olive, open square, long dashes
+set style line 19 lw 2 lc rgb "#31a354" pt 6  ps 1.0 dt (8,3) # gauss_s3: mid green, open circle, long dashes
+set style line 20 lw 2 lc rgb "#d6616b" pt 8  ps 1.0 dt (8,3) # lobatto3ab_s3: salmon, open triangle, long dashes
+set style line 30 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
+# Curves that are not methods (a parameter family, step sizes, energies of one method, bodies):
+# an ordered dark-to-light palette, styles 41-48, so they cannot be mistaken for a method.
+set style line 41 lw 2 lc rgb "#440154" pt 7
+set style line 42 lw 2 lc rgb "#46327e" pt 5
+set style line 43 lw 2 lc rgb "#365c8d" pt 9
+set style line 44 lw 2 lc rgb "#277f8e" pt 11
+set style line 45 lw 2 lc rgb "#1fa187" pt 13
+set style line 46 lw 2 lc rgb "#4ac16d" pt 7
+set style line 47 lw 2 lc rgb "#8fc31f" pt 5
+set style line 48 lw 2 lc rgb "#c9a800" pt 9
+# Legends sit above the plot in rows, so they take neither width nor data area.
+key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 spacing 1.1"
+
 # Every figure is written twice: PNG (README) and PDF (reports).
 png_term = "pngcairo size 1000,650 font 'DejaVu Sans,11'"
 pdf_term = "pdfcairo size 7in,4.5in font 'DejaVu Sans,9'"
