@@ -16,13 +16,13 @@ do for [format in "png pdf"] {
   if (format eq "png") { set term pngcairo size 1200,760 font 'DejaVu Sans,10' } else { set term pdfcairo size 8in,5in font 'DejaVu Sans,8' }
   set termoption noenhanced
   set output "heatmap.".format
-  set title "log10 error_final at t_end and force evaluations (grey: failed, with status and time reached)"
+  set title "Final error |(q, p) - exact| (colour, first line) and force evaluations (f) per method and case;\ngrey: failed, with its status and the time reached"
   set xrange [0.5:words(cases) + 0.5]; set yrange [words(methods) + 0.5:0.5]
   set xtics () ; set ytics ()
   do for [i=1:words(cases)] { set xtics add (word(cases, i) i) }
   do for [i=1:words(methods)] { set ytics add (word(method_titles, i) i) }
   set xtics nomirror; set ytics nomirror; unset grid
-  set cbrange [-12:1]; set cblabel "log10 |(q, p) - exact|"
+  set cbrange [-12:1]; set cblabel "log10 of |(q, p) - exact| at t_end (dimensionless)"
   set palette defined (-12 "#1a9850", -8 "#91cf60", -4 "#fee08b", -2 "#fc8d59", 1 "#d73027")
   set style fill solid 1.0 border lc rgb "white"
   unset key

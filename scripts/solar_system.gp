@@ -1,5 +1,6 @@
 # Outer solar system (GNI I.2.4): energy and angular-momentum error over 1e6 days, and the orbits.
 # Run inside results/solar_system (scripts/reproduce.sh does); reads series/{h10,h100,orbits}/.
+# Units: AU, days, solar masses; the relative errors are dimensionless.
 load scripts."/common.gp"
 methods = "stormer_verlet symplectic_euler_a hp_alpha_0.5 rk4"
 file(l, m) = "series/".l."/".m.".csv"
@@ -9,6 +10,7 @@ names = "Sun Jupiter Saturn Uranus Neptune Pluto"
 max(a, b) = a > b ? a : b
 # Initial energy and angular momentum: the first row of any run (all start from Table 2.1).
 first = file("h10", "stormer_verlet")
+envelope(f) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=4333 -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", E0, scripts, f)
 stats first using "energy" every ::0::0 nooutput; E0 = STATS_min
 stats first using "angular_momentum_0" every ::0::0 nooutput; L0x = STATS_min
 stats first using "angular_momentum_1" every ::0::0 nooutput; L0y = STATS_min
@@ -19,30 +21,31 @@ do for [format in "png pdf"] {
   set termoption noenhanced
 
   # Relative energy error, both step sizes side by side on log-log axes: bounded oscillation for
-  # the symplectic methods, linear drift for RK4.
+  # the symplectic methods, linear drift for RK4. The series are sampled about once per Jupiter
+  # period, so the curves are the per-window maximum (scripts/envelope.awk), not the samples.
   set output "energy.".format
-  set multiplot layout 1,2 title "Relative energy error |H - H0|/|H0|, outer solar system"
-  set xlabel "t [days]"; set ylabel "relative energy error"
-  set logscale xy; set format x "1e%T"; set format y "1e%T"; set xrange [1e3:1e6]
+  set multiplot layout 1,2 title "Relative energy error, outer solar system: largest value per window\n(one tenth of a decade, at least one Jupiter period and 5 samples)"
+  set xlabel "t [days]"; set ylabel "max |H - H0| / |H0| in the window"
+  set logscale xy; set format x "1e%T"; set format y "1e%T"; set xrange [1e4:1.2e6]
   set key below horizontal
   do for [h in "10 100"] {
     set title "h = ".h." days"
-    plot for [i=1:words(methods)] file("h".h, word(methods,i)) \
-         using "t":(abs(column("energy") - E0) / abs(E0)) with lines ls i title word(methods,i)
+    plot for [i=1:words(methods)] envelope(file("h".h, word(methods,i))) \
+         using 1:2 with linespoints ls ms(word(methods,i)) pn 8 title mtitle(word(methods,i))
   }
   unset multiplot
 
   # Relative angular-momentum error |L - L0|/|L0| (round-off for the symplectic methods).
   set output "angular_momentum.".format
   set multiplot layout 1,2 title "Relative angular-momentum error |L - L0|/|L0|"
-  set ylabel "relative angular-momentum error"; set yrange [1e-17:*]
+  set ylabel "|L - L0| / |L0| (dimensionless)"; set yrange [1e-17:*]; set xrange [1e3:1.2e6]
   do for [h in "10 100"] {
     set title "h = ".h." days"
     plot for [i=1:words(methods)] file("h".h, word(methods,i)) \
          using "t":(max(1e-17, sqrt((column("angular_momentum_0") - L0x)**2 + \
                                    (column("angular_momentum_1") - L0y)**2 + \
                                    (column("angular_momentum_2") - L0z)**2) / L0)) \
-         with lines ls i title word(methods,i)
+         with lines ls ms(word(methods,i)) title mtitle(word(methods,i))
   }
   unset multiplot
   unset logscale; set format x "% h"; set format y "% h"; set xrange [*:*]; set yrange [*:*]
@@ -56,7 +59,7 @@ do for [format in "png pdf"] {
   set xlabel "x - x_Sun [AU]"; set ylabel "y - y_Sun [AU]"; set size ratio -1; set key inside top right vertical
   plot for [b=1:5] file("orbits", "stormer_verlet") \
        using (column(sprintf("q_%d", 3*b)) - column("q_0")):(column(sprintf("q_%d", 3*b+1)) - column("q_1")) \
-       with lines ls b+1 title word(names, b+1), \
+       with lines ls 40 + b title word(names, b+1), \
        "+" using (0):(0) every ::0::0 with points pt 7 ps 2 lc rgb "#d62728" title "Sun"
   set size noratio
 }
