@@ -18,7 +18,7 @@ mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(metho
 set style line 1  lw 2 lc rgb "#d62728" pt 5  ps 1.1          # explicit_euler: red, filled square
 set style line 2  lw 2 lc rgb "#1f77b4" pt 6  ps 1.6          # implicit_euler: blue, large open circle
 set style line 3  lw 2 lc rgb "#2ca02c" pt 9  ps 1.2          # symplectic_euler_a: green, filled triangle
-set style line 4  lw 2 lc rgb "#6b8e23" pt 11 ps 1.2          # symplectic_euler_b: olive, filled triangle down
+set style line 4  lw 2 lc rgb "#a09a00" pt 11 ps 1.2 dt (5,3) # symplectic_euler_b: dark yellow, filled triangle down, dashed
 set style line 5  lw 2 lc rgb "#ff7f0e" pt 7  ps 1.1          # stormer_verlet: orange, filled circle
 set style line 6  lw 2 lc rgb "#9467bd" pt 13 ps 1.3          # rk4: purple, filled diamond
 set style line 7  lw 2 lc rgb "#000000" pt 4  ps 1.4          # del: black, open square
@@ -50,5 +50,5 @@ set style line 48 lw 2 lc rgb "#c9a800" pt 9
 key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 spacing 1.1"
 
 # Every figure is written twice: PNG (README) and PDF (reports).
-png_term = "pngcairo size 1000,650 font 'DejaVu Sans,11'"
-pdf_term = "pdfcairo size 7in,4.5in font 'DejaVu Sans,9'"
+png_term = "pngcairo noenhanced size 1000,650 font 'DejaVu Sans,11'"
+pdf_term = "pdfcairo noenhanced size 7in,4.5in font 'DejaVu Sans,9'"

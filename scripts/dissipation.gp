@@ -30,8 +30,10 @@ do for [format in "png pdf"] {
   set output "energy.".format
   set title "Damped oscillator (zeta = 0.1), h = 0.2: energy against the exact decay"
   set xlabel "t (dimensionless)"; set ylabel "H(t) (dimensionless)"; set logscale y; set format y "1e%T"
+  set label 1 "del:midpoint, hp:alpha=0.5 and the exact decay lie on one another\n(hp magenta dashes, exact black dashes)" at graph 0.02, graph 0.05 left font ",9" front
   plot for [i=1:words(methods)] decay(i, "0.2") using "t":"energy" with lines ls ms(word(methods, i)) title mtitle(word(methods, i)), \
        exact_energy(x) with lines lw 1 dt 2 lc rgb "black" title "exact"
+  unset label 1
 
   set output "energy_error.".format
   set title "Damped oscillator: largest energy error to t = 30 against the step size"

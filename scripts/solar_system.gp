@@ -38,7 +38,7 @@ do for [format in "png pdf"] {
   # Relative angular-momentum error |L - L0|/|L0| (round-off for the symplectic methods).
   set output "angular_momentum.".format
   set multiplot layout 1,2 title "Relative angular-momentum error |L - L0|/|L0|"
-  set ylabel "|L - L0| / |L0| (dimensionless)"; set yrange [1e-17:*]; set xrange [1e3:1.2e6]
+  set ylabel "|L - L0| / |L0| (dimensionless)"; set yrange [1e-17:*]; set xrange [4e3:1.2e6]
   do for [h in "10 100"] {
     set title "h = ".h." days"
     plot for [i=1:words(methods)] file("h".h, word(methods,i)) \
@@ -59,7 +59,7 @@ do for [format in "png pdf"] {
   set xlabel "x - x_Sun [AU]"; set ylabel "y - y_Sun [AU]"; set size ratio -1; set key inside top right vertical
   plot for [b=1:5] file("orbits", "stormer_verlet") \
        using (column(sprintf("q_%d", 3*b)) - column("q_0")):(column(sprintf("q_%d", 3*b+1)) - column("q_1")) \
-       with lines ls 40 + b title word(names, b+1), \
+       with lines ls word("41 43 45 47 48", b) + 0 title word(names, b+1), \
        "+" using (0):(0) every ::0::0 with points pt 7 ps 2 lc rgb "#d62728" title "Sun"
   set size noratio
 }
