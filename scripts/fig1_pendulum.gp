@@ -42,9 +42,9 @@ do for [format in "png pdf"] {
   unset label 1
 
   set output "energy_long.".format
-  set title "Relative energy error to t = 100000 (about 16000 periods), h = 0.05:\nlargest value in each window of one tenth of a decade (at least one period)"
+  set title "Relative energy error to t = 100000 (about 16000 periods), h = 0.05:\nlargest value per window (a tenth of a decade, at least one period and 5 samples)"
   set xlabel "t (dimensionless)"; set ylabel "max |H - H0| / H0 in the window"
-  set logscale x; set format x "1e%T"; set xrange [1:2e5]
+  set logscale x; set format x "1e%T"; set xrange [3:1.5e5]
   plot for [i=1:words(long_names)] envelope(word(long_names,i)) using 1:2 with linespoints ls ms(word(long_names,i)) pn 12 title mtitle(word(long_names,i))
   unset logscale; set format x "% h"; set format y "% h"; set xrange [*:*]
 }
