@@ -16,10 +16,12 @@ do for [format in "png pdf"] {
     @key_above
     ref = (label eq "pendulum") ? 0.1 : 0.02
     set xrange [ref/600:ref*1.5]
+    set label 1 "implicit_euler (open circles) lies on explicit_euler at small h,\nsymplectic_euler_b (dashed) on symplectic_euler_a" at graph 0.98, graph 0.2 right font ",9" front
     plot for [i=1:words(methods)] "order_points.csv" using "dt":(select(label, word(methods,i))) \
            with linespoints ls ms(word(methods,i)) title mtitle(word(methods,i)), \
          1e-1*(x/ref) with lines lw 1 dt 2 lc rgb "black" title "slope 1", \
          1e-3*(x/ref)**2 with lines lw 1 dt 3 lc rgb "black" title "slope 2", \
          1e-5*(x/ref)**4 with lines lw 1 dt 4 lc rgb "black" title "slope 4"
+    unset label 1
   }
 }
