@@ -3,7 +3,6 @@
 #include "harness/gate.hpp"
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "harness/toml_reader.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
@@ -53,41 +53,14 @@ bool values_match(const std::string& expected, const std::string& actual) {
   return std::abs(*a - *b) <= 1e-12 * std::max(std::abs(*a), std::abs(*b));
 }
 
-const char* const kAllowedKeys =
-    "name, scene, table, variants, file, where, column, min, max, equals, quick_min, quick_max, "
-    "quick_equals";
-
-// Reads one [[gate]] block's keys (typed, with messages naming the gate and the key).
-class GateBlock {
- public:
-  GateBlock(const toml::table& block, std::string where)
-      : block_(block), where_(std::move(where)) {}
-  void rename(std::string where) { where_ = std::move(where); }
-  const std::string& where() const { return where_; }
-
-  std::optional<std::string> text(const char* key) const {
-    const toml::node* node = block_.get(key);
-    if (!node) return std::nullopt;
-    if (auto value = node->value<std::string>()) return *value;
-    throw InputError(fmt::format("{}: key '{}' must be a string", where_, key));
+// A band bound must be a number: NaN would make every comparison false.
+std::optional<double> bound(TomlBlock& block, const char* key) {
+  const auto value = block.optional_number(key);
+  if (value && std::isnan(*value)) {
+    throw InputError(fmt::format("{}: key '{}' is NaN: a band needs a number", block.where(), key));
   }
-  std::optional<double> number(const char* key) const {
-    const toml::node* node = block_.get(key);
-    if (!node) return std::nullopt;
-    auto value = node->value<double>();
-    if (!value || node->is_boolean()) {
-      throw InputError(fmt::format("{}: key '{}' must be a number", where_, key));
-    }
-    if (std::isnan(*value)) {
-      throw InputError(fmt::format("{}: key '{}' is NaN: a band needs a number", where_, key));
-    }
-    return *value;
-  }
-
- private:
-  const toml::table& block_;
-  std::string where_;
-};
+  return value;
+}
 
 void validate_check(const GateCheck& check, const std::string& where, const char* prefix) {
   if (!check.min && !check.max && !check.equals) {
@@ -170,67 +143,41 @@ ResultFile read_result_file(const fs::path& path) {
 }  // namespace
 
 std::vector<Gate> load_gates(const std::string& path) {
-  if (fs::is_directory(path)) {
-    throw InputError(fmt::format("gates file '{}' is a directory; give a GATES.toml file", path));
-  }
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& error) {
-    throw InputError(fmt::format("gates file '{}': {} (line {})", path, error.description(),
-                                 error.source().begin.line));
-  }
-  for (const auto& [key, node] : root) {
-    if (key.str() != "gate") {
-      throw InputError(
-          fmt::format("gates file '{}': unknown top-level key '{}' (allowed: [[gate]] blocks)",
-                      path, key.str()));
-    }
-  }
-  const toml::array* blocks = root["gate"].as_array();
-  if (!blocks || blocks->empty()) {
-    throw InputError(fmt::format("gates file '{}': no [[gate]] blocks", path));
-  }
-  const std::set<std::string> allowed = {
-      "name", "scene", "table",  "variants",  "file",      "where",       "column",
-      "min",  "max",   "equals", "quick_min", "quick_max", "quick_equals"};
+  const std::string file_where = fmt::format("gates file '{}'", path);
+  const toml::table root = parse_toml_file(path, "gates file", "GATES.toml");
+  TomlBlock top(root, file_where);
+  top.known("gate");
+  top.finish();
+  const auto blocks = array_of_tables(root, "gate", file_where);
+  if (blocks.empty()) throw InputError(fmt::format("{}: no [[gate]] blocks", file_where));
   std::vector<Gate> gates;
   std::set<std::string> names;
   int index = 0;
-  for (const toml::node& block_node : *blocks) {
+  for (const toml::table* table : blocks) {
     ++index;
-    const toml::table* table = block_node.as_table();
-    if (!table) {
-      throw InputError(
-          fmt::format("gates file '{}', gate {}: must be a table ([[gate]])", path, index));
+    TomlBlock block(*table, fmt::format("{}, gate {}", file_where, index));
+    // Unknown keys are reported first, before a missing key they may be a typo of.
+    for (const char* key : {"name", "scene", "table", "variants", "file", "where", "column", "min",
+                            "max", "equals", "quick_min", "quick_max", "quick_equals"}) {
+      block.known(key);
     }
-    GateBlock block(*table, fmt::format("gates file '{}', gate {}", path, index));
-    for (const auto& [key, node] : *table) {
-      if (!allowed.count(std::string(key.str()))) {
-        throw InputError(fmt::format("{}: unknown key '{}' (allowed: {})", block.where(), key.str(),
-                                     kAllowedKeys));
-      }
-    }
+    block.finish();
     Gate gate;
-    const auto name = block.text("name");
-    if (!name) throw InputError(fmt::format("{}: missing key 'name'", block.where()));
-    gate.name = *name;
+    gate.name = block.string("name", true);
     block.rename(fmt::format("gates file '{}', gate '{}'", path, gate.name));
     if (!names.insert(gate.name).second) {
       throw InputError(fmt::format("{}: name used twice", block.where()));
     }
-    const auto column = block.text("column");
-    if (!column) throw InputError(fmt::format("{}: missing key 'column'", block.where()));
-    gate.column = *column;
-    if (const auto file = block.text("file")) {
+    gate.column = block.string("column", true);
+    if (const auto file = block.optional_string("file")) {
       if (table->get("scene") || table->get("table")) {
         throw InputError(
             fmt::format("{}: give 'scene'/'table' or 'file', not both", block.where()));
       }
       parse_legacy_file(*file, gate, block.where());
     }
-    if (const auto scene = block.text("scene")) gate.scene = *scene;
-    if (const auto table_name = block.text("table")) gate.table = *table_name;
+    if (const auto scene = block.optional_string("scene")) gate.scene = *scene;
+    if (const auto table_name = block.optional_string("table")) gate.table = *table_name;
     if (const toml::node* node = table->get("variants")) {
       const toml::array* array = node->as_array();
       gate.variants.clear();
@@ -251,13 +198,13 @@ std::vector<Gate> load_gates(const std::string& path) {
                         block.where()));
       }
     }
-    gate.full.min = block.number("min");
-    gate.full.max = block.number("max");
-    gate.full.equals = block.text("equals");
+    gate.full.min = bound(block, "min");
+    gate.full.max = bound(block, "max");
+    gate.full.equals = block.optional_string("equals");
     validate_check(gate.full, block.where(), "");
-    const auto quick_min = block.number("quick_min");
-    const auto quick_max = block.number("quick_max");
-    const auto quick_equals = block.text("quick_equals");
+    const auto quick_min = bound(block, "quick_min");
+    const auto quick_max = bound(block, "quick_max");
+    const auto quick_equals = block.optional_string("quick_equals");
     if (quick_min || quick_max || quick_equals) {
       GateCheck quick = gate.full;
       if (quick_equals) quick = GateCheck{std::nullopt, std::nullopt, quick_equals};

@@ -12,9 +12,10 @@
 
 #include "harness/gate.hpp"
 #include "harness/order.hpp"
-#include "harness/reference.hpp"
+#include "harness/paths.hpp"
+#include "harness/reference_generator.hpp"
 #include "harness/run.hpp"
-#include "harness/scene.hpp"
+#include "harness/sweep.hpp"
 
 using namespace geomint;
 
@@ -139,6 +140,9 @@ int main(int argc, char** argv) {
   sweep->add_option("scene", scene_path, "results/<scene>/scene.toml")->required();
   sweep->add_option("--jobs", jobs, "parallel accuracy runs")->check(CLI::Range(1, 256));
   sweep->add_flag("--quick", quick, "apply the scene's quick_* settings (CI-sized)");
+  bool markdown_only = false;
+  sweep->add_flag("--markdown-only", markdown_only,
+                  "run nothing: rewrite table.md from the CSVs already in the output folder");
   sweep->add_option("--out", sweep_out,
                     "output folder (default: the scene's folder; with --quick: <folder>/quick)");
 
@@ -313,6 +317,10 @@ int main(int argc, char** argv) {
       options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
       options.variant = quick ? "quick" : "full";
       check_output_dir(options.out_dir, sweep_out.empty() ? "output folder" : "--out");
+      if (markdown_only) {
+        rewrite_scene_markdown(scene, options.out_dir);
+        return 0;
+      }
       const int failed = run_sweep(scene, options);
       fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
                  scene.title, failed, options.out_dir);

@@ -1,6 +1,6 @@
-// Reference solutions for problems without an exact solution (issue 5): Gauss–Legendre
-// collocation, s = 3 (order 6; Hairer–Lubich–Wanner, GNI §II.1.3), with a long double state and
-// a Kahan-compensated update, checked against an independent run at twice the step.
+// Reference solutions for problems without an exact solution (issue 5; docs/METHOD.md): where
+// the files live, the loader, and the observer that measures a run's error against them. The
+// files are written by harness/reference_generator.hpp.
 #pragma once
 
 #include <memory>
@@ -12,37 +12,12 @@
 
 namespace geomint {
 
-// Rows of one reference file (all are held in memory until written).
-constexpr double kMaxReferenceRows = 1e6;
-
-struct ReferenceOptions {
-  std::string problem_spec;
-  double t_end = 0;          // horizon (> 0) from the problem's initial time
-  double dt = 0;             // step of the written run; 0 = default_dt / 8
-  double output_every = 0;   // spacing of the written rows; 0 = t_end / 100
-  std::string out_path;      // empty = reference_path(kReferenceDir, problem_spec)
-  std::string command_line;  // for the provenance lines
-};
-
-struct ReferenceSummary {
-  std::string path;
-  double dt = 0;
-  long steps = 0;
-  double estimated_error_final = 0;  // ‖y_dt − y_2dt‖₂ at t_end
-  double estimated_error_max = 0;    // max of that over the written rows
-  double seconds = 0;
-};
-
 // Where the harness looks for references, relative to the working directory (the repository
 // root for the CLI and scripts/reproduce.sh).
 inline constexpr const char* kReferenceDir = "results/references";
 
 // <dir>/<sanitized canonical problem spec>.csv
 std::string reference_path(const std::string& dir, const std::string& problem_spec);
-
-// Runs the reference and its check run, writes the CSV. InputError on bad options; a run whose
-// stage iteration does not converge throws InputError suggesting a smaller --dt.
-ReferenceSummary generate_reference(const ReferenceOptions& options);
 
 // A loaded reference: rows (t, q, p) at the output times.
 struct ReferenceSolution {

@@ -1,8 +1,6 @@
 // Reference solutions (issue 5): the generator reproduces exact solutions to its own error
 // estimate, the harness measures errors against a reference file and names it, and missing or
 // malformed files are InputErrors that name the file.
-#include "harness/reference.hpp"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,6 +9,7 @@
 #include <functional>
 #include <sstream>
 
+#include "harness/reference_generator.hpp"
 #include "harness/run.hpp"
 #include "problems/spec.hpp"
 

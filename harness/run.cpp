@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "harness/observers.hpp"
+#include "harness/paths.hpp"
 #include "harness/reference.hpp"
 
 namespace geomint {

@@ -1,7 +1,6 @@
-// Scenes (docs/DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs (problems ×
-// methods × dt), of order studies and of stability searches; `sweep` runs them (accuracy runs in
-// parallel, timing runs one at a time) and writes summary.csv, order.csv, stability.csv, series/
-// and table.md into the folder.
+// Scene files (docs/DESIGN.md §3, §5): results/<scene>/scene.toml describes blocks of runs
+// (problems × methods × dt), of order studies and of stability searches. This is the reader
+// (TOML → Scene, through harness/toml_reader.hpp); harness/sweep.hpp runs a Scene.
 #pragma once
 
 #include <string>
@@ -47,24 +46,5 @@ struct Scene {
 // sweep that starts never stops on its input. `quick` applies the quick_* keys; both the full
 // and the quick configuration are validated either way.
 Scene load_scene(const std::string& path, bool quick);
-
-struct SweepOptions {
-  int jobs = 1;
-  std::string out_dir;  // where outputs go
-  std::string command_line;
-  // Written as `# scene:` and `# variant:` provenance lines, which `geomint gate` selects by.
-  std::string scene_name;
-  std::string variant = "full";  // "full" or "quick"
-  bool progress = true;          // progress on stderr when it is a terminal
-};
-
-// Runs the scene; returns the number of failed runs (failure rows are results, not errors).
-// Throws InputError before any computing when the output folder cannot be written or two runs
-// would write the same series file. No exception escapes a worker thread: a run that throws
-// becomes a row with status `error` and the exception's text as message.
-int run_sweep(const Scene& scene, const SweepOptions& options);
-
-// File-name-safe form of a spec ("hp:alpha=0.5" → "hp_alpha_0.5").
-std::string sanitize_for_path(const std::string& text);
 
 }  // namespace geomint

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "harness/scene.hpp"
+#include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {

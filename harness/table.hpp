@@ -56,16 +56,6 @@ class AtomicFileWriter {
   bool committed_ = false;
 };
 
-// Checks, before any computing, that a file can be written at `path`: it is not a directory and
-// its nearest existing ancestor is a writable folder (missing folders are created on writing).
-// Creates nothing. Throws InputError "<option> '<path>': <reason>".
-void check_output_file(const std::string& path, const std::string& option);
-// The same for a folder that will receive output files.
-void check_output_dir(const std::string& path, const std::string& option);
-// True when `a` and `b` name the same file (after resolving `.`, `..` and symbolic links of the
-// existing part).
-bool same_file_path(const std::string& a, const std::string& b);
-
 // The column order every geomint CSV uses.
 const std::vector<std::string>& standard_columns();
 

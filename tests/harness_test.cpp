@@ -9,6 +9,7 @@
 
 #include "harness/observers.hpp"
 #include "harness/order.hpp"
+#include "harness/paths.hpp"
 #include "harness/run.hpp"
 #include "harness/scene.hpp"
 #include "harness/table.hpp"

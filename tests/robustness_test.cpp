@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
-#include "harness/scene.hpp"
+#include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
