@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
-        format clean mutation mutation-check sanitize-build test-sanitize fuzz
+        format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables
 
 all: build
 
@@ -94,6 +94,12 @@ mutation: deps
 # Only checks that every mutant's `find` text still occurs exactly once (seconds, no build).
 mutation-check:
 	@/usr/bin/python3 scripts/mutation.py --check
+
+# Rewrites README.md's method and problem tables (between the <!-- methods:begin/end --> and
+# <!-- problems:begin/end --> markers) with `geomint list --markdown`; the test
+# Readme.TablesAreTheOutputOfListMarkdown fails until they agree.
+readme-tables: build
+	@/usr/bin/python3 scripts/readme_tables.py $(BUILD_DIR)/geomint README.md
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
