@@ -52,7 +52,9 @@ sanitize-build: deps
 # method, problem or scene do not run: 10^4 spring-net steps of lobatto3ab:s=4 and gauss:s=3
 # (their order, energy, reversibility and Kepler tests stay), the committed work_precision rows
 # (every method is re-run by the other scenes' rows) and kepler:e=0.99 against an RK4 reference
-# (the other Kepler eccentricities stay). `make test-sanitize SAN_EXCLUDE=` runs everything.
+# (the other Kepler eccentricities stay). Three of them (not work_precision) also carry the label
+# `slow` (tests/slow_tests.cmake), which -LE slow leaves out in any case; `make test-sanitize
+# SAN_EXCLUDE=` runs everything else.
 SAN_EXCLUDE ?= KeepsSpringNetMomentaOver10000Steps/(lobatto3ab_s_4|gauss_s_3)( |$$)|CheapRowsReproduce/"work_precision"|ExactMatchesIndependentRk4/kepler_e_0p99( |$$)
 test-sanitize: sanitize-build
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE slow \
