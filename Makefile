@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
-        format clean mutation mutation-check sanitize-build test-sanitize fuzz
+        format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables
 
 all: build
 
@@ -52,7 +52,9 @@ sanitize-build: deps
 # method, problem or scene do not run: 10^4 spring-net steps of lobatto3ab:s=4 and gauss:s=3
 # (their order, energy, reversibility and Kepler tests stay), the committed work_precision rows
 # (every method is re-run by the other scenes' rows) and kepler:e=0.99 against an RK4 reference
-# (the other Kepler eccentricities stay). `make test-sanitize SAN_EXCLUDE=` runs everything.
+# (the other Kepler eccentricities stay). Three of them (not work_precision) also carry the label
+# `slow` (tests/slow_tests.cmake), which -LE slow leaves out in any case; `make test-sanitize
+# SAN_EXCLUDE=` runs everything else.
 SAN_EXCLUDE ?= KeepsSpringNetMomentaOver10000Steps/(lobatto3ab_s_4|gauss_s_3)( |$$)|CheapRowsReproduce/"work_precision"|ExactMatchesIndependentRk4/kepler_e_0p99( |$$)
 test-sanitize: sanitize-build
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE slow \
@@ -94,6 +96,12 @@ mutation: deps
 # Only checks that every mutant's `find` text still occurs exactly once (seconds, no build).
 mutation-check:
 	@/usr/bin/python3 scripts/mutation.py --check
+
+# Rewrites README.md's method and problem tables (between the <!-- methods:begin/end --> and
+# <!-- problems:begin/end --> markers) with `geomint list --markdown`; the test
+# Readme.TablesAreTheOutputOfListMarkdown fails until they agree.
+readme-tables: build
+	@/usr/bin/python3 scripts/readme_tables.py $(BUILD_DIR)/geomint README.md
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done

@@ -12,12 +12,8 @@
 #include <string>
 
 #include "integrators/integrator.hpp"
+#include "problems/elastic_bar.hpp"
 #include "problems/problem.hpp"
-
-namespace geomint {
-// Defined in problems/elastic_bar.cpp (problems have no per-problem headers).
-std::size_t elastic_bar_footprint_bytes(const Problem& problem);
-}  // namespace geomint
 
 namespace {
 

@@ -54,35 +54,80 @@ std::string joined_command_line(int argc, char** argv) {
   return out;
 }
 
-void print_methods() {
-  fmt::print("{:<22} {:>5}  {:<48} {}\n", "method", "order", "flags", "parameters (default)");
+std::string parameter_list(const Params& params) {
+  std::vector<std::string> parameters;
+  for (const auto& doc : params.docs()) {
+    parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+  }
+  return fmt::format("{}", fmt::join(parameters, ","));
+}
+
+// A Markdown table cell: '|' would end the cell.
+std::string markdown_cell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+// The default configuration's order, then the other orders among the variants the tests cover
+// (integrators/registry.def): "2 (variants: 1)" for hp.
+std::string order_column(const IntegratorEntry& entry, int default_order) {
+  std::vector<int> others;
+  for (const auto& variant : entry.variants) {
+    const int order = make_integrator(entry.name + ":" + variant)->info().order;
+    if (order != default_order && std::find(others.begin(), others.end(), order) == others.end()) {
+      others.push_back(order);
+    }
+  }
+  if (others.empty()) return std::to_string(default_order);
+  std::sort(others.begin(), others.end());
+  return fmt::format("{} (variants: {})", default_order, fmt::join(others, ", "));
+}
+
+// `markdown`: the README's table (README.md, between <!-- methods:begin/end -->), one row per
+// registry entry; otherwise aligned columns with every parameter and its default.
+void print_methods(bool markdown) {
+  if (markdown) {
+    fmt::print("| method | order | flags | what it is |\n|---|---|---|---|\n");
+  } else {
+    fmt::print("{:<22} {:>5}  {:<48} {}\n", "method", "order", "flags", "parameters (default)");
+  }
   for (const auto& entry : integrator_registry()) {
     Params params(Spec{entry.name, {}}, entry.name);
     const auto integrator = entry.factory(params);
     const MethodInfo info = integrator->info();
-    std::vector<std::string> parameters;
-    for (const auto& doc : params.docs()) {
-      parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+    const std::string flags = fmt::format("{}", fmt::join(flag_names(info.flags), ", "));
+    if (markdown) {
+      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, order_column(entry, info.order), flags,
+                 markdown_cell(entry.summary));
+    } else {
+      fmt::print("{:<22} {:>5}  {:<48} {}\n", entry.name, info.order,
+                 fmt::format("{}", fmt::join(flag_names(info.flags), ",")), parameter_list(params));
     }
-    fmt::print("{:<22} {:>5}  {:<48} {}\n", entry.name, info.order,
-               fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
-               fmt::format("{}", fmt::join(parameters, ",")));
   }
 }
 
-void print_problems() {
-  fmt::print("{:<20} {:>5}  {:<58} {}\n", "problem", "dof", "capabilities (defaults)",
-             "parameters (default)");
+void print_problems(bool markdown) {
+  if (markdown) {
+    fmt::print("| problem | dof | capabilities | what it is |\n|---|---|---|---|\n");
+  } else {
+    fmt::print("{:<20} {:>5}  {:<58} {}\n", "problem", "dof", "capabilities (defaults)",
+               "parameters (default)");
+  }
   for (const auto& entry : problem_registry()) {
     Params params(Spec{entry.name, {}}, entry.name);
     const auto problem = entry.factory(params);
-    std::vector<std::string> parameters;
-    for (const auto& doc : params.docs()) {
-      parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+    const auto capabilities = capability_names(problem->capabilities());
+    if (markdown) {
+      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, problem->dof(),
+                 fmt::format("{}", fmt::join(capabilities, ", ")), markdown_cell(entry.summary));
+    } else {
+      fmt::print("{:<20} {:>5}  {:<58} {}\n", entry.name, problem->dof(),
+                 fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params));
     }
-    fmt::print("{:<20} {:>5}  {:<58} {}\n", entry.name, problem->dof(),
-               fmt::format("{}", fmt::join(capability_names(problem->capabilities()), ",")),
-               fmt::format("{}", fmt::join(parameters, ",")));
   }
 }
 
@@ -91,11 +136,22 @@ void print_problems() {
 int main(int argc, char** argv) {
   CLI::App app{"geomint: verification and benchmark suite for geometric time integrators"};
   app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 ok; 1 a run failed (run), no order could be fitted (order) or a gate failed "
+      "(gate); 2 bad input: the message names the offending option, key or value, and nothing is "
+      "written (checked before any computing, outputs included); 3 internal error (\"geomint: "
+      "internal error: ...\"): a defect, or an I/O failure after those checks such as a full "
+      "disk. A numerical failure is a row whose status says what happened; a sweep exits 0 with "
+      "its failures as rows.");
 
   auto* list = app.add_subcommand("list", "List registered methods and/or problems");
   std::string list_what = "all";
   list->add_option("what", list_what, "methods | problems | all")
       ->check(CLI::IsMember({"methods", "problems", "all"}));
+  bool list_markdown = false;
+  list->add_flag("--markdown", list_markdown,
+                 "print the README's Markdown tables (methods: order, flags, summary; problems: "
+                 "dof, capabilities of the defaults, summary); `make readme-tables` pastes them");
 
   std::string problem_spec, method_spec, out_path, series_path;
   double dt = 0, t_end = 0;
@@ -185,9 +241,9 @@ int main(int argc, char** argv) {
   const std::string command_line = joined_command_line(argc, argv);
   try {
     if (*list) {
-      if (list_what != "problems") print_methods();
+      if (list_what != "problems") print_methods(list_markdown);
       if (list_what == "all") fmt::print("\n");
-      if (list_what != "methods") print_problems();
+      if (list_what != "methods") print_problems(list_markdown);
       return 0;
     }
     if (*run) {
@@ -331,6 +387,9 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   } catch (const std::exception& error) {
     fmt::print(stderr, "geomint: internal error: {}\n", error.what());
+    return kExitInternal;
+  } catch (...) {
+    fmt::print(stderr, "geomint: internal error: an exception of unknown type\n");
     return kExitInternal;
   }
   return 0;

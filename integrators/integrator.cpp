@@ -13,20 +13,6 @@ namespace geomint {
 #include "integrators/registry.def"
 #undef GEOMINT_METHOD
 
-namespace {
-std::vector<std::string> split_variants(const std::string& text) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (start < text.size()) {
-    const auto semicolon = text.find(';', start);
-    out.push_back(text.substr(start, semicolon - start));
-    if (semicolon == std::string::npos) break;
-    start = semicolon + 1;
-  }
-  return out;
-}
-}  // namespace
-
 const std::vector<IntegratorEntry>& integrator_registry() {
   static const std::vector<IntegratorEntry> entries = {
 #define GEOMINT_METHOD(name, factory, variants, summary) \

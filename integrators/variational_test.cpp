@@ -11,6 +11,7 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "tests/test_util.hpp"
 
 namespace geomint {
 namespace {
@@ -606,31 +607,25 @@ TEST(Stiffness, TrapezoidalNewmarkConvergesFarBeyondTheExplicitLimit) {
 }
 
 TEST(Parameters, BadValuesAndUnknownKeysNameTheKey) {
-  const auto expect_error_naming = [](const std::string& spec, const std::string& key) {
-    try {
-      make_integrator(spec);
-      ADD_FAILURE() << spec << " was accepted";
-    } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find(key), std::string::npos)
-          << spec << ": " << error.what();
-    }
+  const test::InputErrorCases cases = {
+      {"hp:alpha=1.5", "alpha"},
+      {"hp:alpha=-0.1", "alpha"},
+      {"hp:solver=cg", "solver"},
+      {"hp:max_iter=0", "max_iter"},
+      {"hp:tol=0", "tol"},
+      {"hp:force_slot=middle", "force_slot"},
+      {"del:force_at=end", "force_at"},
+      {"del:rule=nope", "rule"},
+      {"del:rule=midpoint,alpha=0.3", "alpha"},  // midpoint has no alpha
+      {"del:rule=alpha,alpha=2", "alpha"},
+      {"newmark:beta=-1", "beta"},
+      {"newmark:beta=0.6", "beta"},
+      {"newmark:gamma=1.5", "gamma"},
+      {"newmark:delta=1", "delta"},
+      {"implicit_midpoint:alpha=0.5", "alpha"},
+      {"hp:foo=1", "foo"},
   };
-  expect_error_naming("hp:alpha=1.5", "alpha");
-  expect_error_naming("hp:alpha=-0.1", "alpha");
-  expect_error_naming("hp:solver=cg", "solver");
-  expect_error_naming("hp:max_iter=0", "max_iter");
-  expect_error_naming("hp:tol=0", "tol");
-  expect_error_naming("hp:force_slot=middle", "force_slot");
-  expect_error_naming("del:force_at=end", "force_at");
-  expect_error_naming("del:rule=nope", "rule");
-  expect_error_naming("del:rule=midpoint,alpha=0.3", "alpha");  // midpoint has no alpha
-  expect_error_naming("del:rule=alpha,alpha=2", "alpha");
-  expect_error_naming("newmark:beta=-1", "beta");
-  expect_error_naming("newmark:beta=0.6", "beta");
-  expect_error_naming("newmark:gamma=1.5", "gamma");
-  expect_error_naming("newmark:delta=1", "delta");
-  expect_error_naming("implicit_midpoint:alpha=0.5", "alpha");
-  expect_error_naming("hp:foo=1", "foo");
+  EXPECT_TRUE(test::input_errors_name(make_integrator, cases));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -2,6 +2,8 @@
 // masses, F = D_s D_m⁻¹, St Venant–Kirchhoff or neo-Hookean W with P(F) and dP/dF from Sifakis &
 // Barbič, "FEM simulation of 3D deformable solids" (2012); strain-rate damping after Kharevych
 // §5.2.
+#include "problems/elastic_bar.hpp"
+
 #include <fmt/format.h>
 
 #include <Eigen/Core>
@@ -609,8 +611,6 @@ class ElasticBar final : public Problem {
 
 }  // namespace
 
-// Memory of an elastic_bar's precomputed data, 0 for any other problem. Declared where used
-// (the benchmark), since problems have no per-problem headers.
 std::size_t elastic_bar_footprint_bytes(const Problem& problem) {
   const auto* bar = dynamic_cast<const ElasticBar*>(&problem);
   return bar == nullptr ? 0 : bar->footprint_bytes();

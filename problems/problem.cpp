@@ -5,17 +5,27 @@
 
 namespace geomint {
 
-#define GEOMINT_PROBLEM(name, factory, summary) std::unique_ptr<Problem> factory(Params&);
+#define GEOMINT_PROBLEM(name, factory, variants, summary) std::unique_ptr<Problem> factory(Params&);
 #include "problems/registry.def"
 #undef GEOMINT_PROBLEM
 
 const std::vector<ProblemEntry>& problem_registry() {
   static const std::vector<ProblemEntry> entries = {
-#define GEOMINT_PROBLEM(name, factory, summary) {#name, summary, &factory},
+#define GEOMINT_PROBLEM(name, factory, variants, summary) \
+  {#name, summary, &factory, split_variants(variants)},
 #include "problems/registry.def"
 #undef GEOMINT_PROBLEM
   };
   return entries;
+}
+
+std::vector<std::string> problem_test_specs() {
+  std::vector<std::string> specs;
+  for (const auto& entry : problem_registry()) {
+    specs.push_back(entry.name);
+    for (const auto& variant : entry.variants) specs.push_back(entry.name + ":" + variant);
+  }
+  return specs;
 }
 
 std::unique_ptr<Problem> make_problem(const std::string& spec_text) {

@@ -126,7 +126,12 @@ struct ProblemEntry {
   std::string name;
   std::string summary;
   std::unique_ptr<Problem> (*factory)(Params&);
+  std::vector<std::string> variants;  // extra parameter sets for the registry-driven tests
 };
 const std::vector<ProblemEntry>& problem_registry();
+
+// The specs the registry-driven tests exercise (problems/problems_test.cpp): each entry's
+// defaults, then its variants from problems/registry.def.
+std::vector<std::string> problem_test_specs();
 
 }  // namespace geomint

@@ -65,6 +65,18 @@ std::string format_number(double value) {
   return std::string(buffer, result.ptr);
 }
 
+std::vector<std::string> split_variants(const std::string& text) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start < text.size()) {
+    const auto semicolon = text.find(';', start);
+    out.push_back(text.substr(start, semicolon - start));
+    if (semicolon == std::string::npos) break;
+    start = semicolon + 1;
+  }
+  return out;
+}
+
 Params::Params(const Spec& spec, std::string context) : spec_(spec), context_(std::move(context)) {}
 
 const std::string* Params::raw(const std::string& key) {

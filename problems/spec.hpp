@@ -27,6 +27,10 @@ struct Spec {
   static Spec parse(const std::string& text);
 };
 
+// The extra parameter sets a registry entry lists for the registry-driven tests
+// (integrators/registry.def, problems/registry.def): "a=1;a=2,b=3" -> {"a=1", "a=2,b=3"}.
+std::vector<std::string> split_variants(const std::string& text);
+
 // Documentation of one parameter, collected while a factory reads its parameters.
 struct ParamDoc {
   std::string key;

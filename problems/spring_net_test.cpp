@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "problems/problem.hpp"
+#include "tests/test_util.hpp"
 
 namespace geomint {
 namespace {
@@ -369,7 +370,7 @@ TEST(SpringNet, TenThousandDofNetEvaluates) {
 }
 
 TEST(SpringNet, BadParametersNameTheKey) {
-  const std::vector<std::pair<std::string, std::string>> cases = {
+  const test::InputErrorCases cases = {
       {"spring_net:nx=1", "nx=1"},
       {"spring_net:ny=0", "ny=0"},
       {"spring_net:dim=4", "dim=4"},
@@ -385,15 +386,7 @@ TEST(SpringNet, BadParametersNameTheKey) {
       {"spring_net:nx=5000,ny=5000", "nx"},
       {"spring_net:bogus=1", "bogus"},
   };
-  for (const auto& [spec, expected] : cases) {
-    try {
-      make_problem(spec);
-      ADD_FAILURE() << spec << " accepted";
-    } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find(expected), std::string::npos)
-          << spec << ": " << error.what();
-    }
-  }
+  EXPECT_TRUE(test::input_errors_name(make_problem, cases));
 }
 
 }  // namespace

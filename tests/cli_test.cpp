@@ -196,5 +196,51 @@ TEST(Readme, MethodAndProblemTablesMatchTheRegistry) {
   for (const auto& name : problems) EXPECT_NE(listing.output.find(name), std::string::npos);
 }
 
+// The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of README.md.
+std::string readme_block(const std::string& marker) {
+  std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
+  std::string line, block;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    if (line == "<!-- " + marker + ":end -->") break;
+    if (inside) block += line + "\n";
+    if (line == "<!-- " + marker + ":begin -->") inside = true;
+  }
+  return block;
+}
+
+// The README's method and problem tables are generated (README "Adding a method or a problem"):
+// they must be `geomint list --markdown` verbatim, so a new or changed registry entry fails
+// here with the rows to paste.
+TEST(Readme, TablesAreTheOutputOfListMarkdown) {
+  for (const std::string what : {"methods", "problems"}) {
+    const Outcome listing = geomint("list " + what + " --markdown");
+    ASSERT_EQ(listing.exit_code, 0) << listing.output;
+    const std::string readme = readme_block(what);
+    if (readme == listing.output) continue;
+    std::istringstream expected(listing.output), actual(readme);
+    std::set<std::string> readme_rows;
+    for (std::string row; std::getline(actual, row);) readme_rows.insert(row);
+    std::string changed;
+    for (std::string row; std::getline(expected, row);) {
+      if (!readme_rows.count(row)) changed += "  " + row + "\n";
+    }
+    ADD_FAILURE() << "README.md's " << what << " table is not `geomint list " << what
+                  << " --markdown`. Run `make readme-tables`, or paste between <!-- " << what
+                  << ":begin --> and <!-- " << what << ":end -->:\n"
+                  << listing.output << "(rows new or changed:\n"
+                  << changed << ")";
+  }
+}
+
+// `geomint --help` documents every exit code main() returns (README "Exit codes").
+TEST(Cli, HelpListsEveryExitCode) {
+  const Outcome help = geomint("--help");
+  EXPECT_EQ(help.exit_code, 0) << help.output;
+  for (const char* code : {"0 ok", "1 a run failed", "2 bad input", "3 internal error"}) {
+    EXPECT_NE(help.output.find(code), std::string::npos) << code << " missing in:\n" << help.output;
+  }
+}
+
 }  // namespace
 }  // namespace geomint

@@ -1,0 +1,59 @@
+// Shared GoogleTest helpers for every suite (docs/DESIGN.md §7, "Tests"). Bad input must be an
+// InputError whose message names the offending input (README "Exit codes": exit 2 with a message
+// naming the option, key or value), checked here once instead of in a copy per test file.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "problems/spec.hpp"
+
+namespace geomint::test {
+
+// Success when make(input) throws InputError and its message contains every fragment; the
+// failure names the input and quotes the message, or says the input was accepted. Use as
+// EXPECT_TRUE(input_error_names(make_problem, "kepler:e=1", "e=1")) so a failure points at the
+// caller's line.
+template <class Make>
+::testing::AssertionResult input_error_names(Make&& make, const std::string& input,
+                                             const std::vector<std::string>& fragments) {
+  try {
+    make(input);
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    for (const auto& fragment : fragments) {
+      if (message.find(fragment) == std::string::npos) {
+        return ::testing::AssertionFailure()
+               << input << ": the message does not name '" << fragment << "': " << message;
+      }
+    }
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << input << " was accepted";
+}
+
+template <class Make>
+::testing::AssertionResult input_error_names(Make&& make, const std::string& input,
+                                             const std::string& fragment) {
+  return input_error_names(make, input, std::vector<std::string>{fragment});
+}
+
+// Pairs of a bad input and the fragment its message must contain.
+using InputErrorCases = std::vector<std::pair<std::string, std::string>>;
+
+// input_error_names for every case; the failure lists every case that failed.
+template <class Make>
+::testing::AssertionResult input_errors_name(Make&& make, const InputErrorCases& cases) {
+  std::string failures;
+  for (const auto& [input, fragment] : cases) {
+    const ::testing::AssertionResult result = input_error_names(make, input, fragment);
+    if (!result) failures += std::string("\n  ") + result.message();
+  }
+  if (failures.empty()) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "bad input not rejected as expected:" << failures;
+}
+
+}  // namespace geomint::test
