@@ -169,10 +169,8 @@ class DiscreteLagrangianVI final : public Integrator {
       cached_q_ = q1;
       gradient_cache_ = gradient_end_;
     }
-    if (plus > 0.0) {
-      plus_slot_force(problem, forcing_, state, q1, h, v, force_, counters_);
-      p1 += (plus * h) * force_;
-    }
+    if (plus > 0.0)
+      add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     state.q = q1;
     state.p = p1;
     state.t += h;

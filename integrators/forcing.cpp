@@ -53,12 +53,14 @@ void add_minus_impulse_jacobian(const Problem& problem, const Forcing& forcing,
   counters.force_evals += 2 * v.size();
 }
 
-void plus_slot_force(const Problem& problem, const Forcing& forcing, const State& start,
-                     const Vec& q1, double h, const Vec& v, Vec& force, Counters& counters) {
+void add_plus_impulse(const Problem& problem, const Forcing& forcing, const State& start,
+                      const Vec& q1, double h, const Vec& v, double plus_weight, Vec& p1,
+                      Vec& force, Counters& counters) {
   const bool node = forcing.at == ForceAt::kNode;
   ++counters.force_evals;
   problem.force(node ? q1 : Vec(start.q + (h / 2) * v), v, node ? start.t + h : start.t + h / 2,
                 force);
+  p1 += (plus_weight * h) * force;
 }
 
 void decide_damping_symmetry(const Problem& problem, const Vec& q, const Vec& v, double t,

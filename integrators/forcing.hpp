@@ -65,10 +65,11 @@ void add_minus_impulse_jacobian(const Problem& problem, const Forcing& forcing,
                                 const ImpulseStep& step, const Vec& v, SparseMatrix& jacobian,
                                 SparseMatrix& damping, Counters& counters);
 
-// F(x⁺, v, t⁺) for the plus slot, x⁺ = q_{k+1} (node) or q_k + (h/2)v (midpoint); one force
-// evaluation, counted. The caller adds w⁺·h times it to p_{k+1}.
-void plus_slot_force(const Problem& problem, const Forcing& forcing, const State& start,
-                     const Vec& q1, double h, const Vec& v, Vec& force, Counters& counters);
+// p_{k+1} += F_d⁺ = w⁺·h·F(x⁺, v, t⁺) with x⁺ = q_{k+1} (node) or q_k + (h/2)v (midpoint), from
+// the step's `start` state; one force evaluation (into `force`), counted.
+void add_plus_impulse(const Problem& problem, const Forcing& forcing, const State& start,
+                      const Vec& q1, double h, const Vec& v, double plus_weight, Vec& p1,
+                      Vec& force, Counters& counters);
 
 // Decided once per run (a no-op once `symmetric` is set, or without force_jacobian_v): whether
 // C = −∂F/∂v at (q, v, t) is symmetric — true for dissipative forces, false for gyroscopic ones —

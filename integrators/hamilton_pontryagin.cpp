@@ -126,14 +126,12 @@ class HamiltonPontryagin final : public Integrator {
       eval_gradient(problem, q1, gradient_);
       p1 -= h * gradient_;
     }
-    if (plus > 0.0) {
-      plus_slot_force(problem, forcing_, state, q1, h, v, force_, counters_);
-      p1 += (plus * h) * force_;
-    }
-    velocity_ = v;
+    if (plus > 0.0)
+      add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     state.q = q1;
     state.p = p1;
     state.t += h;
+    velocity_ = v;
     ++counters_.steps;
     return StepStatus::success();
   }
