@@ -227,9 +227,8 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   const bool adaptive = (info.flags & kAdaptive) != 0;
   validate_run_config(config, adaptive);
   check_run_outputs(config);
-  if ((info.flags & kNeedsHessian) && !problem->has(kHessian)) {
-    throw InputError(fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
-                                 info.name, problem->name()));
+  if (const Applicability fit = applicable(*integrator, *problem); !fit.ok) {
+    throw InputError(fit.reason);
   }
 
   RunResult result;

@@ -11,26 +11,8 @@
 namespace geomint {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kTwoPi = 6.283185307179586;
-
-double value_of(const Spec& spec, const std::string& key) {
-  const auto it = spec.values.find(key);
-  return it == spec.values.end() ? kNaN : std::stod(it->second);
-}
-
-// The α-rule is Newmark with γ = ½, β = α(1 − α) on linear forces (docs/METHOD.md §1), and
-// ¼ − α(1 − α) = (½ − α)², so the Newmark bound below gives hω < 1/|½ − α|.
-double alpha_rule_limit(double alpha) { return alpha == 0.5 ? kInf : 1.0 / std::abs(0.5 - alpha); }
-
-// Undamped Newmark on ẍ = −ω²x (Hughes 2000, §9.1.2): unconditionally stable for 2β ≥ γ ≥ ½,
-// otherwise for γ ≥ ½ stable iff hω < 1/√(γ/2 − β); γ < ½ amplifies every mode.
-double newmark_limit(double beta, double gamma) {
-  if (gamma < 0.5) return 0.0;
-  if (2 * beta >= gamma) return kInf;
-  return 1.0 / std::sqrt(gamma / 2 - beta);
-}
 
 struct Search {
   const Problem& problem;
@@ -99,26 +81,7 @@ void resolve(const Problem& problem, const StabilityOptions& options, double* ho
 }  // namespace
 
 double predicted_homega_limit(const std::string& method_spec) {
-  const Spec spec = Spec::parse(make_integrator(method_spec)->spec());
-  const std::string& name = spec.name;
-  if (name == "explicit_euler") return 0.0;  // |1 + ihω| > 1 for every h > 0
-  if (name == "implicit_euler" || name == "implicit_midpoint") return kInf;
-  if (name == "symplectic_euler_a" || name == "symplectic_euler_b" || name == "stormer_verlet" ||
-      name == "odeint_velocity_verlet") {
-    return 2.0;
-  }
-  if (name == "rk4") return 2.0 * std::sqrt(2.0);  // |R(iy)| ≤ 1 iff y ≤ 2√2 (GNI §VI.4)
-  if (name == "hp") return alpha_rule_limit(value_of(spec, "alpha"));
-  if (name == "del") {
-    const std::string rule = spec.values.at("rule");
-    if (rule == "left" || rule == "right" || rule == "trapezoid") return 2.0;
-    if (rule == "midpoint") return kInf;
-    // symmetric_alpha averages the α and 1 − α rules, whose linear recurrences share
-    // β = α(1 − α): the same bound.
-    return alpha_rule_limit(value_of(spec, "alpha"));
-  }
-  if (name == "newmark") return newmark_limit(value_of(spec, "beta"), value_of(spec, "gamma"));
-  return kNaN;
+  return make_integrator(method_spec)->predicted_linear_stability().homega_limit;
 }
 
 void validate_stability_options(const StabilityOptions& options, const std::string& where) {
@@ -196,9 +159,8 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
     throw InputError(fmt::format(
         "method '{}' is adaptive: a stability search needs a fixed-step method", info.name));
   }
-  if ((info.flags & kNeedsHessian) && !problem->has(kHessian)) {
-    throw InputError(fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
-                                 info.name, problem->name()));
+  if (const Applicability fit = applicable(*integrator, *problem); !fit.ok) {
+    throw InputError(fit.reason);
   }
   double horizon = 0, h_lo = 0, h_hi = 0;
   resolve(*problem, options, &horizon, &h_lo, &h_hi);
@@ -254,7 +216,8 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
     }
   }
   result.homega_limit = limit * unit;
-  result.predicted = problem->name() == "harmonic" ? predicted_homega_limit(method_spec) : kNaN;
+  result.predicted =
+      problem->name() == "harmonic" ? integrator->predicted_linear_stability().homega_limit : kNaN;
 
   Row& row = result.row;
   row["problem"] = problem->spec();

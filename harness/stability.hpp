@@ -48,9 +48,9 @@ struct StabilityResult {
 StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
                                  const StabilityOptions& options);
 
-// The linear-theory limit of h·ω on the harmonic oscillator for a canonical method spec: +inf
-// for unconditionally stable methods, 0 for explicit Euler (never stable), NaN when geomint has
-// no formula for the method.
+// The linear-theory limit of h·ω on the harmonic oscillator for a method spec, as the method
+// predicts it (Integrator::predicted_linear_stability): +inf for unconditionally stable methods,
+// 0 for explicit Euler (never stable), NaN when the method has no prediction.
 double predicted_homega_limit(const std::string& method_spec);
 
 // Caps on the work of one search: steps per run (at the bottom of the range, the longest run)

@@ -73,6 +73,36 @@ TEST(Stability, PredictionsFromTheCanonicalSpec) {
   EXPECT_TRUE(std::isnan(predicted_homega_limit("odeint_mclachlan4")));
 }
 
+// Every method of the registry, in every configuration the registry tests, predicts its linear
+// stability limit or says why it cannot; where it predicts one for a fixed-step method, the
+// search on the harmonic oscillator measures it.
+TEST(Stability, EveryMethodPredictsItsLimitOrSaysWhyNot) {
+  StabilityOptions options = fast_options();
+  options.min_steps = 2000;
+  options.rel_tol = 1e-5;
+  int compared = 0;
+  for (const std::string& spec : integrator_test_specs()) {
+    const auto integrator = make_integrator(spec);
+    const StabilityPrediction prediction = integrator->predicted_linear_stability();
+    EXPECT_TRUE(prediction.predicted() != !prediction.reason.empty())
+        << spec << ": a limit or a reason, not both, not neither (reason '" << prediction.reason
+        << "')";
+    if (!prediction.predicted() || (integrator->info().flags & kAdaptive)) continue;
+    ++compared;
+    const auto result = stability_search("harmonic", spec, options);
+    EXPECT_EQ(result.predicted, prediction.homega_limit) << spec;
+    if (std::isinf(prediction.homega_limit)) {
+      EXPECT_EQ(result.status, "stable_to_max") << spec;
+    } else if (prediction.homega_limit == 0.0) {
+      EXPECT_EQ(result.status, "unstable_at_min") << spec;
+    } else {
+      EXPECT_EQ(result.status, "bracketed") << spec;
+      EXPECT_NEAR(result.homega_limit / prediction.homega_limit, 1.0, 2e-3) << spec;
+    }
+  }
+  EXPECT_GE(compared, 15);
+}
+
 TEST(Stability, BadInputNamesTheKey) {
   StabilityOptions options = fast_options();
   options.homega_max = options.homega_min / 2;

@@ -31,6 +31,12 @@ class Composition final : public Integrator {
             fmt::format("symmetric composition ({}) of {}, GNI §V.3", scheme_.source, base_name_)};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::none(
+        "no formula in geomint: the composed map's limit (from the product of the base steps' "
+        "matrices at γ_i h) is not derived here");
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     base_->reset(problem, state, gamma_.front() * h);

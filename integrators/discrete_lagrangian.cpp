@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 
@@ -46,61 +47,11 @@ struct Node {
   double w;  // weight, Σ w = 1
 };
 
-enum class ForceSlot { kMinus, kPlus, kSplit };
-enum class ForceAt { kNode, kMidpoint };
-
-// Discrete Lagrange–d'Alembert impulses of one step (docs/METHOD.md §2): the step's impulse h·F is
-// put into F_d⁻ (minus), F_d⁺ (plus) or half into each (split); each part is evaluated with the
-// step velocity v at its own node (q_k for F_d⁻, q_{k+1} for F_d⁺) or, force_at=midpoint, at
-// q_{k+½} = q_k + (h/2)v. Forced discrete Noether: the change of a momentum map J over a step is
-// the sum of the impulses' torques about the points where they act, so for a frame-invariant
-// force (zero net force and torque about its own evaluation point, e.g. spring_net's damping)
-// the node choice keeps linear and angular momentum to solver tolerance. At the midpoint the
-// impulse hF(q_{k+½}) is torque-free about q_{k+½} but acts at q_k = q_{k+½} − (h/2)v (minus) or
-// q_{k+1} = q_{k+½} + (h/2)v (plus): each step changes the angular momentum by ∓(h²/2) Σ_i v_i ×
-// F_i = O(h²), i.e. O(h) over a time interval. split applies equal halves at both ends, whose
-// torques cancel exactly, so it keeps angular momentum at the midpoint too. Linear momentum is kept
-// in every case (Σ_i F_i = 0). docs/METHOD.md §2 reports drift for the minus slot only; measured
-// here (results/dissipation, integrators/variational_test.cpp) minus and plus drift alike, with
-// opposite signs, at the midpoint and neither drifts at the node. Default: split at the midpoint,
-// docs/METHOD.md's "typical" F_d⁻ = F_d⁺ = (h/2)F(q_{k+½}, v) — second order, momenta kept, and on
-// forced problems the same map as implicit_midpoint.
-struct Forcing {
-  ForceSlot slot = ForceSlot::kSplit;
-  ForceAt at = ForceAt::kMidpoint;
-  double minus_weight() const {
-    return slot == ForceSlot::kMinus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
-  }
-  double plus_weight() const {
-    return slot == ForceSlot::kPlus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
-  }
-};
-
-// The force_slot and force_at options (docs/METHOD.md §2); hamilton_pontryagin.cpp reads the same
-// keys.
-Forcing read_forcing(Params& params) {
-  Forcing forcing;
-  const std::string slot =
-      params.choice("force_slot", "split", {"minus", "plus", "split"},
-                    "where the step's force impulse h F goes: F_d- (at q_k), F_d+ (at q_k+1), half "
-                    "each");
-  forcing.slot = slot == "minus"  ? ForceSlot::kMinus
-                 : slot == "plus" ? ForceSlot::kPlus
-                                  : ForceSlot::kSplit;
-  const std::string at =
-      params.choice("force_at", "midpoint", {"node", "midpoint"},
-                    "evaluate each impulse's force at its own node, or at q_k+1/2 for all slots");
-  forcing.at = at == "node" ? ForceAt::kNode : ForceAt::kMidpoint;
-  return forcing;
-}
-
 class DiscreteLagrangianVI final : public Integrator {
  public:
-  DiscreteLagrangianVI(std::string rule, std::vector<Node> nodes, Forcing forcing, double tolerance,
-                       int max_iterations)
-      : rule_(std::move(rule)), nodes_(std::move(nodes)), forcing_(forcing) {
-    newton_.options().tolerance = tolerance;
-    newton_.options().max_iterations = max_iterations;
+  DiscreteLagrangianVI(std::string rule, std::vector<Node> nodes, Forcing forcing,
+                       const NewtonOptions& newton)
+      : rule_(std::move(rule)), nodes_(std::move(nodes)), forcing_(forcing), newton_(newton) {
     newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
     double first_moment = 0.0;
     for (const Node& node : nodes_) {
@@ -127,6 +78,12 @@ class DiscreteLagrangianVI final : public Integrator {
                         rule_)};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    // Every rule is an α-rule or the mean of the α and 1 − α rules, whose linear recurrences share
+    // β = α(1 − α), with α the first node: left and trapezoid α = 0, right α = 1, midpoint ½.
+    return alpha_rule_stability(nodes_.front().a);
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     newton_.forget_pattern();
@@ -137,10 +94,7 @@ class DiscreteLagrangianVI final : public Integrator {
   StepStatus step(const Problem& problem, State& state, double h) override {
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
-    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
-      mass_diagonal_ = mass;
-      mass_matrix_ = SparseMatrix(mass.asDiagonal());
-    }
+    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double minus = forced ? forcing_.minus_weight() : 0.0;
     const double plus = forced ? forcing_.plus_weight() : 0.0;
@@ -164,10 +118,8 @@ class DiscreteLagrangianVI final : public Integrator {
       // Start from v₀ = M⁻¹p_k: the residual's linear momentum Σ(Mv − p_k) is then zero and the
       // Newton updates (whose matrix has the translations in the kernel of its ∇²V and C parts)
       // keep it zero, so linear momentum is exact through every iterate, not only at convergence.
-      if (forced && minus > 0.0 && problem.has(kForceJacobian) && !damping_symmetric_) {
-        // Decided once per run: C = −∂F/∂v is symmetric for dissipative forces, not gyroscopic.
-        problem.force_jacobian_v(state.q, v, state.t, damping_);
-        damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
+      if (forced && minus > 0.0) {
+        decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
       }
       double inner_scale = 0.0;
       NewtonSystem system;
@@ -185,7 +137,10 @@ class DiscreteLagrangianVI final : public Integrator {
           inner_scale += std::abs(h * node.w) * gradient_term_scale(hessian_, q_node);
           jacobian += (h * h * node.w * node.a * (1 - node.a)) * hessian_;
         }
-        if (minus > 0.0) add_impulse_jacobian(problem, x, jacobian);
+        if (minus > 0.0) {
+          add_minus_impulse_jacobian(problem, forcing_, impulse_step(), x, jacobian, damping_,
+                                     counters_);
+        }
       };
       system.symmetric = minus == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_);
 
@@ -214,12 +169,8 @@ class DiscreteLagrangianVI final : public Integrator {
       cached_q_ = q1;
       gradient_cache_ = gradient_end_;
     }
-    if (plus > 0.0) {
-      const bool node = forcing_.at == ForceAt::kNode;
-      eval_counted_force(problem, node ? q1 : Vec(state.q + (h / 2) * v), v,
-                         node ? state.t + h : state.t + h / 2, force_);
-      p1 += (plus * h) * force_;
-    }
+    if (plus > 0.0)
+      add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     state.q = q1;
     state.p = p1;
     state.t += h;
@@ -228,10 +179,7 @@ class DiscreteLagrangianVI final : public Integrator {
   }
 
  private:
-  void eval_counted_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {
-    ++counters_.force_evals;
-    eval_force(problem, q, v, t, f);
-  }
+  ImpulseStep impulse_step() const { return {q0_, t0_, h_, minus_}; }
 
   void start_gradient(const Problem& problem, const Vec& q) {
     if (cached_problem_ == &problem && cached_q_.size() == q.size() && cached_q_ == q) {
@@ -239,16 +187,6 @@ class DiscreteLagrangianVI final : public Integrator {
     } else {
       eval_gradient(problem, q, gradient_start_);
     }
-  }
-
-  // F_d⁻(v) = minus·h·F(x⁻, v, t⁻) with x⁻ = q_k (node) or q_k + (h/2)v (midpoint).
-  void minus_impulse(const Problem& problem, const Vec& v, Vec& impulse) {
-    if (forcing_.at == ForceAt::kNode) {
-      eval_counted_force(problem, q0_, v, t0_, impulse);
-    } else {
-      eval_counted_force(problem, q0_ + (h_ / 2) * v, v, t0_ + h_ / 2, impulse);
-    }
-    impulse *= minus_ * h_;
   }
 
   // implicit_term_ = h Σ_interior w_j (1 − a_j) ∇V(q^j(v)) − F_d⁻(v), memoised on v so that the
@@ -265,7 +203,7 @@ class DiscreteLagrangianVI final : public Integrator {
       implicit_term_ += (h_ * interior_[j].w * (1 - interior_[j].a)) * interior_gradients_[j];
     }
     if (minus_ > 0.0) {
-      minus_impulse(problem, v, impulse_);
+      minus_impulse(problem, forcing_, impulse_step(), v, impulse_, counters_);
       implicit_term_ -= impulse_;
     }
     memo_valid_ = true;
@@ -273,28 +211,6 @@ class DiscreteLagrangianVI final : public Integrator {
     memo_q_ = q0_;
     memo_h_ = h_;
     memo_problem_ = &problem;
-  }
-
-  // −∂F_d⁻/∂v: minus·h·C(x⁻, v) with C = −∂F/∂v. Exact at the node x⁻ = q_k; at the midpoint
-  // the (h/2)∂F/∂q part is left out (problems do not provide it): only the Newton matrix is
-  // approximate, the residual and hence the solution are exact (as in implicit_euler).
-  void add_impulse_jacobian(const Problem& problem, const Vec& v, SparseMatrix& jacobian) {
-    if (problem.has(kForceJacobian)) {
-      const bool node = forcing_.at == ForceAt::kNode;
-      problem.force_jacobian_v(node ? q0_ : Vec(q0_ + (h_ / 2) * v), v, node ? t0_ : t0_ + h_ / 2,
-                               damping_);
-      jacobian += (minus_ * h_) * damping_;
-      return;
-    }
-    const bool node = forcing_.at == ForceAt::kNode;
-    jacobian -= central_difference_jacobian(
-        [&](const Vec& x, Vec& impulse) {
-          eval_force(problem, node ? q0_ : Vec(q0_ + (h_ / 2) * x), x, node ? t0_ : t0_ + h_ / 2,
-                     impulse);
-          impulse *= minus_ * h_;
-        },
-        v);
-    counters_.force_evals += 2 * v.size();
   }
 
   std::string rule_;
@@ -355,13 +271,8 @@ std::unique_ptr<Integrator> make_del(Params& params) {
     label = fmt::format("{}, alpha={}", rule, format_number(alpha));
   }
   const Forcing forcing = read_forcing(params);
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|grad V| + |F_d-|)",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<DiscreteLagrangianVI>(label, std::move(nodes), forcing, tolerance,
-                                                static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|grad V| + |F_d-|");
+  return std::make_unique<DiscreteLagrangianVI>(label, std::move(nodes), forcing, newton);
 }
 
 }  // namespace geomint

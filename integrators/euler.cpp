@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 
@@ -19,6 +20,10 @@ class ExplicitEuler final : public Integrator {
   MethodInfo info() const override {
     return {"explicit_euler", 1, kExplicit,
             "forward Euler, Hairer-Norsett-Wanner Solving ODEs I §I.7; docs/METHOD.md §7"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(0.0);  // |1 + ihω| > 1 for every h > 0
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
@@ -47,14 +52,15 @@ class ExplicitEuler final : public Integrator {
 //    for the small forced test problems; large forced problems should provide force_jacobian_v.
 class ImplicitEuler final : public Integrator {
  public:
-  ImplicitEuler(double tolerance, int max_iterations) {
-    newton_.options().tolerance = tolerance;
-    newton_.options().max_iterations = max_iterations;
-  }
+  explicit ImplicitEuler(const NewtonOptions& newton) : newton_(newton) {}
 
   MethodInfo info() const override {
     return {"implicit_euler", 1, kImplicit | kNeedsHessian,
             "backward Euler, Hairer-Wanner Solving ODEs II §IV.3; docs/METHOD.md §7"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::unconditional();  // |1/(1 − ihω)| < 1 (A-stable)
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
@@ -67,10 +73,7 @@ class ImplicitEuler final : public Integrator {
   StepStatus step(const Problem& problem, State& state, double h) override {
     const Vec& mass = problem.mass();
     const double t_next = state.t + h;
-    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
-      mass_diagonal_ = mass;
-      mass_matrix_ = SparseMatrix(mass.asDiagonal());
-    }
+    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
 
     // Scale of the balanced terms for the relative residual test: ‖p‖ + h‖F‖ at the start of
     // the step. ‖F‖ at the end of the previous step is reused when the state was not changed
@@ -98,12 +101,8 @@ class ImplicitEuler final : public Integrator {
       jacobian = (h * h) * hessian_ + mass_matrix_;
       if (problem.has(kForce)) add_force_jacobian(problem, state.q, v, t_next, h, jacobian);
     };
-    if (problem.has(kForceJacobian) && !damping_symmetric_.has_value()) {
-      // Decided once per run: C is symmetric for dissipative forces, not for gyroscopic ones.
-      problem.force_jacobian_v(state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
-                               damping_);
-      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
-    }
+    decide_damping_symmetry(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
+                            damping_, damping_symmetric_);
     system.symmetric = !problem.has(kForce) || (problem.has(kForceJacobian) && *damping_symmetric_);
 
     Vec velocity = problem.inverse_mass().cwiseProduct(state.p);
@@ -175,12 +174,8 @@ std::unique_ptr<Integrator> make_explicit_euler(Params&) {
 }
 
 std::unique_ptr<Integrator> make_implicit_euler(Params& params) {
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale ‖p‖ + h‖F‖)",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<ImplicitEuler>(tolerance, static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "‖p‖ + h‖F‖");
+  return std::make_unique<ImplicitEuler>(newton);
 }
 
 }  // namespace geomint

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -35,21 +36,10 @@ class ScopedGslErrorsAsStatus {
 
 enum class GslMethod { kRk8pd, kMsbdf, kRk4imp };
 
-// Starting step from the size of y and y' in the error norm (Hairer, Nørsett & Wanner I,
-// §II.4, first two stages of the starting-step algorithm): GSL has no estimate of its own, and
-// a poor guess only costs rejected steps.
-double starting_step(const Vec& y, const Vec& ydot, double rtol, double atol) {
-  const Vec scale = (atol + rtol * y.array().abs()).matrix();
-  const double d0 = std::sqrt((y.array() / scale.array()).square().mean());
-  const double d1 = std::sqrt((ydot.array() / scale.array()).square().mean());
-  if (!(d0 >= 1e-5 && d1 >= 1e-5) || !std::isfinite(d0 / d1)) return 1e-6;
-  return 0.01 * d0 / d1;
-}
-
-class GslOdeiv2 final : public Integrator {
+class GslOdeiv2 final : public AdaptiveIntegrator {
  public:
-  GslOdeiv2(GslMethod method, double rtol, double atol, long max_steps)
-      : method_(method), rtol_(rtol), atol_(atol), max_steps_(max_steps) {}
+  GslOdeiv2(GslMethod method, const AdaptiveSettings& settings)
+      : AdaptiveIntegrator(settings, "GSL odeiv2 wrappers"), method_(method) {}
 
   MethodInfo info() const override {
     switch (method_) {
@@ -68,12 +58,8 @@ class GslOdeiv2 final : public Integrator {
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
-    Integrator::reset(problem, state, h);
     driver_.reset();
-    problem_ = &problem;
-    setup_status_ = StepStatus::success();
-    callback_error_.clear();
-    t_ = state.t;
+    begin_adaptive_reset(problem, state, h);
     const int dof = problem.dof();
     y_.resize(2 * dof);
     ydot_start_.resize(2 * dof);
@@ -93,7 +79,7 @@ class GslOdeiv2 final : public Integrator {
                                           "f(t0, y0) is not finite or threw " + callback_error_);
       return;
     }
-    h_ = starting_step(y_buffer_, ydot_buffer_, rtol_, atol_);
+    h_ = starting_step(y_buffer_, ydot_buffer_, settings_.rtol, settings_.atol);
 
     const gsl_odeiv2_step_type* type = method_ == GslMethod::kRk8pd   ? gsl_odeiv2_step_rk8pd
                                        : method_ == GslMethod::kMsbdf ? gsl_odeiv2_step_msbdf
@@ -103,46 +89,22 @@ class GslOdeiv2 final : public Integrator {
     // gsl_odeiv2_evolve_apply, which takes a single step (gsl_odeiv2_driver_apply would
     // integrate to t1 in many).
     const ScopedGslErrorsAsStatus errors_as_status;
-    driver_.reset(gsl_odeiv2_driver_alloc_y_new(&system_, type, h_, atol_, rtol_));
+    driver_.reset(
+        gsl_odeiv2_driver_alloc_y_new(&system_, type, h_, settings_.atol, settings_.rtol));
     if (!driver_) {
       setup_status_ =
           StepStatus::failure("gsl_status_alloc", "gsl_odeiv2_driver_alloc_y_new failed");
     }
   }
 
-  StepStatus step(const Problem&, State&, double) override {
-    return StepStatus::failure(
-        "adaptive_only", "GSL odeiv2 wrappers are adaptive; the harness calls adaptive_step()");
-  }
-
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
-    if (problem_ == nullptr)
-      return StepStatus::failure("not_reset", "adaptive_step before reset()");
-    if (!setup_status_.ok) return setup_status_;
-    if (&problem != problem_) {
-      return StepStatus::failure("problem_changed",
-                                 "adaptive_step called with another problem than reset()");
-    }
-    if (t_stop == state.t) return StepStatus::success();
-    if (!(t_stop > t_)) {
-      return StepStatus::failure(
-          "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
-    }
-    // The run-total step budget: at a tolerance below round-off GSL keeps accepting steps near
-    // the smallest representable size, and a huge horizon needs ever more steps; both end here.
-    if (counters_.steps >= max_steps_) {
-      return StepStatus::failure(
-          "max_steps", fmt::format("max_steps={} accepted steps taken before t={:.6g} (t_stop "
-                                   "{:.6g}); raise max_steps or loosen rtol/atol",
-                                   max_steps_, t_, t_stop));
-    }
+    StepStatus guard;
+    if (!ready_to_step(problem, state, t_stop, guard)) return guard;
     // Tolerances below round-off: GSL would accept ever smaller steps near t = 0 until the
-    // budget above runs out; say so at once, as CVODE does.
-    if (const double ratio =
-            roundoff_tolerance_ratio(y_.data(), static_cast<long>(y_.size()), rtol_, atol_);
-        !(ratio <= 1.0)) {
-      return too_much_accuracy("too_much_accuracy", info().name, t_, rtol_, atol_, ratio);
-    }
+    // step budget runs out; say so at once, as CVODE does.
+    guard = check_tolerances_above_roundoff(y_.data(), static_cast<long>(y_.size()),
+                                            "too_much_accuracy", info().name);
+    if (!guard.ok) return guard;
     // evolve_apply lands exactly on t1 only when the proposed step exceeds t1 − t (it then
     // stamps t = t1). A suggested step that would leave a sliver of less than 1% is stretched
     // to cover it, so the run ends on t_stop without a tiny last step.
@@ -223,14 +185,8 @@ class GslOdeiv2 final : public Integrator {
   }
 
   GslMethod method_;
-  double rtol_, atol_;
-  long max_steps_;
-  const Problem* problem_ = nullptr;
-  StepStatus setup_status_;
-  std::string callback_error_;
   std::vector<double> y_;  // the solver's state of record (q, p)
   std::vector<double> ydot_start_;
-  double t_ = 0.0;
   double h_ = 0.0;  // step size carried across calls
   gsl_odeiv2_system system_{};
   Vec y_buffer_, ydot_buffer_;
@@ -239,16 +195,11 @@ class GslOdeiv2 final : public Integrator {
 };
 
 std::unique_ptr<Integrator> make_gsl(Params& params, GslMethod method) {
-  const double rtol = params.real(
-      "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
-  const double atol = params.real(
-      "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
-  const long max_steps = params.integer(
-      "max_steps", 1000000,
+  const AdaptiveSettings settings = read_adaptive_settings(
+      params,
       "maximum number of accepted steps over the whole run (the run then fails with status "
-      "max_steps)",
-      1, 1000000000000L);
-  return std::make_unique<GslOdeiv2>(method, rtol, atol, max_steps);
+      "max_steps)");
+  return std::make_unique<GslOdeiv2>(method, settings);
 }
 
 }  // namespace

@@ -8,29 +8,15 @@
 #include <optional>
 #include <string>
 
+#include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 
 namespace geomint {
 namespace {
 
-enum class ForceSlot { kMinus, kPlus, kSplit };
-enum class ForceAt { kNode, kMidpoint };
-
-// Same meaning as in discrete_lagrangian.cpp (see the forced-Noether note there).
-struct Forcing {
-  ForceSlot slot = ForceSlot::kSplit;
-  ForceAt at = ForceAt::kMidpoint;
-  double minus_weight() const {
-    return slot == ForceSlot::kMinus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
-  }
-  double plus_weight() const {
-    return slot == ForceSlot::kPlus ? 1.0 : slot == ForceSlot::kSplit ? 0.5 : 0.0;
-  }
-};
-
 // Update from (q_k, p_k), with q^α = q_k + αhv and the impulses F_d∓ of the force_slot/force_at
-// options (defined as in discrete_lagrangian.cpp, whose α-rule is the same map):
+// options (integrators/forcing.hpp; discrete_lagrangian.cpp's α-rule is the same map):
 //   1. solve R(v) = Mv − p_k + (1−α)h∇V(q^α) − F_d⁻(v) = 0   (α = 0: ∇V(q_k), explicit)
 //   2. q_{k+1} = q_k + hv,   3. p_{k+1} = Mv − αh∇V(q^α) + F_d⁺(v).
 // v = (q_{k+1} − q_k)/h is the HP velocity variable; it is kept inside the integrator (velocity()),
@@ -69,12 +55,9 @@ struct Forcing {
 // exact objective.
 class HamiltonPontryagin final : public Integrator {
  public:
-  HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, double tolerance,
-                     int max_iterations)
-      : alpha_(alpha), minimize_(minimize), forcing_(forcing) {
+  HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, const NewtonOptions& newton)
+      : alpha_(alpha), minimize_(minimize), forcing_(forcing), newton_(newton) {
     NewtonOptions& options = newton_.options();
-    options.tolerance = tolerance;
-    options.max_iterations = max_iterations;
     options.polish = true;  // momentum maps to round-off, not to the tolerance
     options.line_search = minimize;
   }
@@ -86,6 +69,10 @@ class HamiltonPontryagin final : public Integrator {
     return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
             "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
             "§4; docs/METHOD.md §4"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return alpha_rule_stability(alpha_);
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
@@ -103,10 +90,7 @@ class HamiltonPontryagin final : public Integrator {
   StepStatus step(const Problem& problem, State& state, double h) override {
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
-    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
-      mass_diagonal_ = mass;
-      mass_matrix_ = SparseMatrix(mass.asDiagonal());
-    }
+    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     minus_ = forced ? forcing_.minus_weight() : 0.0;
     const double plus = forced ? forcing_.plus_weight() : 0.0;
@@ -142,16 +126,12 @@ class HamiltonPontryagin final : public Integrator {
       eval_gradient(problem, q1, gradient_);
       p1 -= h * gradient_;
     }
-    if (plus > 0.0) {
-      const bool node = forcing_.at == ForceAt::kNode;
-      eval_counted_force(problem, node ? q1 : Vec(state.q + (h / 2) * v), v,
-                         node ? state.t + h : state.t + h / 2, force_);
-      p1 += (plus * h) * force_;
-    }
-    velocity_ = v;
+    if (plus > 0.0)
+      add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     state.q = q1;
     state.p = p1;
     state.t += h;
+    velocity_ = v;
     ++counters_.steps;
     return StepStatus::success();
   }
@@ -159,10 +139,8 @@ class HamiltonPontryagin final : public Integrator {
  private:
   StepStatus solve(const Problem& problem, const State& state, bool coupled, Vec& v) {
     const Vec& mass = problem.mass();
-    if (minus_ > 0.0 && problem.has(kForceJacobian) && !damping_symmetric_) {
-      // Decided once per run: C = −∂F/∂v is symmetric for dissipative forces, not gyroscopic.
-      problem.force_jacobian_v(state.q, v, state.t, damping_);
-      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
+    if (minus_ > 0.0) {
+      decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
     }
     // The exact-objective form needs −F_d⁻ to be a gradient in v (see the file comment).
     linearised_ = false;
@@ -275,16 +253,16 @@ class HamiltonPontryagin final : public Integrator {
     eval_force(problem, q, v, t, f);
   }
 
-  // F_d⁻(v) = w⁻·h·F(x⁻, v, t⁻) with x⁻ = q_k (node) or q_k + (h/2)v (midpoint).
+  ImpulseStep impulse_step() const { return {q0_, t0_, h_, minus_}; }
+
+  // F_d⁻(v) = w⁻·h·F(x⁻, v, t⁻), with the affine model F₀ − C₀v in the dissipation-potential form.
   void minus_impulse(const Problem& problem, const Vec& v, Vec& impulse) {
     if (linearised_) {
       impulse = force_zero_ - damping_zero_ * v;
-    } else if (forcing_.at == ForceAt::kNode) {
-      eval_counted_force(problem, q0_, v, t0_, impulse);
+      impulse *= minus_ * h_;
     } else {
-      eval_counted_force(problem, q0_ + (h_ / 2) * v, v, t0_ + h_ / 2, impulse);
+      geomint::minus_impulse(problem, forcing_, impulse_step(), v, impulse, counters_);
     }
-    impulse *= minus_ * h_;
   }
 
   // implicit_term_ = (1−α)h∇V(q^α(v)) − F_d⁻(v), memoised on v so that the gradient at the
@@ -304,25 +282,13 @@ class HamiltonPontryagin final : public Integrator {
     memo_v_ = v;
   }
 
-  // −∂F_d⁻/∂v = w⁻·h·C. Exact at the node; at the midpoint the (h/2)∂F/∂q part is left out
-  // (problems do not provide it): only the Newton matrix is approximate, not the solution.
+  // −∂F_d⁻/∂v = w⁻·h·C (forcing.hpp), with C₀ in the dissipation-potential form.
   void add_impulse_jacobian(const Problem& problem, const Vec& v, SparseMatrix& jacobian) {
-    const bool node = forcing_.at == ForceAt::kNode;
     if (linearised_) {
       jacobian += (minus_ * h_) * damping_zero_;
-    } else if (problem.has(kForceJacobian)) {
-      problem.force_jacobian_v(node ? q0_ : Vec(q0_ + (h_ / 2) * v), v, node ? t0_ : t0_ + h_ / 2,
-                               damping_);
-      jacobian += (minus_ * h_) * damping_;
     } else {
-      jacobian -= central_difference_jacobian(
-          [&](const Vec& x, Vec& impulse) {
-            eval_force(problem, node ? q0_ : Vec(q0_ + (h_ / 2) * x), x, node ? t0_ : t0_ + h_ / 2,
-                       impulse);
-            impulse *= minus_ * h_;
-          },
-          v);
-      counters_.force_evals += 2 * v.size();
+      add_minus_impulse_jacobian(problem, forcing_, impulse_step(), v, jacobian, damping_,
+                                 counters_);
     }
   }
 
@@ -351,22 +317,6 @@ class HamiltonPontryagin final : public Integrator {
   std::optional<bool> dissipation_potential_;  // F affine in v at the node, decided once per run
 };
 
-Forcing read_forcing(Params& params) {
-  Forcing forcing;
-  const std::string slot =
-      params.choice("force_slot", "split", {"minus", "plus", "split"},
-                    "where the step's force impulse h F goes: F_d- (at q_k), F_d+ (at q_k+1), half "
-                    "each");
-  forcing.slot = slot == "minus"  ? ForceSlot::kMinus
-                 : slot == "plus" ? ForceSlot::kPlus
-                                  : ForceSlot::kSplit;
-  const std::string at =
-      params.choice("force_at", "midpoint", {"node", "midpoint"},
-                    "evaluate each impulse's force at its own node, or at q_k+1/2 for all slots");
-  forcing.at = at == "node" ? ForceAt::kNode : ForceAt::kMidpoint;
-  return forcing;
-}
-
 }  // namespace
 
 std::unique_ptr<Integrator> make_hp(Params& params) {
@@ -377,13 +327,8 @@ std::unique_ptr<Integrator> make_hp(Params& params) {
       "solver", "minimize", {"minimize", "newton"},
       "minimise E_k with line search and SPD safeguard, or plain Newton on the residual");
   const Forcing forcing = read_forcing(params);
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|grad V| + |F_d-|)",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", forcing, tolerance,
-                                              static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|grad V| + |F_d-|");
+  return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", forcing, newton);
 }
 
 }  // namespace geomint

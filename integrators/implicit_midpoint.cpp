@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 
+#include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 
@@ -24,9 +25,7 @@ namespace {
 // force it is that map with F_d⁻ = F_d⁺ = (h/2)F(q̄, v̄) (force_slot=split, force_at=midpoint).
 class ImplicitMidpoint final : public Integrator {
  public:
-  ImplicitMidpoint(double tolerance, int max_iterations) {
-    newton_.options().tolerance = tolerance;
-    newton_.options().max_iterations = max_iterations;
+  explicit ImplicitMidpoint(const NewtonOptions& newton) : newton_(newton) {
     newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
   }
 
@@ -34,6 +33,10 @@ class ImplicitMidpoint final : public Integrator {
     return {"implicit_midpoint", 2,
             kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
             "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::unconditional();  // |R(iy)| = 1 for every y (GNI §VI.4)
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
@@ -44,17 +47,11 @@ class ImplicitMidpoint final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     const Vec& mass = problem.mass();
-    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
-      mass_diagonal_ = mass;
-      mass_matrix_ = SparseMatrix(mass.asDiagonal());
-    }
+    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double t_mid = state.t + h / 2;
     Vec v = problem.inverse_mass().cwiseProduct(state.p);
-    if (forced && problem.has(kForceJacobian) && !damping_symmetric_) {
-      problem.force_jacobian_v(state.q, v, state.t, damping_);
-      damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
-    }
+    if (forced) decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
 
     // −(h/2)[−∇V(q̄) + F(q̄, v̄, t + h/2)], the implicit part of R, memoised on v̄ (the solver's
     // first evaluation repeats the one for the residual scale).
@@ -126,12 +123,8 @@ class ImplicitMidpoint final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_implicit_midpoint(Params& params) {
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|F|/2)",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<ImplicitMidpoint>(tolerance, static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|F|/2");
+  return std::make_unique<ImplicitMidpoint>(newton);
 }
 
 }  // namespace geomint

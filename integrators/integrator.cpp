@@ -86,6 +86,36 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
 
 void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }
 
+void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatrix& matrix) {
+  const Vec& mass = problem.mass();
+  if (matrix.rows() != problem.dof() || diagonal != mass) {
+    diagonal = mass;
+    matrix = SparseMatrix(mass.asDiagonal());
+  }
+}
+
+Applicability applicable(const Integrator& method, const Problem& problem) {
+  const MethodInfo info = method.info();
+  if ((info.flags & kNeedsHessian) && !problem.has(kHessian)) {
+    return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
+                               info.name, problem.name())};
+  }
+  return {};
+}
+
+StabilityPrediction alpha_rule_stability(double alpha) {
+  if (alpha == 0.5) return StabilityPrediction::unconditional();
+  return StabilityPrediction::limit(1.0 / std::abs(0.5 - alpha));
+}
+
+StabilityPrediction Integrator::predicted_linear_stability() const {
+  if (info().flags & kAdaptive) {
+    return StabilityPrediction::none(
+        "adaptive: error control chooses the step, so there is no fixed-step limit");
+  }
+  return StabilityPrediction::none("");
+}
+
 StepStatus Integrator::adaptive_step(const Problem&, State&, double) {
   return StepStatus::failure("not_adaptive", "method has no adaptive_step; use step()");
 }

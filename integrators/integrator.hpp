@@ -3,6 +3,8 @@
 // Adaptive library solvers implement advance_to() instead of fixed steps.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,6 +43,28 @@ struct StepStatus {
   }
 };
 
+// The linear theory's largest stable step on the undamped harmonic oscillator q̈ = −ω²q
+// (docs/METHOD.md §7; GNI §I.5, §XIII), as a bound on h·ω: +inf when every h is stable, 0 when
+// none is, NaN when there is no prediction — then `reason` says why not. harness/stability.cpp
+// reports it next to the measured limit.
+struct StabilityPrediction {
+  double homega_limit = std::numeric_limits<double>::quiet_NaN();
+  std::string reason;  // why there is no prediction (homega_limit NaN)
+  static StabilityPrediction limit(double homega) { return {homega, ""}; }
+  static StabilityPrediction unconditional() {
+    return {std::numeric_limits<double>::infinity(), ""};
+  }
+  static StabilityPrediction none(std::string why) {
+    return {std::numeric_limits<double>::quiet_NaN(), std::move(why)};
+  }
+  bool predicted() const { return !std::isnan(homega_limit); }
+};
+
+// The α-rule family (hp:alpha, del:rule=alpha and symmetric_alpha, and del's left, right,
+// trapezoid and midpoint rules as α ∈ {0, 1, 0, ½}): Newmark with γ = ½, β = α(1 − α) on linear
+// forces (docs/METHOD.md §1), and ¼ − α(1 − α) = (½ − α)², so Newmark's bound gives hω < 1/|½ − α|.
+StabilityPrediction alpha_rule_stability(double alpha);
+
 struct Counters {
   long steps = 0;
   long force_evals = 0;   // gradient (and force) evaluations
@@ -70,6 +94,11 @@ class Integrator {
   // harness calls it until state.t == t_stop.
   virtual StepStatus adaptive_step(const Problem& problem, State& state, double t_stop);
 
+  // Every method says what the linear theory predicts for its stable step (with its own
+  // parameters), or why it predicts nothing; the default covers adaptive methods only, so a
+  // fixed-step method without an override fails the registry test in harness/stability_test.cpp.
+  virtual StabilityPrediction predicted_linear_stability() const;
+
   const Counters& counters() const { return counters_; }
 
  protected:
@@ -87,6 +116,19 @@ class Integrator {
   friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
   std::string spec_;
 };
+
+// The diagonal mass matrix as a sparse matrix for Newton Jacobians: `matrix` is rebuilt only when
+// the problem's masses differ from `diagonal`, the masses it was last built from.
+void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatrix& matrix);
+
+// Whether a method can run on a problem, and if not why (an InputError message). The one place
+// the harness asks (harness/run.cpp, harness/stability.cpp): rules for new problem kinds
+// (holonomic constraints, first-order-only problems) are added here.
+struct Applicability {
+  bool ok = true;
+  std::string reason;
+};
+Applicability applicable(const Integrator& method, const Problem& problem);
 
 // CVODE's "too much accuracy" test (tolsf, CVODE user guide §2.1): unit roundoff times the
 // weighted RMS norm of y with weights 1/(rtol|y_i| + atol). Above 1 the tolerances ask for less

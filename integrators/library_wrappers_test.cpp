@@ -423,9 +423,16 @@ TEST(JacobianMethods, RefuseProblemsWithoutAHessian) {
     EXPECT_FALSE(run.status.ok) << method;
     EXPECT_EQ(run.status.reason, "needs_hessian") << method;
   }
-  // The harness refuses these pairs up front through the flag.
-  for (const char* method : {"gsl_msbdf", "gsl_rk4imp", "odeint_rosenbrock4"}) {
-    EXPECT_TRUE(make_integrator(method)->info().flags & kNeedsHessian) << method;
+  // The harness refuses these pairs up front through the flag, in applicable().
+  for (const char* method : {"gsl_msbdf", "gsl_rk4imp", "odeint_rosenbrock4", "implicit_euler"}) {
+    const auto integrator = make_integrator(method);
+    EXPECT_TRUE(integrator->info().flags & kNeedsHessian) << method;
+    const Applicability fit = applicable(*integrator, problem);
+    EXPECT_FALSE(fit.ok) << method;
+    EXPECT_NE(fit.reason.find("needs a Hessian"), std::string::npos) << fit.reason;
+  }
+  for (const char* method : {"rk4", "cvode_bdf", "gsl_rk8pd", "hp:alpha=0"}) {
+    EXPECT_TRUE(applicable(*make_integrator(method), problem).ok) << method;
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 
+#include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 
@@ -28,10 +29,8 @@ namespace {
 // is the same object, so a caller that edits the state between steps gets a fresh a₀.
 class Newmark final : public Integrator {
  public:
-  Newmark(double beta, double gamma, double tolerance, int max_iterations)
-      : beta_(beta), gamma_(gamma) {
-    newton_.options().tolerance = tolerance;
-    newton_.options().max_iterations = max_iterations;
+  Newmark(double beta, double gamma, const NewtonOptions& newton)
+      : beta_(beta), gamma_(gamma), newton_(newton) {
     newton_.options().polish = true;  // invariants to round-off, not to the tolerance
   }
 
@@ -49,6 +48,14 @@ class Newmark final : public Integrator {
             "Newmark, Kane-Marsden-Ortiz-West IJNME 2000; docs/METHOD.md §1, §7"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    // Undamped Newmark on ẍ = −ω²x (Hughes 2000, §9.1.2): unconditionally stable for
+    // 2β ≥ γ ≥ ½, otherwise for γ ≥ ½ stable iff hω < 1/√(γ/2 − β); γ < ½ amplifies every mode.
+    if (gamma_ < 0.5) return StabilityPrediction::limit(0.0);
+    if (2 * beta_ >= gamma_) return StabilityPrediction::unconditional();
+    return StabilityPrediction::limit(1.0 / std::sqrt(gamma_ / 2 - beta_));
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     newton_.forget_pattern();
@@ -60,10 +67,7 @@ class Newmark final : public Integrator {
   StepStatus step(const Problem& problem, State& state, double h) override {
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
-    if (mass_matrix_.rows() != problem.dof() || mass_diagonal_ != mass) {
-      mass_diagonal_ = mass;
-      mass_matrix_ = SparseMatrix(mass.asDiagonal());
-    }
+    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool cache_hit = cached_problem_ == &problem && cached_t_ == state.t &&
                            cached_q_.size() == state.q.size() && cached_q_ == state.q &&
                            cached_p_ == state.p;
@@ -82,10 +86,8 @@ class Newmark final : public Integrator {
       eval_gradient(problem, q_predict, gradient_);
       a1 = -inverse_mass.cwiseProduct(gradient_);
     } else {
-      if (forced && problem.has(kForceJacobian) && !damping_symmetric_) {
-        problem.force_jacobian_v(state.q, v0, state.t, damping_);
-        damping_symmetric_ = (damping_ - SparseMatrix(damping_.transpose())).norm() == 0.0;
-      }
+      if (forced)
+        decide_damping_symmetry(problem, state.q, v0, state.t, damping_, damping_symmetric_);
       if (beta_ == 0.0) eval_gradient(problem, q_predict, gradient_);  // constant in a₁
       const auto total_force = [&](const Vec& a, Vec& f) {  // −∇V(q₁) + F(q₁, v₁, t₁)
         const Vec q1 = q_predict + (h * h * beta_) * a;
@@ -189,12 +191,8 @@ std::unique_ptr<Integrator> make_newmark(Params& params) {
   const double gamma = params.real(
       "gamma", 0.5, "velocity weight gamma (1/2: second order, no numerical damping)",
       [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale |p| + h|M a0|)",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<Newmark>(beta, gamma, tolerance, static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
+  return std::make_unique<Newmark>(beta, gamma, newton);
 }
 
 }  // namespace geomint

@@ -51,6 +51,11 @@ struct NewtonOptions {
   int max_spd_shifts = 40;
 };
 
+// The `tol` and `max_iter` options of every implicit method, read once here so that each method
+// accepts the same keys, defaults and ranges; `residual_scale` names what the relative tolerance
+// is relative to (the method's residual_scale passed to NewtonSolver::solve), for the help text.
+NewtonOptions read_newton_options(Params& params, const std::string& residual_scale);
+
 // The nonlinear system R(x) = 0 to solve.
 struct NewtonSystem {
   // R(x); must resize `residual`. Non-finite entries make the solve fail with reason "nan"

@@ -20,6 +20,7 @@
 #include <boost/numeric/odeint/stepper/symplectic_rkn_sb3a_mclachlan.hpp>
 #include <boost/numeric/odeint/stepper/velocity_verlet.hpp>
 
+#include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -40,77 +41,21 @@ Eigen::Map<Vec> view(ublas::vector<double>& v) {
   return {&v.data()[0], static_cast<Eigen::Index>(v.size())};
 }
 
-// Starting step from the size of y and y' in the error norm (Hairer, Nørsett & Wanner I,
-// §II.4, first two stages of the starting-step algorithm); odeint's try_step needs a guess.
-double starting_step(const Vec& y, const Vec& ydot, double rtol, double atol) {
-  const Vec scale = (atol + rtol * y.array().abs()).matrix();
-  const double d0 = std::sqrt((y.array() / scale.array()).square().mean());
-  const double d1 = std::sqrt((ydot.array() / scale.array()).square().mean());
-  if (!(d0 >= 1e-5 && d1 >= 1e-5) || !std::isfinite(d0 / d1)) return 1e-6;
-  return 0.01 * d0 / d1;
-}
-
-struct Tolerances {
-  double rtol = 1e-8;
-  double atol = 1e-10;
-  long max_steps = 1000000;  // accepted steps over the whole run
-};
-
-Tolerances read_tolerances(Params& params) {
-  Tolerances tolerances;
-  tolerances.rtol = params.real(
-      "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
-  tolerances.atol = params.real(
-      "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
-  tolerances.max_steps = params.integer(
-      "max_steps", 1000000,
-      "maximum number of accepted steps over the whole run (the run then fails with status "
-      "max_steps)",
-      1, 1000000000000L);
-  return tolerances;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Controlled steppers: one accepted step per adaptive_step, retrying rejected attempts with the
 // step the controller proposes. The stepper's own state (y, t, step size) is the state of record.
-class OdeintAdaptive : public Integrator {
+class OdeintAdaptive : public AdaptiveIntegrator {
  public:
-  StepStatus step(const Problem&, State&, double) override {
-    return StepStatus::failure("adaptive_only",
-                               "odeint controlled steppers are adaptive; use adaptive_step()");
-  }
-
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
-    if (problem_ == nullptr)
-      return StepStatus::failure("not_reset", "adaptive_step before reset()");
-    if (!setup_status_.ok) return setup_status_;
-    if (&problem != problem_) {
-      return StepStatus::failure("problem_changed",
-                                 "adaptive_step called with another problem than reset()");
-    }
-    if (t_stop == state.t) return StepStatus::success();
-    if (!(t_stop > t_)) {
-      return StepStatus::failure(
-          "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
-    }
-    // The run-total step budget: below round-off tolerances the controller keeps accepting
-    // steps near the smallest representable size, and a huge horizon needs ever more steps.
-    if (counters_.steps >= tolerances_.max_steps) {
-      return StepStatus::failure(
-          "max_steps", fmt::format("max_steps={} accepted steps taken before t={:.6g} (t_stop "
-                                   "{:.6g}); raise max_steps or loosen rtol/atol",
-                                   tolerances_.max_steps, t_, t_stop));
-    }
+    StepStatus status;
+    if (!ready_to_step(problem, state, t_stop, status)) return status;
     // Tolerances below round-off: the controller would accept ever smaller steps near t = 0
-    // until the budget above runs out; say so at once, as CVODE does.
+    // until the step budget runs out; say so at once, as CVODE does.
     y_buffer_.resize(2 * state.q.size());
     y_buffer_ << state.q, state.p;
-    if (const double ratio = roundoff_tolerance_ratio(y_buffer_.data(), y_buffer_.size(),
-                                                      tolerances_.rtol, tolerances_.atol);
-        !(ratio <= 1.0)) {
-      return too_much_accuracy("too_much_accuracy", info().name, t_, tolerances_.rtol,
-                               tolerances_.atol, ratio);
-    }
+    status = check_tolerances_above_roundoff(y_buffer_.data(), y_buffer_.size(),
+                                             "too_much_accuracy", info().name);
+    if (!status.ok) return status;
     // Odeint's own integrate functions give up after 500 failed attempts; so do we.
     constexpr int kMaxAttempts = 500;
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
@@ -153,20 +98,18 @@ class OdeintAdaptive : public Integrator {
   }
 
  protected:
-  explicit OdeintAdaptive(const Tolerances& tolerances) : tolerances_(tolerances) {}
+  explicit OdeintAdaptive(const AdaptiveSettings& settings)
+      : AdaptiveIntegrator(settings, "odeint controlled steppers") {}
 
   // Base reset plus the starting step; derived resets load their state first.
   void begin(const Problem& problem, const State& state, double h) {
-    Integrator::reset(problem, state, h);
-    problem_ = &problem;
-    setup_status_ = StepStatus::success();
-    t_ = state.t;
+    begin_adaptive_reset(problem, state, h);
     y_buffer_.resize(2 * problem.dof());
     y_buffer_ << state.q, state.p;
     try {
       problem.first_order_rhs(t_, y_buffer_, ydot_buffer_);
       ++counters_.force_evals;
-      dt_ = starting_step(y_buffer_, ydot_buffer_, tolerances_.rtol, tolerances_.atol);
+      dt_ = starting_step(y_buffer_, ydot_buffer_, settings_.rtol, settings_.atol);
     } catch (const std::exception& error) {
       setup_status_ = StepStatus::failure("odeint_exception", error.what());
     }
@@ -182,10 +125,6 @@ class OdeintAdaptive : public Integrator {
     problem_->first_order_rhs(t, y, ydot);
   }
 
-  Tolerances tolerances_;
-  const Problem* problem_ = nullptr;
-  StepStatus setup_status_;
-  double t_ = 0.0;
   double dt_ = 0.0;  // the controller's current step size
   Vec y_buffer_, ydot_buffer_;
 };
@@ -197,7 +136,7 @@ class OdeintDopri5 final : public OdeintAdaptive {
   using Stepper = odeint::runge_kutta_dopri5<StdVector>;
   using Controlled = odeint::controlled_runge_kutta<Stepper>;
 
-  explicit OdeintDopri5(const Tolerances& tolerances) : OdeintAdaptive(tolerances) {}
+  explicit OdeintDopri5(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
     return {"odeint_dopri5", 5, kExplicit | kAdaptive,
@@ -208,7 +147,7 @@ class OdeintDopri5 final : public OdeintAdaptive {
     begin(problem, state, h);
     y_.resize(2 * problem.dof());
     view(y_) << state.q, state.p;
-    stepper_.emplace(odeint::make_controlled(tolerances_.atol, tolerances_.rtol, Stepper()));
+    stepper_.emplace(odeint::make_controlled(settings_.atol, settings_.rtol, Stepper()));
   }
 
  private:
@@ -241,7 +180,7 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
   using UblasVector = ublas::vector<double>;
   using UblasMatrix = ublas::matrix<double>;
 
-  explicit OdeintRosenbrock4(const Tolerances& tolerances) : OdeintAdaptive(tolerances) {}
+  explicit OdeintRosenbrock4(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
     return {"odeint_rosenbrock4", 4, kImplicit | kAdaptive | kNeedsHessian,
@@ -256,7 +195,7 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
     }
     y_.resize(2 * problem.dof());
     view(y_) << state.q, state.p;
-    controller_.emplace(tolerances_.atol, tolerances_.rtol);
+    controller_.emplace(settings_.atol, settings_.rtol);
   }
 
  private:
@@ -328,6 +267,10 @@ class OdeintVelocityVerlet final : public Integrator {
             "Boost.Odeint velocity_verlet (Swope et al. 1982; GNI §I.1.4)"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(2.0);  // Störmer–Verlet (GNI §I.5)
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     cached_problem_ = nullptr;
@@ -385,6 +328,11 @@ class OdeintMcLachlan4 final : public Integrator {
             "1995)"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::none(
+        "no formula in geomint: the limit of the 6-stage SB3A splitting is not derived here");
+  }
+
   StepStatus step(const Problem& problem, State& state, double h) override {
     if (StepStatus refused = refuse_force(problem, "odeint_mclachlan4"); !refused.ok) {
       return refused;
@@ -419,13 +367,20 @@ class OdeintMcLachlan4 final : public Integrator {
   Vec gradient_;
 };
 
+AdaptiveSettings read_odeint_settings(Params& params) {
+  return read_adaptive_settings(
+      params,
+      "maximum number of accepted steps over the whole run (the run then fails with status "
+      "max_steps)");
+}
+
 }  // namespace
 
 std::unique_ptr<Integrator> make_odeint_dopri5(Params& params) {
-  return std::make_unique<OdeintDopri5>(read_tolerances(params));
+  return std::make_unique<OdeintDopri5>(read_odeint_settings(params));
 }
 std::unique_ptr<Integrator> make_odeint_rosenbrock4(Params& params) {
-  return std::make_unique<OdeintRosenbrock4>(read_tolerances(params));
+  return std::make_unique<OdeintRosenbrock4>(read_odeint_settings(params));
 }
 std::unique_ptr<Integrator> make_odeint_velocity_verlet(Params&) {
   return std::make_unique<OdeintVelocityVerlet>();

@@ -29,8 +29,8 @@ constexpr double kSameStep = 1e-6;
 class ImplicitPartitionedRk final : public Integrator {
  public:
   ImplicitPartitionedRk(const coefficients::PartitionedTableau& tableau, MethodInfo info,
-                        double tolerance, int max_iterations)
-      : stages_(tableau.stages), info_(std::move(info)) {
+                        const NewtonOptions& newton)
+      : stages_(tableau.stages), info_(std::move(info)), newton_(newton) {
     a_.resize(stages_, stages_);
     a_hat_.resize(stages_, stages_);
     b_.resize(stages_);
@@ -54,12 +54,15 @@ class ImplicitPartitionedRk final : public Integrator {
         extrapolation_(i, j) = weight;
       }
     }
-    newton_.options().tolerance = tolerance;
-    newton_.options().max_iterations = max_iterations;
     newton_.options().polish = true;  // quadratic invariants to round-off, not to the tolerance
   }
 
   MethodInfo info() const override { return info_; }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::none(
+        "no formula in geomint: the partitioned Runge-Kutta tableaux' limits are not derived here");
+  }
 
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
@@ -224,13 +227,8 @@ class ImplicitPartitionedRk final : public Integrator {
 
 std::unique_ptr<Integrator> make_partitioned_rk(const coefficients::PartitionedTableau& tableau,
                                                 MethodInfo info, Params& params) {
-  const double tolerance = params.real(
-      "tol", 1e-12, "Newton relative residual tolerance (scale sqrt(s)(|p| + h|f|))",
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
-  const long max_iterations =
-      params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<ImplicitPartitionedRk>(tableau, std::move(info), tolerance,
-                                                 static_cast<int>(max_iterations));
+  const NewtonOptions newton = read_newton_options(params, "sqrt(s)(|p| + h|f|)");
+  return std::make_unique<ImplicitPartitionedRk>(tableau, std::move(info), newton);
 }
 
 }  // namespace geomint

@@ -12,6 +12,10 @@ class Rk4 final : public Integrator {
     return {"rk4", 4, kExplicit, "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(2.0 * std::sqrt(2.0));  // |R(iy)| ≤ 1 iff y ≤ 2√2 (GNI §VI.4)
+  }
+
   StepStatus step(const Problem& problem, State& state, double h) override {
     const double t = state.t;
     const Vec& q = state.q;

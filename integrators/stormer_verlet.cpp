@@ -24,6 +24,10 @@ class StormerVerlet final : public Integrator {
             "Stormer-Verlet (velocity Verlet), GNI §I.1.4, §VI.3; docs/METHOD.md §1"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     cached_problem_ = nullptr;

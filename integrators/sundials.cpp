@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -83,54 +84,29 @@ void fill_dense(const SparseMatrix& jacobian, double scale, double shift, SUNMat
   }
 }
 
-// Parameters shared by every SUNDIALS wrapper.
-struct SundialsSettings {
-  double rtol = 1e-8;
-  double atol = 1e-10;
-  long max_steps = 1000000;
-};
-
-SundialsSettings read_settings(Params& params) {
-  SundialsSettings settings;
-  settings.rtol = params.real(
-      "rtol", 1e-8, "relative tolerance", [](double v) { return v > 0 && v < 1; }, "in (0, 1)");
-  settings.atol = params.real(
-      "atol", 1e-10, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
-  settings.max_steps = params.integer(
-      "max_steps", 1000000,
+AdaptiveSettings read_settings(Params& params) {
+  return read_adaptive_settings(
+      params,
       "maximum number of internal steps over the whole run (the run fails with flag -1, "
-      "TOO_MUCH_WORK, when it is reached)",
-      1, 1000000000000L);
-  return settings;
+      "TOO_MUCH_WORK, when it is reached)");
 }
 
 // ---------------------------------------------------------------------------------------------
 // Shared plumbing: context, callbacks into the Problem (first_order_rhs/first_order_jacobian),
 // error capture and the run-total step limit.
 //
-// reset() creates the solver; setup problems become setup_status_, reported by the first
-// adaptive_step, because reset() has no status to return. The solver's own y is the state of
-// record: after each step it is copied into State, and edits to State between steps are ignored.
-class SundialsIntegrator : public Integrator {
- public:
-  StepStatus step(const Problem&, State&, double) override {
-    return StepStatus::failure("adaptive_only",
-                               "SUNDIALS wrappers are adaptive; the harness calls adaptive_step()");
-  }
-
+// reset() creates the solver (setup problems: AdaptiveIntegrator::setup_status_). The solver's
+// own y is the state of record.
+class SundialsIntegrator : public AdaptiveIntegrator {
  protected:
-  SundialsIntegrator(const SundialsSettings& settings, std::string library)
-      : settings_(settings), library_(std::move(library)) {}
+  SundialsIntegrator(const AdaptiveSettings& settings, std::string library)
+      : AdaptiveIntegrator(settings, "SUNDIALS wrappers"), library_(std::move(library)) {}
 
   // Base reset, a fresh context and y0 = (q, p). Returns false (setup_status_ set) on failure.
   bool begin_reset(const Problem& problem, const State& state) {
-    Integrator::reset(problem, state, 0.0);
-    problem_ = &problem;
-    setup_status_ = StepStatus::success();
+    begin_adaptive_reset(problem, state, 0.0);
     library_message_.clear();
-    callback_error_.clear();
     extra_rhs_evals_ = extra_jacobian_evals_ = 0;
-    t_ = state.t;
     n_ = 2 * problem.dof();
     y_.reset();  // before the context it was created in
     context_.reset();
@@ -160,41 +136,14 @@ class SundialsIntegrator : public Integrator {
     return setup_failed(flag, fmt::format("{} returned {} {}", call, flag, library_message_));
   }
 
-  // Guards shared by every adaptive_step before it asks the library for a step. Returns false
-  // with `status` set when no library step should be taken (setup failure, t_stop reached or
-  // behind, or the run-total step limit).
-  bool ready_to_step(const Problem& problem, const State& state, double t_stop, long steps_taken,
-                     StepStatus& status) {
-    status = StepStatus::success();
-    if (problem_ == nullptr) {
-      status = StepStatus::failure("not_reset", "adaptive_step called before reset()");
-      return false;
-    }
-    if (!setup_status_.ok) {
-      status = setup_status_;
-      return false;
-    }
-    if (&problem != problem_) {
-      status = StepStatus::failure("problem_changed",
-                                   "adaptive_step called with another problem than reset()");
-      return false;
-    }
-    if (t_stop == state.t) return false;
-    if (!(t_stop > t_)) {
-      status = StepStatus::failure(
-          "bad_t_stop", fmt::format("t_stop={} is not ahead of the solver time {}", t_stop, t_));
-      return false;
-    }
-    // SUNDIALS applies mxstep per call, and in ONE_STEP mode every call takes one step, so the
-    // run-total limit is enforced here and reported as the library's TOO_MUCH_WORK flag (-1).
-    if (steps_taken >= settings_.max_steps) {
-      status = StepStatus::failure(
-          fmt::format("{}_flag_-1", library_),
-          fmt::format("{}: too much work: max_steps={} internal steps taken before t={:.6g}",
-                      library_, settings_.max_steps, t_));
-      return false;
-    }
-    return true;
+  // SUNDIALS applies mxstep per call, and in ONE_STEP mode every call takes one step, so the
+  // run-total limit is enforced by ready_to_step and reported as the library's TOO_MUCH_WORK
+  // flag (-1).
+  StepStatus step_budget_exhausted(double) const override {
+    return StepStatus::failure(
+        fmt::format("{}_flag_-1", library_),
+        fmt::format("{}: too much work: max_steps={} internal steps taken before t={:.6g}",
+                    library_, settings_.max_steps, t_));
   }
 
   StepStatus library_failure(int flag, char* (*lookup)(long int)) {
@@ -251,14 +200,9 @@ class SundialsIntegrator : public Integrator {
         "[{} {}] {}", module ? module : "", function ? function : "", message ? message : "");
   }
 
-  SundialsSettings settings_;
   std::string library_;  // flag prefix: "cvode", "ida", "arkode"
-  const Problem* problem_ = nullptr;
   int n_ = 0;
-  double t_ = 0.0;  // time of the solver's current y
-  StepStatus setup_status_;
   std::string library_message_;
-  std::string callback_error_;
   long extra_rhs_evals_ = 0;       // evaluations made outside the library (IDA's y'(0))
   long extra_jacobian_evals_ = 0;  // ... (the KLU sparsity probe)
   Vec y_buffer_, ydot_buffer_;
@@ -288,7 +232,7 @@ enum class LinearSolverKind { kDense, kKlu };
 
 class Cvode final : public SundialsIntegrator {
  public:
-  Cvode(bool bdf, const SundialsSettings& settings, int max_order, LinearSolverKind solver,
+  Cvode(bool bdf, const AdaptiveSettings& settings, int max_order, LinearSolverKind solver,
         long setup_every, double nonlin_conv_coef)
       : SundialsIntegrator(settings, "cvode"),
         bdf_(bdf),
@@ -362,7 +306,7 @@ class Cvode final : public SundialsIntegrator {
 
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
     StepStatus status;
-    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    if (!ready_to_step(problem, state, t_stop, status)) return status;
     void* cvode = memory_.get();
     int flag = CVodeSetStopTime(cvode, t_stop);
     double t_returned = t_;
@@ -476,7 +420,7 @@ class Cvode final : public SundialsIntegrator {
 // matrix dF/dy + c_j dF/dy' = c_j I − ∂f/∂y, dense.
 class Ida final : public SundialsIntegrator {
  public:
-  Ida(const SundialsSettings& settings, int max_order)
+  Ida(const AdaptiveSettings& settings, int max_order)
       : SundialsIntegrator(settings, "ida"), max_order_(max_order) {}
 
   MethodInfo info() const override {
@@ -529,16 +473,13 @@ class Ida final : public SundialsIntegrator {
 
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
     StepStatus status;
-    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    if (!ready_to_step(problem, state, t_stop, status)) return status;
     // IDA's own too-much-accuracy test (unit roundoff times the weighted RMS norm of y above 1)
     // comes after its initial-step estimate, which overflows first at such tolerances and then
     // reports "tstop is behind current t". The same test here names the real cause.
-    const double tolsf =
-        roundoff_tolerance_ratio(N_VGetArrayPointer(y_.get()), n_, settings_.rtol, settings_.atol);
-    if (!(tolsf <= 1.0)) {
-      return too_much_accuracy("ida_flag_-2", "ida (IDA_TOO_MUCH_ACC)", t_, settings_.rtol,
-                               settings_.atol, tolsf);
-    }
+    status = check_tolerances_above_roundoff(N_VGetArrayPointer(y_.get()), n_, "ida_flag_-2",
+                                             "ida (IDA_TOO_MUCH_ACC)");
+    if (!status.ok) return status;
     void* ida = memory_.get();
     int flag = IDASetStopTime(ida, t_stop);
     double t_returned = t_;
@@ -690,7 +631,7 @@ struct ArkodeDeleter {
 
 class ArkodeErk final : public SundialsIntegrator {
  public:
-  ArkodeErk(const SundialsSettings& settings, std::string table)
+  ArkodeErk(const AdaptiveSettings& settings, std::string table)
       : SundialsIntegrator(settings, "arkode"),
         table_name_(std::move(table)),
         api_(is_fsal(erk_tables().at(table_name_).id) ? &kErkStep : &kArkStepExplicit) {}
@@ -721,7 +662,7 @@ class ArkodeErk final : public SundialsIntegrator {
 
   StepStatus adaptive_step(const Problem& problem, State& state, double t_stop) override {
     StepStatus status;
-    if (!ready_to_step(problem, state, t_stop, counters_.steps, status)) return status;
+    if (!ready_to_step(problem, state, t_stop, status)) return status;
     void* ark = memory_.get();
     int flag = api_->set_stop_time(ark, t_stop);
     double t_returned = t_;
@@ -754,7 +695,7 @@ class ArkodeErk final : public SundialsIntegrator {
 };
 
 std::unique_ptr<Integrator> make_cvode(Params& params, bool bdf) {
-  const SundialsSettings settings = read_settings(params);
+  const AdaptiveSettings settings = read_settings(params);
   const int limit = bdf ? 5 : 12;
   const auto max_order = static_cast<int>(
       params.integer("max_order", limit, "maximum order of the variable-order formulas", 1, limit));
@@ -782,14 +723,14 @@ std::unique_ptr<Integrator> make_cvode_bdf(Params& params) { return make_cvode(p
 std::unique_ptr<Integrator> make_cvode_adams(Params& params) { return make_cvode(params, false); }
 
 std::unique_ptr<Integrator> make_ida(Params& params) {
-  const SundialsSettings settings = read_settings(params);
+  const AdaptiveSettings settings = read_settings(params);
   const auto max_order = static_cast<int>(
       params.integer("max_order", 5, "maximum order of the variable-order BDF formulas", 1, 5));
   return std::make_unique<Ida>(settings, max_order);
 }
 
 std::unique_ptr<Integrator> make_arkode_erk(Params& params) {
-  const SundialsSettings settings = read_settings(params);
+  const AdaptiveSettings settings = read_settings(params);
   std::vector<std::string> names;
   for (const auto& [name, table] : erk_tables()) names.push_back(name);
   const std::string table =

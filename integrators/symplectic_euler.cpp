@@ -16,6 +16,10 @@ class SymplecticEulerA final : public Integrator {
             "symplectic Euler (kick first), GNI §VI.3 Thm 3.3; docs/METHOD.md §1"};
   }
 
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
+  }
+
   StepStatus step(const Problem& problem, State& state, double h) override {
     eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
                      force_);
@@ -38,6 +42,10 @@ class SymplecticEulerB final : public Integrator {
   MethodInfo info() const override {
     return {"symplectic_euler_b", 1, kExplicit | kSymplectic | kVariational,
             "symplectic Euler (drift first), adjoint of GNI §VI.3 Thm 3.3; docs/METHOD.md §1"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
