@@ -25,13 +25,7 @@ using Dense = Eigen::MatrixXd;
 
 constexpr double kPi = std::numbers::pi;
 
-Vec random_vector(int n, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Vec v(n);
-  for (int k = 0; k < n; ++k) v[k] = uniform(generator);
-  return v;
-}
+using test::random_vector;
 
 Eigen::Matrix3d random_rotation(unsigned seed) {
   const Vec r = random_vector(4, seed);

@@ -31,13 +31,7 @@ Vec deformed(const Problem& problem, unsigned seed, double amplitude = 0.2, doub
   return q;
 }
 
-Vec random_vector(int n, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Vec v(n);
-  for (int k = 0; k < n; ++k) v[k] = uniform(generator);
-  return v;
-}
+using test::random_vector;
 
 // Random proper rotation: a normalised random quaternion in 3D, a random angle in 2D.
 Eigen::MatrixXd random_rotation(int dim, unsigned seed) {

@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "problems/problem.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint::test {
@@ -54,6 +56,15 @@ template <class Make>
   }
   if (failures.empty()) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "bad input not rejected as expected:" << failures;
+}
+
+// Reproducible test vector with entries uniform in [-1, 1] (derivative and symmetry checks).
+inline Vec random_vector(int n, unsigned seed) {
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Vec v(n);
+  for (int k = 0; k < n; ++k) v[k] = uniform(generator);
+  return v;
 }
 
 }  // namespace geomint::test
