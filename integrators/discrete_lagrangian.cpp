@@ -97,10 +97,11 @@ Forcing read_forcing(Params& params) {
 class DiscreteLagrangianVI final : public Integrator {
  public:
   DiscreteLagrangianVI(std::string rule, std::vector<Node> nodes, Forcing forcing, double tolerance,
-                       int max_iterations)
+                       int max_iterations, LinearSolverOptions linear)
       : rule_(std::move(rule)), nodes_(std::move(nodes)), forcing_(forcing) {
     newton_.options().tolerance = tolerance;
     newton_.options().max_iterations = max_iterations;
+    newton_.options().linear = linear;
     newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
     double first_moment = 0.0;
     for (const Node& node : nodes_) {
@@ -196,6 +197,7 @@ class DiscreteLagrangianVI final : public Integrator {
       const NewtonResult result = newton_.solve(system, v, residual_scale);
       counters_.newton_iters += result.iterations;
       counters_.linear_solves += result.linear_solves;
+      counters_.factorizations += result.factorizations;
       if (!result.converged) return StepStatus::failure(result.reason, describe(result));
       implicit_terms(problem, v);  // no-op unless the last evaluation was elsewhere
     }
@@ -360,8 +362,9 @@ std::unique_ptr<Integrator> make_del(Params& params) {
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  const LinearSolverOptions linear = read_linear_solver_option(params);
   return std::make_unique<DiscreteLagrangianVI>(label, std::move(nodes), forcing, tolerance,
-                                                static_cast<int>(max_iterations));
+                                                static_cast<int>(max_iterations), linear);
 }
 
 }  // namespace geomint

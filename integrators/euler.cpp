@@ -47,7 +47,8 @@ class ExplicitEuler final : public Integrator {
 //    for the small forced test problems; large forced problems should provide force_jacobian_v.
 class ImplicitEuler final : public Integrator {
  public:
-  ImplicitEuler(double tolerance, int max_iterations) {
+  ImplicitEuler(double tolerance, int max_iterations, LinearSolverOptions linear) {
+    newton_.options().linear = linear;
     newton_.options().tolerance = tolerance;
     newton_.options().max_iterations = max_iterations;
   }
@@ -110,6 +111,7 @@ class ImplicitEuler final : public Integrator {
     const NewtonResult result = newton_.solve(system, velocity, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) {
       end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
       return StepStatus::failure(result.reason, describe(result));
@@ -180,7 +182,8 @@ std::unique_ptr<Integrator> make_implicit_euler(Params& params) {
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<ImplicitEuler>(tolerance, static_cast<int>(max_iterations));
+  const LinearSolverOptions linear = read_linear_solver_option(params);
+  return std::make_unique<ImplicitEuler>(tolerance, static_cast<int>(max_iterations), linear);
 }
 
 }  // namespace geomint

@@ -70,11 +70,12 @@ struct Forcing {
 class HamiltonPontryagin final : public Integrator {
  public:
   HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, double tolerance,
-                     int max_iterations)
+                     int max_iterations, LinearSolverOptions linear)
       : alpha_(alpha), minimize_(minimize), forcing_(forcing) {
     NewtonOptions& options = newton_.options();
     options.tolerance = tolerance;
     options.max_iterations = max_iterations;
+    options.linear = linear;
     options.polish = true;  // momentum maps to round-off, not to the tolerance
     options.line_search = minimize;
   }
@@ -245,6 +246,7 @@ class HamiltonPontryagin final : public Integrator {
     counters_.newton_iters += result.iterations;
     // A shifted refactorisation costs what a linear solve costs: count it as one.
     counters_.linear_solves += result.linear_solves + result.shift_factorisations;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) {
       return StepStatus::failure(result.reason,
                                  fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),
@@ -382,8 +384,9 @@ std::unique_ptr<Integrator> make_hp(Params& params) {
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  const LinearSolverOptions linear = read_linear_solver_option(params);
   return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", forcing, tolerance,
-                                              static_cast<int>(max_iterations));
+                                              static_cast<int>(max_iterations), linear);
 }
 
 }  // namespace geomint

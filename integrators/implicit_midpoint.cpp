@@ -24,7 +24,8 @@ namespace {
 // force it is that map with F_d⁻ = F_d⁺ = (h/2)F(q̄, v̄) (force_slot=split, force_at=midpoint).
 class ImplicitMidpoint final : public Integrator {
  public:
-  ImplicitMidpoint(double tolerance, int max_iterations) {
+  ImplicitMidpoint(double tolerance, int max_iterations, LinearSolverOptions linear) {
+    newton_.options().linear = linear;
     newton_.options().tolerance = tolerance;
     newton_.options().max_iterations = max_iterations;
     newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
@@ -106,6 +107,7 @@ class ImplicitMidpoint final : public Integrator {
     const NewtonResult result = newton_.solve(system, v, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) return StepStatus::failure(result.reason, describe(result));
 
     state.q += h * v;
@@ -131,7 +133,8 @@ std::unique_ptr<Integrator> make_implicit_midpoint(Params& params) {
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<ImplicitMidpoint>(tolerance, static_cast<int>(max_iterations));
+  const LinearSolverOptions linear = read_linear_solver_option(params);
+  return std::make_unique<ImplicitMidpoint>(tolerance, static_cast<int>(max_iterations), linear);
 }
 
 }  // namespace geomint

@@ -28,10 +28,12 @@ namespace {
 // is the same object, so a caller that edits the state between steps gets a fresh a₀.
 class Newmark final : public Integrator {
  public:
-  Newmark(double beta, double gamma, double tolerance, int max_iterations)
+  Newmark(double beta, double gamma, double tolerance, int max_iterations,
+          LinearSolverOptions linear)
       : beta_(beta), gamma_(gamma) {
     newton_.options().tolerance = tolerance;
     newton_.options().max_iterations = max_iterations;
+    newton_.options().linear = linear;
     newton_.options().polish = true;  // invariants to round-off, not to the tolerance
   }
 
@@ -138,6 +140,7 @@ class Newmark final : public Integrator {
       const NewtonResult result = newton_.solve(system, a1, residual_scale);
       counters_.newton_iters += result.iterations;
       counters_.linear_solves += result.linear_solves;
+      counters_.factorizations += result.factorizations;
       if (!result.converged) {
         cached_problem_ = nullptr;
         return StepStatus::failure(result.reason, describe(result));
@@ -194,7 +197,9 @@ std::unique_ptr<Integrator> make_newmark(Params& params) {
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
-  return std::make_unique<Newmark>(beta, gamma, tolerance, static_cast<int>(max_iterations));
+  const LinearSolverOptions linear = read_linear_solver_option(params);
+  return std::make_unique<Newmark>(beta, gamma, tolerance, static_cast<int>(max_iterations),
+                                   linear);
 }
 
 }  // namespace geomint

@@ -29,7 +29,7 @@ constexpr double kSameStep = 1e-6;
 class ImplicitPartitionedRk final : public Integrator {
  public:
   ImplicitPartitionedRk(const coefficients::PartitionedTableau& tableau, MethodInfo info,
-                        double tolerance, int max_iterations)
+                        double tolerance, int max_iterations, LinearSolverOptions linear)
       : stages_(tableau.stages), info_(std::move(info)) {
     a_.resize(stages_, stages_);
     a_hat_.resize(stages_, stages_);
@@ -56,6 +56,7 @@ class ImplicitPartitionedRk final : public Integrator {
     }
     newton_.options().tolerance = tolerance;
     newton_.options().max_iterations = max_iterations;
+    newton_.options().linear = linear;
     newton_.options().polish = true;  // quadratic invariants to round-off, not to the tolerance
   }
 
@@ -170,6 +171,7 @@ class ImplicitPartitionedRk final : public Integrator {
     const NewtonResult result = newton_.solve(system, v, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) return StepStatus::failure(result.reason, describe(result));
 
     evaluate_stages(v);
@@ -229,8 +231,9 @@ std::unique_ptr<Integrator> make_partitioned_rk(const coefficients::PartitionedT
       [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
   const long max_iterations =
       params.integer("max_iter", 50, "Newton iterations per step before the step fails", 1, 10000);
+  const LinearSolverOptions linear = read_linear_solver_option(params);
   return std::make_unique<ImplicitPartitionedRk>(tableau, std::move(info), tolerance,
-                                                 static_cast<int>(max_iterations));
+                                                 static_cast<int>(max_iterations), linear);
 }
 
 }  // namespace geomint
