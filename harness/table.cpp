@@ -19,6 +19,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "harness/blas.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -65,7 +66,7 @@ std::string shorten_number(const std::string& text, int digits) {
 
 std::vector<std::pair<std::string, std::string>> provenance(const std::string& command_line) {
   const auto now = std::chrono::system_clock::now();
-  return {
+  std::vector<std::pair<std::string, std::string>> lines = {
       {"geomint", fmt::format("{} ({})", build_version(), build_git_sha())},
       {"compiler", build_compiler()},
       {"flags", build_flags()},
@@ -78,6 +79,8 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
                            fmt::gmtime(std::chrono::system_clock::to_time_t(now)))},
       {"command", command_line},
   };
+  add_blas_provenance(lines);
+  return lines;
 }
 
 const std::vector<std::string>& standard_columns() {

@@ -72,6 +72,7 @@ struct Counters {
   long hessian_evals = 0;
   long newton_iters = 0;
   long linear_solves = 0;
+  long factorizations = 0;  // numeric factorisations of Newton matrices (NewtonResult)
   long rejected = 0;  // rejected steps (adaptive solvers)
 };
 

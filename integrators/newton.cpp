@@ -4,28 +4,149 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+// clang-format off
+#include <iostream>  // before MetisSupport, which uses std::cerr without including it
+#include <Eigen/MetisSupport>
+// clang-format on
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "problems/spec.hpp"
 
 namespace geomint {
 
+namespace {
+
+using MetisLdlt = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>>;
+
+// Preconditioned conjugate gradients on the lower triangle of A (as the Cholesky solvers read
+// it), from x = 0, until ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient
+// for the curvature test: pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD
+// safeguard needs to know (Nocedal & Wright §5.1 and §7.1, truncated CG).
+enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
+
+template <class Preconditioner>
+CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& preconditioner,
+                            const Vec& b, double target, int max_iterations, Vec& x) {
+  x = Vec::Zero(b.size());
+  Vec r = b;
+  if (r.norm() <= target) return CgOutcome::kConverged;
+  Vec z = preconditioner.solve(r);
+  Vec p = z, Ap;
+  double rz = r.dot(z);
+  for (int k = 0; k < max_iterations; ++k) {
+    Ap.noalias() = A.selfadjointView<Eigen::Lower>() * p;
+    const double curvature = p.dot(Ap);
+    if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
+    const double alpha = rz / curvature;
+    x += alpha * p;
+    r -= alpha * Ap;
+    if (r.norm() <= target) return CgOutcome::kConverged;
+    z = preconditioner.solve(r);
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  return CgOutcome::kNoConvergence;
+}
+
+}  // namespace
+
+LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
+  if (kind != LinearSolverKind::kAuto) return kind;
+  return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
+}
+
+const char* linear_solver_name(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::kAuto:
+      return "auto";
+    case LinearSolverKind::kLdlt:
+      return "ldlt";
+    case LinearSolverKind::kLdltMetis:
+      return "ldlt_metis";
+    case LinearSolverKind::kCholmod:
+      return "cholmod";
+    case LinearSolverKind::kCg:
+      return "cg";
+    case LinearSolverKind::kCgIchol:
+      return "cg_ichol";
+  }
+  return "auto";
+}
+
+LinearSolverOptions read_linear_solver_option(Params& params) {
+  static const LinearSolverKind kinds[] = {
+      LinearSolverKind::kAuto,    LinearSolverKind::kLdlt, LinearSolverKind::kLdltMetis,
+      LinearSolverKind::kCholmod, LinearSolverKind::kCg,   LinearSolverKind::kCgIchol};
+  std::vector<std::string> names;
+  for (LinearSolverKind kind : kinds) names.push_back(linear_solver_name(kind));
+  LinearSolverOptions options;
+  const std::string name = params.choice(
+      "linear_solver", "auto", names,
+      fmt::format("solver of the symmetric Newton systems (auto: ldlt below {} unknowns, "
+                  "else cg)",
+                  kAutoIterativeFrom));
+  for (LinearSolverKind kind : kinds) {
+    if (name == linear_solver_name(kind)) options.kind = kind;
+  }
+  options.modified_newton = params.flag(
+      "modified_newton", false,
+      "keep one factorisation across Newton iterations and steps while the residual contracts "
+      "fast");
+  params.omit_default_from_canonical("linear_solver");
+  params.omit_default_from_canonical("modified_newton");
+  return options;
+}
+
 struct NewtonSolver::Factorisation {
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  MetisLdlt ldlt_metis;
+  Eigen::CholmodSupernodalLLT<SparseMatrix> cholmod;
+  Eigen::DiagonalPreconditioner<double> diagonal;
+  Eigen::IncompleteCholesky<double, Eigen::Lower> ichol;
   Eigen::SparseLU<SparseMatrix> lu;
   SparseMatrix jacobian;
+  LinearSolverKind kind = LinearSolverKind::kLdlt;  // resolved for the current system
+  // The factorisation held is of this matrix (CG: the matrix itself, kept for the iteration).
+  SparseMatrix factored;
+  bool has_factor = false;       // a usable factorisation of the current system's size is held
+  bool direct_fallback = false;  // CG/CHOLMOD found J indefinite: this factor is an LDLT of it
+  // Modified Newton: the last solve ended contracting fast, so its factorisation may start the
+  // next one.
+  bool keep_factor = false;
+  // Set by the caller before solve(): the residual the CG iteration must reach.
+  double cg_target = 0.0;
   // Pattern of the matrix last passed to analyzePattern, and which factorisation it was for.
   bool has_pattern = false;
   bool pattern_symmetric = false;
+  LinearSolverKind pattern_kind = LinearSolverKind::kLdlt;
   Eigen::Index rows = 0;
   std::vector<SparseMatrix::StorageIndex> outer;
   std::vector<SparseMatrix::StorageIndex> inner;
 
+  Factorisation() {
+    // METIS nested dissection only (CHOLMOD's default also tries AMD and keeps the sparser
+    // factor: on a 3-D mesh METIS wins and the extra analysis is wasted); no messages on stderr —
+    // a non-positive-definite matrix is an expected outcome here (the SPD safeguard).
+    cholmod_common& common = cholmod.cholmod();
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_METIS;
+    common.postorder = 1;
+    common.print = 0;
+  }
+
   bool same_pattern(const SparseMatrix& J, bool symmetric) const {
     if (!has_pattern || symmetric != pattern_symmetric || J.rows() != rows) return false;
+    if (symmetric && kind != pattern_kind) return false;
     const auto* J_outer = J.outerIndexPtr();
     const auto* J_inner = J.innerIndexPtr();
     return std::equal(outer.begin(), outer.end(), J_outer, J_outer + J.outerSize() + 1) &&
@@ -35,38 +156,128 @@ struct NewtonSolver::Factorisation {
   void remember_pattern(const SparseMatrix& J, bool symmetric) {
     has_pattern = true;
     pattern_symmetric = symmetric;
+    pattern_kind = kind;
     rows = J.rows();
     outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
     inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
   }
 
-  // Factorises `jacobian`; false when the factorisation hit a zero pivot.
-  bool factorise(bool symmetric, bool reuse_symbolic, int& analyses) {
-    jacobian.makeCompressed();
-    const bool analyse = !reuse_symbolic || !same_pattern(jacobian, symmetric);
-    if (symmetric) {
-      if (analyse) ldlt.analyzePattern(jacobian);
-      ldlt.factorize(jacobian);
-      if (analyse) {
-        ++analyses;
-        remember_pattern(jacobian, symmetric);
-      }
-      return ldlt.info() == Eigen::Success;
-    }
-    if (analyse) lu.analyzePattern(jacobian);
-    lu.factorize(jacobian);
-    if (analyse) {
-      ++analyses;
-      remember_pattern(jacobian, symmetric);
-    }
-    return lu.info() == Eigen::Success;
+  template <class Solver>
+  bool analyse_and_factorise(Solver& solver, const SparseMatrix& A, bool analyse) {
+    if (analyse) solver.analyzePattern(A);
+    solver.factorize(A);
+    return solver.info() == Eigen::Success;
   }
 
-  // Every pivot of the last LDLT factorisation is positive: the matrix is positive definite.
-  bool positive_pivots() const { return (ldlt.vectorD().array() > 0.0).all(); }
+  // Factorises `matrix` (J or a shifted J) with the solver `kind` (symmetric) or SparseLU; false
+  // when it hit a zero pivot (LDLT, LU) or, for the SPD-only solvers, found the matrix not
+  // positive definite — which the caller then handles (SPD shift, or an LDLT fallback).
+  bool factorise(const SparseMatrix& matrix, bool symmetric, bool reuse_symbolic, int& analyses,
+                 int& factorizations) {
+    has_factor = false;
+    direct_fallback = false;
+    const bool analyse = !reuse_symbolic || !same_pattern(matrix, symmetric);
+    ++factorizations;
+    bool ok = false;
+    if (!symmetric) {
+      ok = analyse_and_factorise(lu, matrix, analyse);
+    } else {
+      switch (kind) {
+        case LinearSolverKind::kLdlt:
+          ok = analyse_and_factorise(ldlt, matrix, analyse);
+          break;
+        case LinearSolverKind::kLdltMetis:
+          ok = analyse_and_factorise(ldlt_metis, matrix, analyse);
+          break;
+        case LinearSolverKind::kCholmod:
+          ok = analyse_and_factorise(cholmod, matrix, analyse);
+          break;
+        case LinearSolverKind::kCg:
+          diagonal.compute(matrix);
+          ok = diagonal.info() == Eigen::Success;
+          break;
+        case LinearSolverKind::kCgIchol:
+          ok = analyse_and_factorise(ichol, matrix, analyse);
+          break;
+        case LinearSolverKind::kAuto:
+          break;  // resolved before
+      }
+      factored = matrix;
+    }
+    if (analyse) {
+      ++analyses;
+      remember_pattern(matrix, symmetric);
+    }
+    has_factor = ok;
+    return ok;
+  }
 
-  void solve(bool symmetric, const Vec& rhs, Vec& out) {
-    out = symmetric ? Vec(ldlt.solve(rhs)) : Vec(lu.solve(rhs));
+  // LDLT (AMD) of the last matrix for a solver that needs positive definiteness when the matrix is
+  // not, and the system has no SPD safeguard: the plain Newton step, as before the choice existed.
+  bool factorise_indefinite(int& factorizations) {
+    ++factorizations;
+    ldlt.compute(factored);
+    has_factor = ldlt.info() == Eigen::Success;
+    direct_fallback = has_factor;
+    return has_factor;
+  }
+
+  bool is_cg() const {
+    return !direct_fallback &&
+           (kind == LinearSolverKind::kCg || kind == LinearSolverKind::kCgIchol);
+  }
+
+  // The held factorisation is of a positive definite matrix. LDLT: every pivot of D positive
+  // (Sylvester's law of inertia); CHOLMOD LLᵀ and CG succeed only then (CG's curvature test is
+  // applied in solve()).
+  bool positive_definite() const {
+    if (!has_factor) return false;
+    if (direct_fallback) return (ldlt.vectorD().array() > 0.0).all();
+    switch (kind) {
+      case LinearSolverKind::kLdlt:
+        return (ldlt.vectorD().array() > 0.0).all();
+      case LinearSolverKind::kLdltMetis:
+        return (ldlt_metis.vectorD().array() > 0.0).all();
+      default:
+        return true;
+    }
+  }
+
+  // Solves with the held factorisation; false when CG met negative curvature or did not reach
+  // cg_target (then `out` is not a usable direction).
+  bool solve(bool symmetric, const Vec& rhs, Vec& out, bool& negative_curvature) {
+    negative_curvature = false;
+    if (!symmetric) {
+      out = lu.solve(rhs);
+      return true;
+    }
+    if (direct_fallback) {
+      out = ldlt.solve(rhs);
+      return true;
+    }
+    const int max_cg = static_cast<int>(std::min<Eigen::Index>(10 * rhs.size() + 100, 100000));
+    CgOutcome outcome = CgOutcome::kConverged;
+    switch (kind) {
+      case LinearSolverKind::kLdlt:
+        out = ldlt.solve(rhs);
+        break;
+      case LinearSolverKind::kLdltMetis:
+        out = ldlt_metis.solve(rhs);
+        break;
+      case LinearSolverKind::kCholmod:
+        out = cholmod.solve(rhs);
+        break;
+      case LinearSolverKind::kCg:
+        outcome = preconditioned_cg(factored, diagonal, rhs, cg_target, max_cg, out);
+        break;
+      case LinearSolverKind::kCgIchol:
+        outcome = preconditioned_cg(factored, ichol, rhs, cg_target, max_cg, out);
+        break;
+      case LinearSolverKind::kAuto:
+        break;
+    }
+    negative_curvature = outcome == CgOutcome::kNegativeCurvature;
+    return outcome == CgOutcome::kConverged;
   }
 };
 
@@ -79,6 +290,7 @@ NewtonOptions read_newton_options(Params& params, const std::string& residual_sc
   options.max_iterations = static_cast<int>(
       params.integer("max_iter", options.max_iterations,
                      "Newton iterations per step before the step fails", 1, 10000));
+  options.linear = read_linear_solver_option(params);
   return options;
 }
 
@@ -88,7 +300,10 @@ NewtonSolver::~NewtonSolver() = default;
 NewtonSolver::NewtonSolver(NewtonSolver&&) noexcept = default;
 NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 
-void NewtonSolver::forget_pattern() { factorisation_->has_pattern = false; }
+void NewtonSolver::forget_pattern() {
+  factorisation_->has_pattern = false;
+  factorisation_->has_factor = false;
+}
 
 namespace {
 
@@ -178,6 +393,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   };
   auto fail = [&](const char* reason) {
     result.reason = reason;
+    f.keep_factor = false;
     return result;
   };
 
@@ -199,12 +415,81 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   }
 
   Vec direction, trial, trial_residual;
+  f.kind = resolve_linear_solver(options_.linear.kind, x.size());
+  const bool modified = options_.linear.modified_newton && !f.is_cg();
+  // The CG iteration stops at a residual tied to Newton's: far below ‖R‖ (fast outer
+  // convergence) and below the threshold (the last correction does not leave an error the
+  // stopping test would see). The stopping test on R itself is unchanged.
+  auto set_cg_target = [&] {
+    f.cg_target = std::max(0.1 * result.threshold, 1e-3 * result.residual_norm);
+  };
+  // Solves J d = −R with the held factorisation (or CG on the held matrix).
+  auto solve_held = [&](const Vec& rhs, Vec& out) {
+    set_cg_target();
+    bool negative_curvature = false;
+    return f.solve(system.symmetric, rhs, out, negative_curvature) && all_finite(out);
+  };
+  // Factorises f.jacobian and solves for the Newton direction. The SPD safeguard shifts J when
+  // the solver finds it not positive definite (a non-positive LDLT pivot, CHOLMOD's
+  // NumericalIssue, CG's curvature test); without the safeguard the SPD-only solvers fall back to
+  // an LDLT of J, the plain Newton step.
+  auto newton_direction = [&]() -> bool {
+    ++result.linear_solves;
+    set_cg_target();
+    bool negative_curvature = false;
+    bool factorised = f.factorise(f.jacobian, system.symmetric, options_.reuse_symbolic,
+                                  result.symbolic_analyses, result.factorizations);
+    // Only the safeguard needs J positive definite; LDLT solves indefinite systems as well.
+    bool solved = false;
+    if (factorised && (!safeguard || f.positive_definite())) {
+      solved = f.solve(system.symmetric, -residual, direction, negative_curvature);
+    }
+    if (solved) return all_finite(direction);
+    if (safeguard) {
+      // J is not positive definite (or singular): shift it towards S until it is. J + μS has the
+      // pattern of J when S's pattern is contained in it (M diagonal, J with a full diagonal), so
+      // the symbolic factorisation is reused.
+      ++result.shifted_iterations;
+      const SparseMatrix unshifted = f.jacobian;
+      // Start one growth step below the last successful shift of this solve: consecutive
+      // iterates usually need a similar μ, and the schedule then costs one or two factorisations.
+      double mu =
+          std::max(options_.spd_shift_initial, result.last_shift / options_.spd_shift_growth);
+      for (int attempt = 0; attempt < options_.max_spd_shifts && !solved;
+           ++attempt, mu *= options_.spd_shift_growth) {
+        f.jacobian = unshifted + mu * system.spd_shift;
+        ++result.shift_factorisations;
+        if (!(f.factorise(f.jacobian, true, options_.reuse_symbolic, result.symbolic_analyses,
+                          result.factorizations) &&
+              f.positive_definite())) {
+          continue;
+        }
+        solved = f.solve(true, -residual, direction, negative_curvature);
+        if (solved) result.last_shift = mu;
+        if (!solved && !negative_curvature) break;  // CG did not converge: shifting won't help
+      }
+      if (solved) return all_finite(direction);
+      f.has_factor = false;
+      return false;
+    }
+    if (system.symmetric && !safeguard && f.kind != LinearSolverKind::kLdlt &&
+        f.kind != LinearSolverKind::kLdltMetis && f.factorise_indefinite(result.factorizations)) {
+      solved = f.solve(true, -residual, direction, negative_curvature);
+      return solved && all_finite(direction);
+    }
+    f.has_factor = false;
+    return false;
+  };
+  // Modified Newton: the direction comes from a factorisation of an earlier Jacobian (of this
+  // solve, or of the last one when it ended contracting fast).
+  bool reuse_factor = modified && f.keep_factor && f.has_factor && f.rows == x.size() &&
+                      f.pattern_symmetric == system.symmetric;
   while (true) {
     if (result.residual_norm <= result.threshold) {
       result.converged = true;
-      if (options_.polish && result.iterations > 0) {
-        f.solve(system.symmetric, -residual, direction);
-        if (all_finite(direction)) {
+      f.keep_factor = reuse_factor;
+      if (options_.polish && result.iterations > 0 && f.has_factor) {
+        if (solve_held(-residual, direction)) {
           trial = x + direction;
           evaluate(trial, trial_residual);
           const double polished_norm = trial_residual.norm();
@@ -220,47 +505,28 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     }
     if (result.iterations >= options_.max_iterations) return fail("newton_max_iter");
 
-    system.jacobian(x, f.jacobian);
-    if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
-      throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
-                                         f.jacobian.rows(), f.jacobian.cols(), x.size()));
+    bool stale = false;
+    if (reuse_factor) {
+      ++result.linear_solves;
+      stale = solve_held(-residual, direction);
+      reuse_factor = stale;
     }
-    if (!all_finite(f.jacobian)) return fail("nan");
-    if (system.inner_term_scale) {
-      const double inner = system.inner_term_scale();
-      if (std::isfinite(inner)) {
-        result.threshold = std::max(relative_tolerance * scale, kRoundoffFloor * (scale + inner));
+    if (!stale) {
+      system.jacobian(x, f.jacobian);
+      if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
+        throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
+                                           f.jacobian.rows(), f.jacobian.cols(), x.size()));
       }
-    }
-    ++result.linear_solves;
-    const bool factorised =
-        f.factorise(system.symmetric, options_.reuse_symbolic, result.symbolic_analyses);
-    if (safeguard && !(factorised && f.positive_pivots())) {
-      // J is not positive definite (or singular): shift it towards S until it is. J + μS has the
-      // pattern of J when S's pattern is contained in it (M diagonal, J with a full diagonal), so
-      // the symbolic factorisation is reused.
-      ++result.shifted_iterations;
-      const SparseMatrix unshifted = f.jacobian;
-      // Start one growth step below the last successful shift of this solve: consecutive
-      // iterates usually need a similar μ, and the schedule then costs one or two factorisations.
-      double mu =
-          std::max(options_.spd_shift_initial, result.last_shift / options_.spd_shift_growth);
-      bool positive = false;
-      for (int attempt = 0; attempt < options_.max_spd_shifts && !positive;
-           ++attempt, mu *= options_.spd_shift_growth) {
-        f.jacobian = unshifted + mu * system.spd_shift;
-        ++result.shift_factorisations;
-        positive = f.factorise(true, options_.reuse_symbolic, result.symbolic_analyses) &&
-                   f.positive_pivots();
-        if (positive) result.last_shift = mu;
+      if (!all_finite(f.jacobian)) return fail("nan");
+      if (system.inner_term_scale) {
+        const double inner = system.inner_term_scale();
+        if (std::isfinite(inner)) {
+          result.threshold = std::max(relative_tolerance * scale, kRoundoffFloor * (scale + inner));
+        }
       }
-      if (!positive) return fail("linear_solve_failed");
-    } else if (!factorised) {
-      return fail("linear_solve_failed");
+      // A nearly singular matrix factorises without a zero pivot but yields inf/NaN directions.
+      if (!newton_direction()) return fail("linear_solve_failed");
     }
-    f.solve(system.symmetric, -residual, direction);
-    // A nearly singular matrix factorises without a zero pivot but yields inf/NaN here.
-    if (!all_finite(direction)) return fail("linear_solve_failed");
     ++result.iterations;
 
     // Round-off floor in x: a correction below kRoundoffFloor·‖x‖ changes x by no more than its
@@ -284,7 +550,14 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     // Directional derivative of the merit along the step. For ½‖R‖² it is Rᵀ J d = −‖R‖² for
     // the exact Newton step, whatever J is, so the step is always a descent direction.
     const double slope = system.objective ? residual.dot(direction) : -residual.squaredNorm();
-    if (system.objective && options_.line_search && !(slope < 0.0)) return fail("not_descent");
+    if (system.objective && options_.line_search && !(slope < 0.0)) {
+      if (stale) {  // an old Jacobian's direction: retry this iteration with the current one
+        --result.iterations;
+        reuse_factor = false;
+        continue;
+      }
+      return fail("not_descent");
+    }
 
     double step = 1.0;
     bool accepted = false;
@@ -304,6 +577,9 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
         continue;
       }
       any_finite = true;
+      // Without a line search a full step is taken whatever it does to R; from an old Jacobian
+      // only if it reduces ‖R‖ (otherwise the iteration is redone with the current one).
+      if (stale && !options_.line_search && !(trial_residual.norm() < result.residual_norm)) break;
       if (!options_.line_search || trial_merit <= merit + options_.armijo * step * slope) {
         accepted = true;
         break;
@@ -317,12 +593,20 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
         break;
       }
     }
+    if (!accepted && stale) {
+      --result.iterations;
+      reuse_factor = false;
+      continue;
+    }
     if (!accepted) return fail(any_finite ? "line_search_failed" : "nan");
 
     x.swap(trial);
     residual.swap(trial_residual);
     merit = trial_merit;
+    const double previous_norm = result.residual_norm;
     result.residual_norm = residual.norm();
+    reuse_factor = modified && f.has_factor && step == 1.0 &&
+                   result.residual_norm <= kModifiedNewtonContraction * previous_norm;
     if (options_.record_history) result.residual_history.push_back(result.residual_norm);
   }
 }

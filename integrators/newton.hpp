@@ -12,6 +12,48 @@
 
 namespace geomint {
 
+class Params;
+
+// Which solver factorises (or iterates on) a symmetric Newton matrix (README "Scale"; issue 9).
+// Non-symmetric Jacobians always go to SparseLU.
+//  - kLdlt: Eigen SimplicialLDLT, AMD ordering (bit-identical to the results committed before the
+//    choice existed); kLdltMetis: the same with METIS nested-dissection ordering.
+//  - kCholmod: CHOLMOD supernodal LLᵀ (METIS ordering, dense supernodes through the BLAS).
+//  - kCg, kCgIchol: preconditioned conjugate gradients (diagonal or incomplete-Cholesky
+//    preconditioner), solved to a residual tied to the Newton threshold, so the Newton stopping
+//    test — and with it every conservation result — is unchanged.
+//  - kAuto: by the number of unknowns, from the measurements next to kAutoIterativeFrom.
+enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol };
+
+// `auto` picks kLdlt below this many unknowns (every committed result, bit for bit) and kCg from
+// it on. Measured (README "Scale", CPU s of a whole one-step run, 2-core machine under load 5–7):
+//   /usr/bin/time -f "%U %S" build/geomint run --problem elastic_bar:nx=26,ny=8,nz=8
+//     --method hp:linear_solver=cg --dt 0.022 --t-end 0.022 --timing-repeats 0
+// (and ldlt, cholmod; nx=65,ny=16,nz=16 with --dt 0.011; bench/bench_linear_solvers.cpp).
+// 960 tets (825 dof): all three 0.05 s; 9 984 tets (6 561 dof): ldlt 0.80, cholmod 0.44, cg 0.23;
+// 99 840 tets (56 355 dof, h = 0.011): cholmod 10.3, cg 1.7 (ldlt: 343 s, issue 9).
+inline constexpr long kAutoIterativeFrom = 6000;
+
+struct LinearSolverOptions {
+  LinearSolverKind kind = LinearSolverKind::kAuto;
+  // Modified Newton: keep the last factorisation while the iteration contracts the residual by at
+  // least kModifiedNewtonContraction per iteration, across iterations and steps (a new Jacobian
+  // is factorised as soon as it does not). Direct solvers only; CG always uses the current matrix.
+  bool modified_newton = false;
+};
+
+// Largest ‖R_{k+1}‖/‖R_k‖ for which modified Newton keeps its factorisation.
+inline constexpr double kModifiedNewtonContraction = 0.25;
+
+// Reads the method options `linear_solver=` and `modified_newton=` (InputError naming the allowed
+// values). Every method that solves with NewtonSolver calls it next to its tol/max_iter reads.
+LinearSolverOptions read_linear_solver_option(Params& params);
+
+// The solver a LinearSolverOptions::kind resolves to for a system of `unknowns` unknowns.
+LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns);
+// "ldlt", "ldlt_metis", "cholmod", "cg", "cg_ichol", "auto".
+const char* linear_solver_name(LinearSolverKind kind);
+
 // Smallest relative residual the stopping test asks for: R sums a few terms, each rounded to
 // ε of its size, so ‖R‖ cannot reliably get below a small multiple of ε·residual_scale. The
 // same factor bounds the relative Newton correction below which x counts as converged at
@@ -49,6 +91,7 @@ struct NewtonOptions {
   double spd_shift_initial = 1e-3;
   double spd_shift_growth = 10.0;
   int max_spd_shifts = 40;
+  LinearSolverOptions linear;
 };
 
 // The `tol` and `max_iter` options of every implicit method, read once here so that each method
@@ -113,8 +156,11 @@ struct NewtonResult {
   int symbolic_analyses = 0;     // analyzePattern calls (0 when the cached pattern was reused)
   int shifted_iterations = 0;    // iterations whose Jacobian needed the SPD shift
   int shift_factorisations = 0;  // extra numeric factorisations spent on the shift
-  double last_shift = 0.0;       // μ of the last shifted iteration
-  bool polished = false;         // the polishing correction was taken (NewtonOptions::polish)
+  // Numeric factorisations (or preconditioner set-ups, for CG) of any kind, shifted ones included;
+  // below `iterations` under modified Newton.
+  int factorizations = 0;
+  double last_shift = 0.0;  // μ of the last shifted iteration
+  bool polished = false;    // the polishing correction was taken (NewtonOptions::polish)
   // Converged because the Newton correction fell below kRoundoffFloor·‖x‖: x cannot be resolved
   // further in double precision, so the remaining ‖R‖ is the rounding of its terms (a stiff
   // term h·K·q whose own rounding ε·h·‖K‖‖q‖ exceeds tolerance·residual_scale), not an error.
@@ -152,7 +198,7 @@ class NewtonSolver {
   // failure). Never throws on numerical trouble; the result says what happened.
   NewtonResult solve(const NewtonSystem& system, Vec& x, double residual_scale);
 
-  // Drops the cached symbolic factorisation (e.g. on Integrator::reset()).
+  // Drops the cached symbolic and numeric factorisations (e.g. on Integrator::reset()).
   void forget_pattern();
 
   const NewtonOptions& options() const { return options_; }

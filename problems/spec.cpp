@@ -174,10 +174,19 @@ void Params::finish() const {
   }
 }
 
+void Params::omit_default_from_canonical(const std::string& key) {
+  const auto value = canonical_values_.find(key);
+  if (value == canonical_values_.end()) return;
+  for (const ParamDoc& doc : docs_) {
+    if (doc.key == key && doc.default_value == value->second) omitted_at_default_.insert(key);
+  }
+}
+
 std::string Params::canonical() const {
   std::string out = spec_.name;
   char separator = ':';
   for (const auto& [key, value] : canonical_values_) {
+    if (omitted_at_default_.count(key)) continue;
     out += separator;
     out += key + "=" + value;
     separator = ',';

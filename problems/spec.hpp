@@ -64,6 +64,11 @@ class Params {
   // True when the user wrote this key (for parameters whose default depends on others).
   bool given(const std::string& key) const { return spec_.values.count(key) > 0; }
 
+  // Leaves `key` (already read) out of canonical() while it has its default value: for options
+  // that choose how a result is computed, not what (a linear solver run to the same Newton
+  // tolerance), so that adding one does not rename every committed run of the method.
+  void omit_default_from_canonical(const std::string& key);
+
   // Throws InputError naming any key that no getter read, with the list of valid keys.
   void finish() const;
   // "name:key=value,..." with every parameter read, keys sorted; "name" when there are none.
@@ -80,6 +85,7 @@ class Params {
   std::string context_;
   std::vector<ParamDoc> docs_;
   std::map<std::string, std::string> canonical_values_;
+  std::set<std::string> omitted_at_default_;  // omit_default_from_canonical
 };
 
 // Formats a double so that it round-trips and stays short for common values ("0.5", "1e-08").

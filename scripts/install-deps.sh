@@ -9,6 +9,7 @@ PACKAGES=(
   libeigen3-dev libsundials-dev libgsl-dev libboost-dev
   gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libsuitesparse-dev libmetis-dev libopenblas-dev
   clang libclang-rt-14-dev python3
 )
 

@@ -1,0 +1,190 @@
+// The Newton solver's linear solvers (integrators/newton.hpp LinearSolverKind; README "Scale"):
+// every choice gives the same trajectory to the Newton tolerance, at unit and far-from-unit scales,
+// the SPD safeguard works with each, modified Newton saves factorisations, bad values are named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+#include "integrators/newton.hpp"
+#include "problems/spec.hpp"
+
+namespace geomint {
+namespace {
+
+const std::vector<std::string> kSolvers = {"ldlt", "ldlt_metis", "cholmod", "cg", "cg_ichol"};
+
+struct Trajectory {
+  State state;
+  Counters counters;
+};
+
+// `steps` steps of `method` on `problem_spec` at 20× the explicit limit 2/ω_max.
+Trajectory integrate(const std::string& problem_spec, const std::string& method, int steps) {
+  const auto problem = make_problem(problem_spec);
+  const auto integrator = make_integrator(method);
+  Trajectory out{problem->initial_state(), {}};
+  const double h = 20 * 2 / problem->omega_max(out.state.q);
+  integrator->reset(*problem, out.state, h);
+  for (int k = 0; k < steps; ++k) {
+    const StepStatus status = integrator->step(*problem, out.state, h);
+    EXPECT_TRUE(status.ok) << method << " step " << k << ": " << status.message;
+    if (!status.ok) break;
+  }
+  out.counters = integrator->counters();
+  return out;
+}
+
+double relative_difference(const Vec& a, const Vec& b) {
+  return (a - b).lpNorm<Eigen::Infinity>() / b.lpNorm<Eigen::Infinity>();
+}
+
+class SameTrajectory : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SameTrajectory, EverySolverMatchesLdltToTheNewtonTolerance) {
+  // A free, spinning bar (momenta are exact invariants of hp, so a solver that is off shows
+  // there too) at unit scale and at lengths ×1e3, stiffness ×1e9, density ×1e4.
+  const std::vector<std::string> bars = {
+      "elastic_bar:nx=6,ny=2,nz=2,clamp=none",
+      "elastic_bar:nx=6,ny=2,nz=2,clamp=none,length=1000,width=200,height=200,young=1e14,"
+      "density=1e7"};
+  for (const std::string& bar : bars) {
+    const std::string base = GetParam() + (GetParam().find(':') == std::string::npos ? ":" : ",");
+    const Trajectory reference = integrate(bar, base + "linear_solver=ldlt", 10);
+    for (const std::string& solver : kSolvers) {
+      for (const char* modified : {"false", "true"}) {
+        const std::string method =
+            base + "linear_solver=" + solver + ",modified_newton=" + modified;
+        const Trajectory other = integrate(bar, method, 10);
+        // Ten steps, each solved to a relative residual 1e-12 (the conditioning at 20× the
+        // explicit limit amplifies it into the state).
+        EXPECT_LE(relative_difference(other.state.q, reference.state.q), 1e-9) << bar << method;
+        EXPECT_LE(relative_difference(other.state.p, reference.state.p), 1e-9) << bar << method;
+        EXPECT_GT(other.counters.factorizations, 0) << method;
+        if (std::string(modified) == "true" && solver.rfind("cg", 0) != 0) {
+          EXPECT_LT(other.counters.factorizations, other.counters.newton_iters) << method;
+        }
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ImplicitMethods, SameTrajectory,
+                         ::testing::Values("implicit_euler", "hp", "hp:solver=newton",
+                                           "del:rule=midpoint", "implicit_midpoint"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name;
+                           for (char c : info.param)
+                             name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return name;
+                         });
+
+// E(x) = Σ −cos xᵢ + ½c Σ (xᵢ − xᵢ₊₁)², with the identity as SPD shift. From xᵢ = 2 the Hessian
+// is negative definite, so with the safeguard every solver must detect it (LDLT pivots, CHOLMOD's
+// NumericalIssue, CG's curvature test) and shift; the minimiser is x = 0.
+NewtonSystem cosine_chain(int n, double c) {
+  NewtonSystem system;
+  system.symmetric = true;
+  system.objective = [c](const Vec& x) {
+    double e = 0;
+    for (int i = 0; i < x.size(); ++i) e -= std::cos(x[i]);
+    for (int i = 0; i + 1 < x.size(); ++i) e += 0.5 * c * (x[i] - x[i + 1]) * (x[i] - x[i + 1]);
+    return e;
+  };
+  system.residual = [c](const Vec& x, Vec& r) {
+    r = x.array().sin();
+    for (int i = 0; i + 1 < x.size(); ++i) {
+      r[i] += c * (x[i] - x[i + 1]);
+      r[i + 1] -= c * (x[i] - x[i + 1]);
+    }
+  };
+  system.jacobian = [c](const Vec& x, SparseMatrix& J) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < x.size(); ++i) {
+      const double coupling = (i > 0 ? c : 0.0) + (i + 1 < x.size() ? c : 0.0);
+      t.emplace_back(i, i, std::cos(x[i]) + coupling);
+      if (i + 1 < x.size()) {
+        t.emplace_back(i, i + 1, -c);
+        t.emplace_back(i + 1, i, -c);
+      }
+    }
+    J.resize(x.size(), x.size());
+    J.setFromTriplets(t.begin(), t.end());
+  };
+  SparseMatrix identity(n, n);
+  identity.setIdentity();
+  system.spd_shift = identity;
+  return system;
+}
+
+TEST(LinearSolvers, SpdSafeguardShiftsWithEverySolver) {
+  for (LinearSolverKind kind :
+       {LinearSolverKind::kLdlt, LinearSolverKind::kLdltMetis, LinearSolverKind::kCholmod,
+        LinearSolverKind::kCg, LinearSolverKind::kCgIchol}) {
+    NewtonOptions options;
+    options.linear.kind = kind;
+    Vec x = Vec::Constant(8, 2.0);
+    const NewtonResult result = NewtonSolver(options).solve(cosine_chain(8, 0.5), x, 1.0);
+    ASSERT_TRUE(result.converged) << linear_solver_name(kind) << ": " << describe(result);
+    EXPECT_LE(x.lpNorm<Eigen::Infinity>(), 1e-10) << linear_solver_name(kind);
+    EXPECT_GE(result.shifted_iterations, 1) << linear_solver_name(kind);
+  }
+}
+
+TEST(LinearSolvers, IndefiniteMatrixWithoutSafeguardFallsBackToLdlt) {
+  // Plain Newton on R = ∇E (no objective, hence no safeguard) from xᵢ = 2.5 runs to the maximum
+  // xᵢ = π, where J = −I + c·(graph Laplacian) is negative definite: CHOLMOD and CG cannot
+  // factorise or iterate on it; they fall back to LDLT and reach the same root as LDLT does.
+  Vec reference;
+  for (LinearSolverKind kind :
+       {LinearSolverKind::kLdlt, LinearSolverKind::kCholmod, LinearSolverKind::kCg}) {
+    NewtonSystem system = cosine_chain(6, 0.1);
+    system.objective = nullptr;
+    NewtonOptions options;
+    options.linear.kind = kind;
+    Vec x = Vec::Constant(6, 2.5);
+    const NewtonResult result = NewtonSolver(options).solve(system, x, 1.0);
+    ASSERT_TRUE(result.converged) << linear_solver_name(kind) << ": " << describe(result);
+    if (kind != LinearSolverKind::kLdlt) {  // the LDLT fallback is an extra factorisation
+      EXPECT_GT(result.factorizations, result.iterations) << linear_solver_name(kind);
+    }
+    if (reference.size() == 0) reference = x;
+    EXPECT_LE((x - reference).lpNorm<Eigen::Infinity>(), 1e-10) << linear_solver_name(kind);
+  }
+}
+
+TEST(LinearSolvers, AutoPicksByTheNumberOfUnknowns) {
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom - 1),
+            LinearSolverKind::kLdlt);
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom),
+            LinearSolverKind::kCg);
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kCg, 3), LinearSolverKind::kCg);
+}
+
+TEST(LinearSolvers, OptionIsLeftOutOfTheCanonicalSpecAtItsDefault) {
+  EXPECT_EQ(make_integrator("implicit_euler")->spec(), "implicit_euler:max_iter=50,tol=1e-12");
+  EXPECT_EQ(make_integrator("implicit_euler:linear_solver=auto,modified_newton=false")->spec(),
+            "implicit_euler:max_iter=50,tol=1e-12");
+  EXPECT_EQ(make_integrator("implicit_euler:linear_solver=cg,modified_newton=true")->spec(),
+            "implicit_euler:linear_solver=cg,max_iter=50,modified_newton=true,tol=1e-12");
+}
+
+TEST(LinearSolvers, BadValueIsAnInputErrorNamingTheAllowedValues) {
+  for (const char* method :
+       {"implicit_euler", "hp", "del", "newmark", "implicit_midpoint", "gauss", "lobatto3ab"}) {
+    try {
+      make_integrator(std::string(method) + ":linear_solver=lu");
+      ADD_FAILURE() << method << " accepted linear_solver=lu";
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find("linear_solver"), std::string::npos) << message;
+      EXPECT_NE(message.find("auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol"), std::string::npos)
+          << message;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace geomint
