@@ -109,6 +109,7 @@ class ImplicitEuler final : public Integrator {
     const NewtonResult result = newton_.solve(system, velocity, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) {
       end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
       return StepStatus::failure(result.reason, describe(result));

@@ -223,6 +223,7 @@ class HamiltonPontryagin final : public Integrator {
     counters_.newton_iters += result.iterations;
     // A shifted refactorisation costs what a linear solve costs: count it as one.
     counters_.linear_solves += result.linear_solves + result.shift_factorisations;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) {
       return StepStatus::failure(result.reason,
                                  fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),

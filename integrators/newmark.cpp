@@ -140,6 +140,7 @@ class Newmark final : public Integrator {
       const NewtonResult result = newton_.solve(system, a1, residual_scale);
       counters_.newton_iters += result.iterations;
       counters_.linear_solves += result.linear_solves;
+      counters_.factorizations += result.factorizations;
       if (!result.converged) {
         cached_problem_ = nullptr;
         return StepStatus::failure(result.reason, describe(result));

@@ -173,6 +173,7 @@ class ImplicitPartitionedRk final : public Integrator {
     const NewtonResult result = newton_.solve(system, v, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
     if (!result.converged) return StepStatus::failure(result.reason, describe(result));
 
     evaluate_stages(v);
