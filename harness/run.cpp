@@ -167,6 +167,7 @@ void add_counters(Row& row, const Counters& counters) {
   row["hessian_evals"] = std::to_string(counters.hessian_evals);
   row["newton_iters"] = std::to_string(counters.newton_iters);
   row["linear_solves"] = std::to_string(counters.linear_solves);
+  row["factorizations"] = std::to_string(counters.factorizations);
   row["rejected"] = std::to_string(counters.rejected);
 }
 
