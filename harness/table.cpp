@@ -111,6 +111,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "hessian_evals",
                                                    "newton_iters",
                                                    "linear_solves",
+                                                   "factorizations",
                                                    "rejected",
                                                    "wall_s"};
   return columns;
