@@ -303,7 +303,7 @@ int main(int argc, char** argv) {
       }
       fmt::print("{:.3f}\n", study.fit.order);
       fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
-                 study.row.at("declared_order"), study.row.at("points_used"),
+                 study.record.declared_order, to_row(study.record).at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
       return 0;
     }

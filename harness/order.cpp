@@ -145,19 +145,18 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
   }
   study.fit = fit_order(dts, errors);
   const auto method = make_integrator(method_spec);
-  Row& row = study.row;
-  row["problem"] = study.runs.front().record.problem;
-  row["method"] = study.runs.front().record.method;
-  row["t_end"] = format_number(t_end);
-  row["order"] = std::isfinite(study.fit.order) ? fmt::format("{:.3f}", study.fit.order) : "";
-  row["declared_order"] = std::to_string(method->info().order);
-  std::vector<std::string> used;
-  for (int i : study.fit.used) used.push_back(format_number(dts[i]));
-  row["points_used"] = fmt::format("{}", fmt::join(used, " "));
-  row["status"] = std::isfinite(study.fit.order) ? "ok" : "no_fit";
+  OrderRecord& record = study.record;
+  record.problem = study.runs.front().record.problem;
+  record.method = study.runs.front().record.method;
+  record.ran = true;
+  record.t_end = t_end;
+  if (std::isfinite(study.fit.order)) record.order = study.fit.order;
+  record.declared_order = method->info().order;
+  for (int i : study.fit.used) record.points_used.push_back(dts[i]);
+  record.status = std::isfinite(study.fit.order) ? "ok" : "no_fit";
   std::string note = study.fit.note;
   if (!exact) note += std::string(note.empty() ? "" : "; ") + "error vs finest level";
-  if (!note.empty()) row["message"] = note;
+  if (!note.empty()) record.message = note;
   return study;
 }
 

@@ -110,30 +110,48 @@ Row to_row(const RunRecord& record) {
                       name));
     }
   }
-  Row row;
-  for (const auto& column : record_schema()) {
-    if (auto cell = column.value(record)) row[column.name] = std::move(*cell);
-  }
-  return row;
-}
-
-std::vector<Row> to_rows(const std::vector<RunRecord>& records) {
-  std::vector<Row> rows;
-  rows.reserve(records.size());
-  for (const auto& record : records) rows.push_back(to_row(record));
-  return rows;
+  return row_of(record_schema(), record);
 }
 
 std::vector<std::string> record_columns(const std::vector<RunRecord>& records) {
-  std::vector<std::string> columns;
-  for (const auto& column : record_schema()) {
-    if (std::any_of(records.begin(), records.end(),
-                    [&](const RunRecord& r) { return column.value(r).has_value(); })) {
-      columns.push_back(column.name);
-    }
-  }
-  return columns;
+  return columns_of(record_schema(), records);
 }
+
+const std::vector<Column<OrderRecord>>& order_schema() {
+  using Cell = std::optional<std::string>;
+  static const std::vector<Column<OrderRecord>> schema = {
+      {"label", [](const OrderRecord& r) { return r.label; }},
+      {"problem", [](const OrderRecord& r) { return Cell(r.problem); }},
+      {"method", [](const OrderRecord& r) { return Cell(r.method); }},
+      {"order",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         return r.order ? fmt::format("{:.3f}", *r.order) : "";
+       }},
+      {"declared_order",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         return std::to_string(r.declared_order);
+       }},
+      {"points_used",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         std::vector<std::string> dts;
+         for (double dt : r.points_used) dts.push_back(format_number(dt));
+         return fmt::format("{}", fmt::join(dts, " "));
+       }},
+      {"status", [](const OrderRecord& r) { return Cell(r.status); }},
+      {"message", [](const OrderRecord& r) { return r.message; }},
+      {"t_end",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.t_end) return std::nullopt;
+         return format_number(*r.t_end);
+       }},
+  };
+  return schema;
+}
+
+Row to_row(const OrderRecord& record) { return row_of(order_schema(), record); }
 
 std::string records_to_csv(const std::vector<RunRecord>& records,
                            const std::vector<std::pair<std::string, std::string>>& lines) {

@@ -112,5 +112,37 @@ TEST(RunRecord, TablesListOnlyTheColumnsSomeRecordSets) {
   EXPECT_EQ(to_row(failed).at("message"), "");
 }
 
+// A study that ran lists every fit column, empty when there is no fit; one that threw lists
+// none of them (order.csv keeps the layout of the former generic rows).
+TEST(OrderRecord, FitColumnsOnlyForStudiesThatRan) {
+  OrderRecord no_fit;
+  no_fit.problem = "harmonic";
+  no_fit.method = "rk4";
+  no_fit.ran = true;
+  no_fit.declared_order = 4;
+  no_fit.status = "no_fit";
+  no_fit.t_end = 2;
+  OrderRecord fitted = no_fit;
+  fitted.order = 3.99951;
+  fitted.points_used = {0.1, 0.05, 0.025};
+  fitted.status = "ok";
+  OrderRecord failed;
+  failed.problem = "harmonic";
+  failed.method = "rk5";
+  failed.status = "error";
+  failed.message = "unknown method";
+  const Row row = to_row(no_fit);
+  EXPECT_EQ(row.at("order"), "");
+  EXPECT_EQ(row.at("points_used"), "");
+  EXPECT_EQ(row.at("declared_order"), "4");
+  EXPECT_EQ(to_row(fitted).at("order"), "4.000");
+  EXPECT_EQ(to_row(fitted).at("points_used"), "0.1 0.05 0.025");
+  EXPECT_EQ(columns_of(order_schema(), std::vector<OrderRecord>{failed}),
+            (std::vector<std::string>{"problem", "method", "status", "message"}));
+  EXPECT_EQ(columns_of(order_schema(), std::vector<OrderRecord>{failed, no_fit}),
+            (std::vector<std::string>{"problem", "method", "order", "declared_order", "points_used",
+                                      "status", "message", "t_end"}));
+}
+
 }  // namespace
 }  // namespace geomint

@@ -87,11 +87,12 @@ void parallel_for(size_t n, int jobs, Fn&& fn) {
   if (first_error) std::rethrow_exception(first_error);
 }
 
-// The record of a run that threw instead of returning a status (a defect or an input the scene
-// check missed): it is reported like any failure, never crashes the sweep.
-RunRecord error_record(const std::string& problem, const std::string& method,
-                       const std::string& what) {
-  RunRecord record;
+// The record of a run or study that threw instead of returning a status (a defect or an input
+// the scene check missed): it is reported like any failure, never crashes the sweep.
+template <typename Record = RunRecord>
+Record error_record(const std::string& problem, const std::string& method,
+                    const std::string& what) {
+  Record record;
   record.problem = problem;
   record.method = method;
   record.status = "error";
@@ -143,9 +144,6 @@ std::vector<Row> with_short_specs(std::vector<Row> rows) {
   }
   return rows;
 }
-
-const std::vector<std::string> kOrderColumns = {
-    "label", "problem", "method", "order", "declared_order", "points_used", "status", "message"};
 
 }  // namespace
 
@@ -242,7 +240,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
                                 job.block->t_end, job.block->diverge_factor);
       } catch (const std::exception& error) {
         job.study = OrderStudy{};
-        job.study.row = to_row(error_record(job.problem, job.method, error.what()));
+        job.study.record = error_record<OrderRecord>(job.problem, job.method, error.what());
       }
     }
     progress.tick();
@@ -277,16 +275,15 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   lines.emplace_back("variant", options.variant);
   int failed = 0;
   std::vector<RunRecord> summary_records, order_point_records;
-  std::vector<Row> order_rows;
+  std::vector<OrderRecord> order_records;
   for (const auto& job : jobs) {
     summary_records.push_back(job.record);
     failed += !job.ok;
   }
   for (auto& job : order_jobs) {
-    Row row = job.study.row;
-    failed += row.count("status") && row.at("status") == "error";
-    row["label"] = job.label;
-    order_rows.push_back(row);
+    order_records.push_back(job.study.record);
+    order_records.back().label = job.label;
+    failed += job.study.record.status == "error";
     for (const auto& point : job.study.runs) {
       order_point_records.push_back(point.record);
       order_point_records.back().label = job.label;
@@ -295,13 +292,13 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   const fs::path out(options.out_dir);
   SceneTables tables;
   tables.summary = to_rows(summary_records);
-  tables.order = order_rows;
+  tables.order = to_rows(order_records);
   if (!summary_records.empty()) {
     write_file_atomic((out / "summary.csv").string(), records_to_csv(summary_records, lines));
   }
-  if (!order_rows.empty()) {
+  if (!order_records.empty()) {
     write_file_atomic((out / "order.csv").string(),
-                      to_csv(order_rows, column_union(order_rows, kOrderColumns), lines));
+                      to_csv(tables.order, columns_of(order_schema(), order_records), lines));
     // order_points.csv lists the ladder level right after the label, where a reader looks first.
     std::vector<std::string> point_columns = record_columns(order_point_records);
     const auto level = std::find(point_columns.begin(), point_columns.end(), "order_level");

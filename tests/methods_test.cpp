@@ -52,8 +52,8 @@ void expect_declared_order(const std::string& method, const Ladder& ladder) {
   ASSERT_TRUE(std::isfinite(study.fit.order))
       << method << " on " << ladder.problem << ": " << study.fit.note;
   // ±0.3: the tolerance of docs/DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
-  EXPECT_NEAR(study.fit.order, declared, 0.3)
-      << method << " on " << ladder.problem << " (points " << study.row.at("points_used") << ")";
+  EXPECT_NEAR(study.fit.order, declared, 0.3) << method << " on " << ladder.problem << " (points "
+                                              << to_row(study.record).at("points_used") << ")";
 }
 
 TEST_P(EveryMethod, DeclaredOrderOnPendulum) { expect_declared_order(GetParam(), kPendulumLadder); }
