@@ -270,17 +270,15 @@ int main(int argc, char** argv) {
                         out_path));
       }
       const RunResult result = run_one(problem_spec, method_spec, config);
-      const std::vector<Row> rows = {result.row};
-      const std::string csv =
-          to_csv(rows, column_union(rows, standard_columns()), provenance(command_line));
+      const std::string csv = records_to_csv({result.record}, provenance(command_line));
       if (out_path.empty()) {
         std::cout << csv;
       } else {
         write_file_atomic(out_path, csv);
       }
       if (!result.ok) {
-        fmt::print(stderr, "geomint: run failed: {}: {}\n", result.row.at("status"),
-                   result.row.at("message"));
+        fmt::print(stderr, "geomint: run failed: {}: {}\n", result.record.status,
+                   result.record.message.value_or(""));
       }
       return result.ok ? 0 : kExitFailed;
     }
@@ -290,15 +288,14 @@ int main(int argc, char** argv) {
       const OrderStudy study = order_study(problem_spec, method_spec, dt0, static_cast<int>(levels),
                                            t_end, diverge_factor);
       for (const auto& run_result : study.runs) {
-        const auto& row = run_result.row;
+        const Row row = to_row(run_result.record);
         fmt::print(stderr, "dt={:<12} status={:<8} error_final={}\n", row.at("dt"),
                    row.at("status"), row.count("error_final") ? row.at("error_final") : "-");
       }
       if (!out_path.empty()) {
-        std::vector<Row> rows;
-        for (const auto& run_result : study.runs) rows.push_back(run_result.row);
-        write_file_atomic(out_path, to_csv(rows, column_union(rows, standard_columns()),
-                                           provenance(command_line)));
+        std::vector<RunRecord> records;
+        for (const auto& run_result : study.runs) records.push_back(run_result.record);
+        write_file_atomic(out_path, records_to_csv(records, provenance(command_line)));
       }
       if (!std::isfinite(study.fit.order)) {
         fmt::print(stderr, "geomint: no order fit: {}\n", study.fit.note);
@@ -306,7 +303,7 @@ int main(int argc, char** argv) {
       }
       fmt::print("{:.3f}\n", study.fit.order);
       fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
-                 study.row.at("declared_order"), study.row.at("points_used"),
+                 study.record.declared_order, to_row(study.record).at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
       return 0;
     }

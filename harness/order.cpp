@@ -120,16 +120,16 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     config.timing_repeats = 0;
     config.diverge_factor = diverge_factor;
     RunResult result = run_one(problem_spec, method_spec, config);
-    exact = result.metrics.count("error_final") > 0;
+    exact = result.record.metrics.count("error_final") > 0;
     dts.push_back(config.dt);
-    result.row["order_level"] = std::to_string(k);
+    result.record.order_level = k;
     study.runs.push_back(std::move(result));
   }
   for (const auto& run : study.runs) {
     double error = std::numeric_limits<double>::quiet_NaN();
     if (run.ok) {
       if (exact) {
-        error = run.metrics.at("error_final");
+        error = run.record.metrics.at("error_final");
       } else {
         // No exact solution: compare with the finest level (Richardson-style self-convergence).
         const State& finest = study.runs.back().final_state;
@@ -145,19 +145,18 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
   }
   study.fit = fit_order(dts, errors);
   const auto method = make_integrator(method_spec);
-  Row& row = study.row;
-  row["problem"] = study.runs.front().row.at("problem");
-  row["method"] = study.runs.front().row.at("method");
-  row["t_end"] = format_number(t_end);
-  row["order"] = std::isfinite(study.fit.order) ? fmt::format("{:.3f}", study.fit.order) : "";
-  row["declared_order"] = std::to_string(method->info().order);
-  std::vector<std::string> used;
-  for (int i : study.fit.used) used.push_back(format_number(dts[i]));
-  row["points_used"] = fmt::format("{}", fmt::join(used, " "));
-  row["status"] = std::isfinite(study.fit.order) ? "ok" : "no_fit";
+  OrderRecord& record = study.record;
+  record.problem = study.runs.front().record.problem;
+  record.method = study.runs.front().record.method;
+  record.ran = true;
+  record.t_end = t_end;
+  if (std::isfinite(study.fit.order)) record.order = study.fit.order;
+  record.declared_order = method->info().order;
+  for (int i : study.fit.used) record.points_used.push_back(dts[i]);
+  record.status = std::isfinite(study.fit.order) ? "ok" : "no_fit";
   std::string note = study.fit.note;
   if (!exact) note += std::string(note.empty() ? "" : "; ") + "error vs finest level";
-  if (!note.empty()) row["message"] = note;
+  if (!note.empty()) record.message = note;
   return study;
 }
 

@@ -24,7 +24,7 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
 struct OrderStudy {
   OrderFit fit;
   std::vector<RunResult> runs;  // one per ladder level
-  Row row;                      // problem, method, order, declared_order, points_used, ...
+  OrderRecord record;           // the order.csv row
 };
 
 // Ladder length: at least 3 points for a fit, at most kMaxOrderLevels (dt0·2⁻²⁹ is already far

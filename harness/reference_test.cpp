@@ -83,38 +83,40 @@ TEST(Harness, UsesTheReferenceFileAndNamesIt) {
   config.timing_repeats = 0;
   config.reference_dir = dir.string();
   const RunResult coarse = run_one(kNoExact, "stormer_verlet", config);
-  ASSERT_TRUE(coarse.ok) << coarse.row.at("message");
-  EXPECT_EQ(coarse.row.at("reference"), std::filesystem::path(summary.path).filename().string());
-  ASSERT_TRUE(coarse.metrics.count("error_final"));
-  ASSERT_TRUE(coarse.metrics.count("error_max"));
+  ASSERT_TRUE(coarse.ok) << coarse.record.message.value_or("");
+  EXPECT_EQ(coarse.record.reference.value_or(""),
+            std::filesystem::path(summary.path).filename().string());
+  ASSERT_TRUE(coarse.record.metrics.count("error_final"));
+  ASSERT_TRUE(coarse.record.metrics.count("error_max"));
 
   // error_final is the distance to the reference's last row.
   const auto problem = make_problem(kNoExact);
   const auto reference = load_reference(summary.path, *problem);
   const double direct = std::sqrt((coarse.final_state.q - reference->q.back()).squaredNorm() +
                                   (coarse.final_state.p - reference->p.back()).squaredNorm());
-  EXPECT_DOUBLE_EQ(coarse.metrics.at("error_final"), direct);
-  EXPECT_GE(coarse.metrics.at("error_max"), coarse.metrics.at("error_final"));
+  EXPECT_DOUBLE_EQ(coarse.record.metrics.at("error_final"), direct);
+  EXPECT_GE(coarse.record.metrics.at("error_max"), coarse.record.metrics.at("error_final"));
 
   // Stormer-Verlet's second order shows against the reference: halving dt quarters the error.
   config.dt = 0.005;
   const RunResult fine = run_one(kNoExact, "stormer_verlet", config);
-  const double ratio = coarse.metrics.at("error_final") / fine.metrics.at("error_final");
+  const double ratio =
+      coarse.record.metrics.at("error_final") / fine.record.metrics.at("error_final");
   EXPECT_NEAR(ratio, 4.0, 0.4);
-  EXPECT_LT(reference->estimated_error, 1e-3 * fine.metrics.at("error_final"));
+  EXPECT_LT(reference->estimated_error, 1e-3 * fine.record.metrics.at("error_final"));
 
   // A horizon the reference has no row for: no error columns, no reference column.
   config.t_end = 1.7;
   const RunResult off_grid = run_one(kNoExact, "stormer_verlet", config);
-  EXPECT_FALSE(off_grid.metrics.count("error_final"));
-  EXPECT_FALSE(off_grid.row.count("reference"));
+  EXPECT_FALSE(off_grid.record.metrics.count("error_final"));
+  EXPECT_FALSE(off_grid.record.reference.has_value());
 
   // No reference file: no error columns.
   config.t_end = 2.0;
   config.reference_dir = (dir / "empty").string();
   const RunResult without = run_one(kNoExact, "stormer_verlet", config);
-  EXPECT_FALSE(without.metrics.count("error_final"));
-  EXPECT_FALSE(without.row.count("reference"));
+  EXPECT_FALSE(without.record.metrics.count("error_final"));
+  EXPECT_FALSE(without.record.reference.has_value());
   std::filesystem::remove_all(dir);
 }
 

@@ -161,16 +161,6 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   return outcome;
 }
 
-void add_counters(Row& row, const Counters& counters) {
-  row["force_evals"] = std::to_string(counters.force_evals);
-  row["energy_evals"] = std::to_string(counters.energy_evals);
-  row["hessian_evals"] = std::to_string(counters.hessian_evals);
-  row["newton_iters"] = std::to_string(counters.newton_iters);
-  row["linear_solves"] = std::to_string(counters.linear_solves);
-  row["factorizations"] = std::to_string(counters.factorizations);
-  row["rejected"] = std::to_string(counters.rejected);
-}
-
 }  // namespace
 
 void validate_run_config(const RunConfig& config, bool adaptive) {
@@ -233,11 +223,11 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   }
 
   RunResult result;
-  Row& row = result.row;
-  row["problem"] = problem->spec();
-  row["method"] = integrator->spec();
-  if (!adaptive) row["dt"] = format_number(config.dt);
-  row["t_end"] = format_number(config.t_end);
+  RunRecord& record = result.record;
+  record.problem = problem->spec();
+  record.method = integrator->spec();
+  if (!adaptive) record.dt = config.dt;
+  record.t_end = config.t_end;
 
   auto observers = make_metric_observers(*problem);
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
@@ -246,7 +236,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
       auto reference = load_reference(path, *problem);  // InputError when malformed
       if (reference->row_at(problem->initial_state().t + config.t_end) >= 0) {
         observers.push_back(make_reference_observer(std::move(reference)));
-        row["reference"] = std::filesystem::path(path).filename().string();
+        record.reference = std::filesystem::path(path).filename().string();
       }
     }
   }
@@ -264,22 +254,20 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
                                             observer->observe(*problem, s);
                                           if (series) series->observe(*problem, s, last);
                                         });
-  for (const auto& observer : observers) observer->finish(result.metrics);
+  for (const auto& observer : observers) observer->finish(record.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
-  row["status"] = outcome.status.ok ? "ok" : outcome.status.reason;
+  record.status = outcome.status.ok ? "ok" : outcome.status.reason;
   if (!outcome.status.ok) {
-    row["message"] = outcome.status.message;
-    row["t_reached"] = format_number(outcome.t_reached);
+    record.message = outcome.status.message;
+    record.t_reached = outcome.t_reached;
   }
-  row["steps"] = std::to_string(outcome.steps);
-  for (const auto& [key, value] : result.metrics) row[key] = format_number(value);
-  add_counters(row, integrator->counters());
+  record.steps = outcome.steps;
+  record.counters = integrator->counters();
   if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
-    row["wall_s"] =
-        format_number(time_run(problem_spec, method_spec, config, config.timing_repeats));
+    record.wall_s = time_run(problem_spec, method_spec, config, config.timing_repeats);
   }
   return result;
 }

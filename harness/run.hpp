@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "harness/table.hpp"
+#include "harness/record.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -40,10 +40,9 @@ struct RunConfig {
 // (fixed-step methods: the step ending at t_reached + dt, named in the message; adaptive ones:
 // the solver's next internal step).
 struct RunResult {
-  Row row;  // CSV row: identifiers, status, metrics, counters, wall_s
+  RunRecord record;  // identifiers, status, metrics, counters, wall_s
   bool ok = true;
   State final_state;
-  std::map<std::string, double> metrics;  // numeric metrics by column name
 };
 
 // Validates specs and config (InputError on bad input), then runs. Numerical failures are

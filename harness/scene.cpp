@@ -4,11 +4,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <set>
 
 #include "harness/order.hpp"
+#include "harness/record.hpp"
 #include "harness/toml_reader.hpp"
 
 namespace geomint {
@@ -85,6 +87,20 @@ bool quick_number(TomlBlock& reader, const std::string& key, const std::string& 
   return true;
 }
 
+// table_columns picks summary.csv columns for table.md: each must be a column of the run record
+// schema, so a misspelt name is an error instead of an empty column.
+void check_table_columns(const std::vector<std::string>& columns, const std::string& where) {
+  std::vector<std::string> known;
+  for (const auto& column : record_schema()) known.push_back(column.name);
+  for (const auto& name : columns) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      throw InputError(
+          fmt::format("{}: table_columns: '{}' is not a column of summary.csv (one of: {})", where,
+                      name, fmt::join(known, ", ")));
+    }
+  }
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, bool quick) {
@@ -94,6 +110,7 @@ Scene load_scene(const std::string& path, bool quick) {
   scene.title = top.string("title", true);
   scene.description = top.string("description", false);
   scene.table_columns = top.strings("table_columns", false);
+  check_table_columns(scene.table_columns, path);
   const auto run_tables = array_of_tables(root, "runs", path);
   const auto order_tables = array_of_tables(root, "orders", path);
   top.known("runs");

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -33,7 +34,7 @@ struct Job {
   std::string label, problem, method;
   RunConfig config;
   int timing_repeats = 0;
-  Row row;
+  RunRecord record;
   bool ok = true;
 };
 
@@ -86,10 +87,17 @@ void parallel_for(size_t n, int jobs, Fn&& fn) {
   if (first_error) std::rethrow_exception(first_error);
 }
 
-// The row of a run that threw instead of returning a status (a defect or an input the scene
-// check missed): it is reported like any failure, never crashes the sweep.
-Row error_row(const std::string& problem, const std::string& method, const std::string& what) {
-  return {{"problem", problem}, {"method", method}, {"status", "error"}, {"message", what}};
+// The record of a run or study that threw instead of returning a status (a defect or an input
+// the scene check missed): it is reported like any failure, never crashes the sweep.
+template <typename Record = RunRecord>
+Record error_record(const std::string& problem, const std::string& method,
+                    const std::string& what) {
+  Record record;
+  record.problem = problem;
+  record.method = method;
+  record.status = "error";
+  record.message = what;
+  return record;
 }
 
 std::string series_name(const RunBlock& block, const std::string& problem,
@@ -136,9 +144,6 @@ std::vector<Row> with_short_specs(std::vector<Row> rows) {
   }
   return rows;
 }
-
-const std::vector<std::string> kOrderColumns = {
-    "label", "problem", "method", "order", "declared_order", "points_used", "status", "message"};
 
 }  // namespace
 
@@ -221,13 +226,13 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       Job& job = jobs[i];
       try {
         RunResult result = run_one(job.problem, job.method, job.config);
-        job.row = std::move(result.row);
+        job.record = std::move(result.record);
         job.ok = result.ok;
       } catch (const std::exception& error) {
-        job.row = error_row(job.problem, job.method, error.what());
+        job.record = error_record(job.problem, job.method, error.what());
         job.ok = false;
       }
-      job.row["label"] = job.label;
+      job.record.label = job.label;
     } else {
       OrderJob& job = order_jobs[i - jobs.size()];
       try {
@@ -235,7 +240,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
                                 job.block->t_end, job.block->diverge_factor);
       } catch (const std::exception& error) {
         job.study = OrderStudy{};
-        job.study.row = error_row(job.problem, job.method, error.what());
+        job.study.record = error_record<OrderRecord>(job.problem, job.method, error.what());
       }
     }
     progress.tick();
@@ -247,10 +252,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       job.row = stability_search(job.problem, job.method, *job.options).row;
     } catch (const std::exception& error) {
       // E.g. a problem without omega_max given an h*omega range: a row, not a crashed thread.
-      job.row = {{"problem", job.problem},
-                 {"method", job.method},
-                 {"status", "error"},
-                 {"message", error.what()}};
+      job.row = to_row(error_record(job.problem, job.method, error.what()));
     }
     job.row["label"] = job.label;
     progress.tick();
@@ -260,10 +262,9 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (job.timing_repeats == 0) continue;
     if (job.ok) {
       try {
-        job.row["wall_s"] =
-            format_number(time_run(job.problem, job.method, job.config, job.timing_repeats));
+        job.record.wall_s = time_run(job.problem, job.method, job.config, job.timing_repeats);
       } catch (const std::exception& error) {
-        job.row["message"] = fmt::format("timing pass failed: {}", error.what());
+        job.record.message = fmt::format("timing pass failed: {}", error.what());
       }
     }
     progress.tick();
@@ -273,37 +274,41 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
   lines.emplace_back("variant", options.variant);
   int failed = 0;
-  std::vector<Row> summary_rows, order_rows, order_point_rows;
+  std::vector<RunRecord> summary_records, order_point_records;
+  std::vector<OrderRecord> order_records;
   for (const auto& job : jobs) {
-    summary_rows.push_back(job.row);
+    summary_records.push_back(job.record);
     failed += !job.ok;
   }
   for (auto& job : order_jobs) {
-    Row row = job.study.row;
-    failed += row.count("status") && row.at("status") == "error";
-    row["label"] = job.label;
-    order_rows.push_back(row);
-    for (auto point : job.study.runs) {
-      point.row["label"] = job.label;
-      order_point_rows.push_back(point.row);
+    order_records.push_back(job.study.record);
+    order_records.back().label = job.label;
+    failed += job.study.record.status == "error";
+    for (const auto& point : job.study.runs) {
+      order_point_records.push_back(point.record);
+      order_point_records.back().label = job.label;
     }
   }
   const fs::path out(options.out_dir);
-  std::vector<std::string> point_columns = standard_columns();
-  point_columns.insert(point_columns.begin() + 1, "order_level");
   SceneTables tables;
-  tables.summary = summary_rows;
-  tables.order = order_rows;
-  if (!summary_rows.empty()) {
-    write_file_atomic((out / "summary.csv").string(),
-                      to_csv(summary_rows, column_union(summary_rows, standard_columns()), lines));
+  tables.summary = to_rows(summary_records);
+  tables.order = to_rows(order_records);
+  if (!summary_records.empty()) {
+    write_file_atomic((out / "summary.csv").string(), records_to_csv(summary_records, lines));
   }
-  if (!order_rows.empty()) {
+  if (!order_records.empty()) {
     write_file_atomic((out / "order.csv").string(),
-                      to_csv(order_rows, column_union(order_rows, kOrderColumns), lines));
-    write_file_atomic(
-        (out / "order_points.csv").string(),
-        to_csv(order_point_rows, column_union(order_point_rows, point_columns), lines));
+                      to_csv(tables.order, columns_of(order_schema(), order_records), lines));
+    // order_points.csv lists the ladder level right after the label, where a reader looks first.
+    std::vector<std::string> point_columns = record_columns(order_point_records);
+    const auto level = std::find(point_columns.begin(), point_columns.end(), "order_level");
+    if (level != point_columns.end()) {
+      point_columns.erase(level);
+      point_columns.insert(point_columns.begin() + (point_columns.front() == "label"),
+                           "order_level");
+    }
+    write_file_atomic((out / "order_points.csv").string(),
+                      to_csv(to_rows(order_point_records), point_columns, lines));
   }
   if (!stability_jobs.empty()) {
     for (const auto& job : stability_jobs) tables.stability.push_back(job.row);

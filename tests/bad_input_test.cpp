@@ -228,6 +228,13 @@ const std::vector<Case>& cases() {
        "problems",
        {{"scene.toml", scene("[[runs]]\nlabel = 'a'\nmethods = ['rk4']\ndt = 0.1\nt_end = 1.0\n")}},
        {"scene.toml"}},
+      {"SceneTableColumnUnknown",
+       "sweep {dir}/scene.toml",
+       2,
+       "energy_error_max",
+       {{"scene.toml", "title = 'x'\ntable_columns = ['method', 'energy_error_max']\n" + kRunBlock +
+                           "dt = 0.1\nt_end = 1.0\n"}},
+       {"scene.toml"}},
       {"SceneNegativeTEnd",
        "sweep {dir}/scene.toml",
        2,

@@ -22,7 +22,7 @@ double run_metric(const std::string& problem, const std::string& method, double 
   config.timing_repeats = 0;
   const RunResult result = run_one(problem, method, config);
   EXPECT_TRUE(result.ok) << problem << " " << method << " dt " << dt;
-  return result.metrics.at(metric);
+  return result.record.metrics.at(metric);
 }
 
 TEST(SpringChainRuns, StormerVerletConvergesToNormalModes) {
@@ -51,7 +51,7 @@ TEST(SpringChainRuns, FreeChainKeepsLinearMomentum) {
     const RunResult result = run_one(
         "spring_chain:ends=free,model=fpu_beta,n=10,velocity=0.4,amplitude=0.8", method, config);
     ASSERT_TRUE(result.ok) << method;
-    EXPECT_LE(result.metrics.at("momentum_err_max"), 1e-12) << method;
+    EXPECT_LE(result.record.metrics.at("momentum_err_max"), 1e-12) << method;
   }
 }
 
@@ -117,9 +117,9 @@ TEST(SolarSystemRuns, SymplecticMethodsKeepAngularMomentumAndBoundEnergy) {
   config.timing_repeats = 0;
   const RunResult verlet = run_one("outer_solar_system", "stormer_verlet", config);
   ASSERT_TRUE(verlet.ok);
-  EXPECT_LE(verlet.metrics.at("angular_momentum_err_max"), 1e-17);
-  EXPECT_LE(verlet.metrics.at("momentum_err_max"), 1e-17);
-  EXPECT_LE(verlet.metrics.at("energy_err_max"), 2e-5);
+  EXPECT_LE(verlet.record.metrics.at("angular_momentum_err_max"), 1e-17);
+  EXPECT_LE(verlet.record.metrics.at("momentum_err_max"), 1e-17);
+  EXPECT_LE(verlet.record.metrics.at("energy_err_max"), 2e-5);
 }
 
 TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
@@ -136,9 +136,9 @@ TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
     config.t_end = 1.0;
     config.timing_repeats = 0;
     const RunResult result = run_one(problem, entry.name, config);
-    ASSERT_TRUE(result.ok) << entry.name << ": " << result.row.at("message");
-    EXPECT_LE(result.metrics.at("momentum_err_max"), 1e-10) << entry.name;
-    EXPECT_LE(result.metrics.at("angular_momentum_err_max"), 1e-10) << entry.name;
+    ASSERT_TRUE(result.ok) << entry.name << ": " << result.record.message.value_or("");
+    EXPECT_LE(result.record.metrics.at("momentum_err_max"), 1e-10) << entry.name;
+    EXPECT_LE(result.record.metrics.at("angular_momentum_err_max"), 1e-10) << entry.name;
     ++checked;
   }
   EXPECT_GE(checked, 6);
@@ -148,7 +148,7 @@ TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
   config.timing_repeats = 0;
   const RunResult euler = run_one(problem, "implicit_euler", config);
   ASSERT_TRUE(euler.ok);
-  EXPECT_GT(euler.metrics.at("angular_momentum_err_max"), 1e-4);
+  EXPECT_GT(euler.record.metrics.at("angular_momentum_err_max"), 1e-4);
 }
 
 }  // namespace

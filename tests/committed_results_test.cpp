@@ -85,7 +85,7 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
     ++checked;
     const std::string where = committed.at("problem") + " / " + committed.at("method") +
                               " / dt=" + (committed.count("dt") ? committed.at("dt") : "-");
-    for (const auto& [column, value] : rerun.row) {
+    for (const auto& [column, value] : to_row(rerun.record)) {
       if (column.find("wall") != std::string::npos) continue;
       ASSERT_TRUE(committed.count(column))
           << where << ": column " << column << " is not in the committed table; regenerate";

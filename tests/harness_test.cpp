@@ -116,14 +116,15 @@ TEST(Table, RunRowMetricsRoundTripExactly) {
   config.timing_repeats = 0;
   const RunResult result = run_one("kepler:e=0.6", "stormer_verlet", config);
   ASSERT_TRUE(result.ok);
-  ASSERT_GE(result.metrics.size(), 5u);
-  for (const auto& [column, value] : result.metrics) {
-    ASSERT_TRUE(result.row.count(column)) << column;
-    const std::string& text = result.row.at(column);
+  ASSERT_GE(result.record.metrics.size(), 5u);
+  const Row row = to_row(result.record);
+  for (const auto& [column, value] : result.record.metrics) {
+    ASSERT_TRUE(row.count(column)) << column;
+    const std::string& text = row.at(column);
     EXPECT_EQ(std::strtod(text.c_str(), nullptr), value) << column << " written as " << text;
   }
-  EXPECT_EQ(std::strtod(result.row.at("dt").c_str(), nullptr), config.dt);
-  EXPECT_EQ(std::strtod(result.row.at("t_end").c_str(), nullptr), config.t_end);
+  EXPECT_EQ(std::strtod(row.at("dt").c_str(), nullptr), config.dt);
+  EXPECT_EQ(std::strtod(row.at("t_end").c_str(), nullptr), config.t_end);
 }
 
 TEST(Table, AtomicWriteLeavesNoTemporaryFile) {

@@ -52,8 +52,8 @@ void expect_declared_order(const std::string& method, const Ladder& ladder) {
   ASSERT_TRUE(std::isfinite(study.fit.order))
       << method << " on " << ladder.problem << ": " << study.fit.note;
   // ±0.3: the tolerance of docs/DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
-  EXPECT_NEAR(study.fit.order, declared, 0.3)
-      << method << " on " << ladder.problem << " (points " << study.row.at("points_used") << ")";
+  EXPECT_NEAR(study.fit.order, declared, 0.3) << method << " on " << ladder.problem << " (points "
+                                              << to_row(study.record).at("points_used") << ")";
 }
 
 TEST_P(EveryMethod, DeclaredOrderOnPendulum) { expect_declared_order(GetParam(), kPendulumLadder); }
@@ -123,8 +123,8 @@ bool energy_bounded_without_drift(const std::string& method, double* ratio) {
     *ratio = INFINITY;
     return false;
   }
-  const double drift = result.metrics.at("energy_drift");
-  const double err_max = result.metrics.at("energy_err_max");
+  const double drift = result.record.metrics.at("energy_drift");
+  const double err_max = result.record.metrics.at("energy_err_max");
   *ratio = std::abs(drift) * config.t_end / err_max;
   return *ratio < 0.1 && err_max < 0.1;
 }
@@ -182,12 +182,12 @@ TEST_P(EveryMethod, SymplecticKeepsKeplerAngularMomentum) {
   config.t_end = 1000.0;  // 1e5 steps
   config.timing_repeats = 0;
   const RunResult result = run_one("kepler:e=0.6", GetParam(), config);
-  ASSERT_TRUE(result.ok) << result.row.at("message");
+  ASSERT_TRUE(result.ok) << result.record.message.value_or("");
   const double angular0 = std::sqrt(1 - 0.6 * 0.6);
   // Exact conservation up to rounding, which random-walks as eps * sqrt(steps * stages): about
   // 1e-13 for a 5-stage composition over 1e5 steps. The bound is 1e-12, far below RK4's
   // truncation drift (NegativeControl below) and the 1e-10 that separates the two classes.
-  EXPECT_LT(result.metrics.at("angular_momentum_err_max") / angular0, 1e-12);
+  EXPECT_LT(result.record.metrics.at("angular_momentum_err_max") / angular0, 1e-12);
 }
 
 TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
@@ -196,7 +196,7 @@ TEST(NegativeControl, Rk4DoesNotKeepKeplerAngularMomentum) {
   config.t_end = 1000.0;
   config.timing_repeats = 0;
   const RunResult result = run_one("kepler:e=0.6", "rk4", config);
-  EXPECT_GT(result.metrics.at("angular_momentum_err_max"), 1e-10);
+  EXPECT_GT(result.record.metrics.at("angular_momentum_err_max"), 1e-10);
 }
 
 // L → cL (masses and potential scaled by the same c) leaves the equations of motion unchanged, so

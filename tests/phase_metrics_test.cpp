@@ -95,8 +95,9 @@ TEST(PhaseMetrics, StormerVerletOnHarmonicMatchesDiscreteFrequency) {
   const RunResult result = run_one("harmonic", "stormer_verlet", config);
   ASSERT_TRUE(result.ok);
   const double expected_phase = (discrete_omega - 1) * result.final_state.t;
-  EXPECT_NEAR(result.metrics.at("phase_err"), expected_phase, 1e-2 * expected_phase);
-  EXPECT_NEAR(result.metrics.at("period_err"), 1 / discrete_omega - 1, 1e-2 * (discrete_omega - 1));
+  EXPECT_NEAR(result.record.metrics.at("phase_err"), expected_phase, 1e-2 * expected_phase);
+  EXPECT_NEAR(result.record.metrics.at("period_err"), 1 / discrete_omega - 1,
+              1e-2 * (discrete_omega - 1));
   // Circular Kepler orbit: the phase error of a second-order method grows linearly in time and
   // as h² (the discrete orbit's radius changes too, so there is no one-line formula here).
   const auto kepler_phase = [&](double dt, double periods) {
@@ -104,7 +105,7 @@ TEST(PhaseMetrics, StormerVerletOnHarmonicMatchesDiscreteFrequency) {
     config.t_end = periods * 2 * kPi;
     const RunResult kepler = run_one("kepler:e=0", "stormer_verlet", config);
     EXPECT_TRUE(kepler.ok);
-    return kepler.metrics.at("phase_err");
+    return kepler.record.metrics.at("phase_err");
   };
   const double reference = kepler_phase(0.05, 50);
   EXPECT_NEAR(kepler_phase(0.05, 100) / reference, 2, 0.02);

@@ -40,10 +40,10 @@ TEST(StepBudget, EveryAdaptiveMethodStopsAtMaxSteps) {
     ++adaptive;
     const RunResult result = run_one("kepler", entry.name + ":max_steps=40", quiet(0, 1e6));
     EXPECT_FALSE(result.ok) << entry.name;
-    EXPECT_EQ(result.row.at("steps"), "40") << entry.name;
-    EXPECT_NE(result.row.at("message").find("max_steps=40"), std::string::npos)
-        << entry.name << ": " << result.row.at("message");
-    EXPECT_GT(std::stod(result.row.at("t_reached")), 0.0) << entry.name;
+    EXPECT_EQ(result.record.steps, 40) << entry.name;
+    EXPECT_NE(result.record.message.value_or("").find("max_steps=40"), std::string::npos)
+        << entry.name << ": " << result.record.message.value_or("");
+    EXPECT_GT(*result.record.t_reached, 0.0) << entry.name;
     // The same budget is ample for a normal run.
     EXPECT_TRUE(run_one("kepler", entry.name + ":max_steps=100000", quiet(0, 1)).ok) << entry.name;
   }
@@ -59,9 +59,9 @@ TEST(StepBudget, TolerancesBelowRoundoffEndAtOnce) {
     const RunResult result =
         run_one("kepler", entry.name + ":rtol=1e-300,atol=1e-300", quiet(0, 20));
     EXPECT_FALSE(result.ok) << entry.name;
-    EXPECT_EQ(result.row.at("steps"), "0") << entry.name << ": " << result.row.at("message");
-    EXPECT_NE(result.row.at("message").find("accuracy"), std::string::npos)
-        << entry.name << ": " << result.row.at("message");
+    EXPECT_EQ(result.record.steps, 0) << entry.name << ": " << result.record.message.value_or("");
+    EXPECT_NE(result.record.message.value_or("").find("accuracy"), std::string::npos)
+        << entry.name << ": " << result.record.message.value_or("");
   }
   // Pure relative tolerance: every component is 1/rtol in the error norm.
   EXPECT_DOUBLE_EQ(roundoff_tolerance_ratio(std::vector<double>{3, 4}.data(), 2, 1e-300, 0),
@@ -73,21 +73,21 @@ TEST(StepBudget, TolerancesBelowRoundoffEndAtOnce) {
 // 1.01^3000 = 9e12 at t = 300, past the default factor 1e8 (reached after ~1850 steps).
 TEST(DivergeFactor, DefaultStopsAndZeroOrInfinityLetTheRunFinish) {
   const RunResult stopped = run_one("harmonic", "explicit_euler", quiet(0.1, 300));
-  EXPECT_EQ(stopped.row.at("status"), "diverged");
-  const double t_stop = std::stod(stopped.row.at("t_reached"));
+  EXPECT_EQ(stopped.record.status, "diverged");
+  const double t_stop = *stopped.record.t_reached;
   EXPECT_NEAR(t_stop, 0.1 * std::ceil(std::log(1e8) / std::log(1.01)), 0.2);
   for (double factor : {0.0, std::numeric_limits<double>::infinity(), 1e15}) {
     RunConfig config = quiet(0.1, 300);
     config.diverge_factor = factor;
     const RunResult run = run_one("harmonic", "explicit_euler", config);
-    EXPECT_TRUE(run.ok) << factor << ": " << run.row.at("status");
-    EXPECT_GT(run.metrics.at("energy_err_max"), 1e12) << factor;
+    EXPECT_TRUE(run.ok) << factor << ": " << run.record.status;
+    EXPECT_GT(run.record.metrics.at("energy_err_max"), 1e12) << factor;
   }
   RunConfig config = quiet(0.1, 300);
   config.diverge_factor = 1e4;
   const RunResult earlier = run_one("harmonic", "explicit_euler", config);
-  EXPECT_EQ(earlier.row.at("status"), "diverged");
-  EXPECT_LT(std::stod(earlier.row.at("t_reached")), t_stop);
+  EXPECT_EQ(earlier.record.status, "diverged");
+  EXPECT_LT(*earlier.record.t_reached, t_stop);
   config.diverge_factor = -1;
   EXPECT_THROW(run_one("harmonic", "explicit_euler", config), InputError);
 }
@@ -97,10 +97,10 @@ TEST(DivergeFactor, DefaultStopsAndZeroOrInfinityLetTheRunFinish) {
 TEST(TReached, IsTheLastGoodStepPoint) {
   const RunResult fixed = run_one("harmonic:omega=100", "explicit_euler", quiet(0.1, 100));
   ASSERT_FALSE(fixed.ok);
-  EXPECT_DOUBLE_EQ(std::stod(fixed.row.at("t_reached")), 0.1 * std::stol(fixed.row.at("steps")));
+  EXPECT_DOUBLE_EQ(*fixed.record.t_reached, 0.1 * *fixed.record.steps);
   const RunResult adaptive = run_one("kepler", "gsl_rk8pd:max_steps=10", quiet(0, 20));
   ASSERT_FALSE(adaptive.ok);
-  EXPECT_EQ(adaptive.row.at("t_reached"), format_number(adaptive.final_state.t));
+  EXPECT_EQ(to_row(adaptive.record).at("t_reached"), format_number(adaptive.final_state.t));
 }
 
 // The warm start (previous stage velocities extrapolated to the new nodes) must be used on
@@ -110,13 +110,13 @@ TEST(TReached, IsTheLastGoodStepPoint) {
 TEST(WarmStart, GaussAndLobattoContinueAcrossRoundedSteps) {
   const RunResult gauss = run_one("pendulum:theta0=1.5", "gauss:s=3", quiet(0.1, 10));
   ASSERT_TRUE(gauss.ok);
-  EXPECT_LE(std::stol(gauss.row.at("newton_iters")), 115) << "README: 108";
+  EXPECT_LE(gauss.record.counters->newton_iters, 115) << "README: 108";
   // Lobatto IIIA-IIIB s = 4 gains as much (150 before); s = 3 and Gauss s = 2 do not (184 and
   // 187 with the warm start, 167 and 179 when it was mostly skipped): the extrapolated guess is
   // not always better than the explicit-Euler one, but now it is the one documented and used.
   const RunResult lobatto = run_one("pendulum:theta0=1.5", "lobatto3ab:s=4", quiet(0.1, 10));
   ASSERT_TRUE(lobatto.ok);
-  EXPECT_LE(std::stol(lobatto.row.at("newton_iters")), 120) << "measured: 109";
+  EXPECT_LE(lobatto.record.counters->newton_iters, 120) << "measured: 109";
 }
 
 // A run that throws inside a worker thread becomes a row with status `error`; the other runs

@@ -44,16 +44,16 @@ TEST(VariationalMomenta, HpKeepsSpringNetMomentaNewmarkLosesAngularMomentum) {
   for (const char* method :
        {"hp:alpha=0.5,solver=minimize", "hp:alpha=0.5,solver=newton", "del", "implicit_midpoint"}) {
     const RunResult result = run_spring_net(method);
-    ASSERT_TRUE(result.ok) << method << ": " << result.row.at("message");
+    ASSERT_TRUE(result.ok) << method << ": " << result.record.message.value_or("");
     // Absolute metrics (docs/DESIGN.md §3); |L₀| ≈ 19 and |J₀| ≈ 320 here, so 1e-10 is a relative
     // 5e-12 or less: polished Newton solves leave round-off only (measured ≈ 4e-13).
-    EXPECT_LT(result.metrics.at("momentum_err_max"), 1e-10) << method;
-    EXPECT_LT(result.metrics.at("angular_momentum_err_max"), 1e-10) << method;
+    EXPECT_LT(result.record.metrics.at("momentum_err_max"), 1e-10) << method;
+    EXPECT_LT(result.record.metrics.at("angular_momentum_err_max"), 1e-10) << method;
   }
   const RunResult newmark = run_spring_net("newmark:beta=0.25,gamma=0.5");
-  ASSERT_TRUE(newmark.ok) << newmark.row.at("message");
-  EXPECT_LT(newmark.metrics.at("momentum_err_max"), 1e-10);
-  EXPECT_GT(newmark.metrics.at("angular_momentum_err_max"), 1e-8);  // measured ≈ 8e-3
+  ASSERT_TRUE(newmark.ok) << newmark.record.message.value_or("");
+  EXPECT_LT(newmark.record.metrics.at("momentum_err_max"), 1e-10);
+  EXPECT_GT(newmark.record.metrics.at("angular_momentum_err_max"), 1e-8);  // measured ≈ 8e-3
 }
 
 }  // namespace

@@ -1,0 +1,163 @@
+// The run record's column schema and writers (see record.hpp).
+#include "harness/record.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "problems/spec.hpp"
+
+namespace geomint {
+namespace {
+
+// A new field of Counters needs its column in counter_columns() (named, in that order, in
+// standard_columns()): this fails to compile until it has one, so no counter is left out of the
+// tables or written under a second spelling.
+constexpr int kCounterFields = 8;  // steps (from the run loop, not the integrator) + 7 below
+static_assert(sizeof(Counters) == kCounterFields * sizeof(long),
+              "a Counters field was added or removed: update counter_columns() in record.cpp");
+
+const std::vector<std::pair<const char*, long Counters::*>>& counter_columns() {
+  static const std::vector<std::pair<const char*, long Counters::*>> columns = {
+      {"force_evals", &Counters::force_evals},
+      {"energy_evals", &Counters::energy_evals},
+      {"hessian_evals", &Counters::hessian_evals},
+      {"newton_iters", &Counters::newton_iters},
+      {"linear_solves", &Counters::linear_solves},
+      {"factorizations", &Counters::factorizations},
+      {"rejected", &Counters::rejected}};
+  return columns;
+}
+
+// The metric columns: the run of standard_columns() from energy_err_max to perihelion_err, so a
+// metric's name is spelled in one place (table.cpp) for every writer.
+const std::vector<std::string>& metric_columns() {
+  static const std::vector<std::string> columns = [] {
+    const auto& standard = standard_columns();
+    const auto first = std::find(standard.begin(), standard.end(), "energy_err_max");
+    const auto last = std::find(standard.begin(), standard.end(), "perihelion_err");
+    return std::vector<std::string>(first, last + 1);
+  }();
+  return columns;
+}
+
+template <typename T>
+std::function<std::optional<std::string>(const RunRecord&)> text(
+    std::optional<T> RunRecord::*field) {
+  return [field](const RunRecord& record) { return record.*field; };
+}
+
+std::function<std::optional<std::string>(const RunRecord&)> real(
+    std::optional<double> RunRecord::*field) {
+  return [field](const RunRecord& record) -> std::optional<std::string> {
+    if (!(record.*field)) return std::nullopt;
+    return format_number(*(record.*field));
+  };
+}
+
+std::function<std::optional<std::string>(const RunRecord&)> integer(
+    std::optional<long> RunRecord::*field) {
+  return [field](const RunRecord& record) -> std::optional<std::string> {
+    if (!(record.*field)) return std::nullopt;
+    return std::to_string(*(record.*field));
+  };
+}
+
+std::vector<RecordColumn> build_schema() {
+  std::vector<RecordColumn> schema = {
+      {"label", text(&RunRecord::label)},
+      {"problem", [](const RunRecord& r) { return std::optional(r.problem); }},
+      {"method", [](const RunRecord& r) { return std::optional(r.method); }},
+      {"dt", real(&RunRecord::dt)},
+      {"t_end", real(&RunRecord::t_end)},
+      {"status", [](const RunRecord& r) { return std::optional(r.status); }},
+      {"message", text(&RunRecord::message)},
+      {"t_reached", real(&RunRecord::t_reached)},
+      {"steps", integer(&RunRecord::steps)},
+  };
+  for (const auto& name : metric_columns()) {
+    schema.push_back({name, [name](const RunRecord& r) {
+                        const auto found = r.metrics.find(name);
+                        if (found == r.metrics.end()) return std::optional<std::string>();
+                        return std::optional(format_number(found->second));
+                      }});
+  }
+  for (const auto& [name, member] : counter_columns()) {
+    schema.push_back({name, [member = member](const RunRecord& r) {
+                        if (!r.counters) return std::optional<std::string>();
+                        return std::optional(std::to_string((*r.counters).*member));
+                      }});
+  }
+  schema.push_back({"wall_s", real(&RunRecord::wall_s)});
+  schema.push_back({"order_level", integer(&RunRecord::order_level)});
+  schema.push_back({"reference", text(&RunRecord::reference)});
+  return schema;
+}
+
+}  // namespace
+
+const std::vector<RecordColumn>& record_schema() {
+  static const std::vector<RecordColumn> schema = build_schema();
+  return schema;
+}
+
+Row to_row(const RunRecord& record) {
+  for (const auto& [name, value] : record.metrics) {
+    const auto& metrics = metric_columns();
+    if (std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
+      throw std::logic_error(
+          fmt::format("metric '{}' has no column in the run record schema "
+                      "(harness/record.cpp)",
+                      name));
+    }
+  }
+  return row_of(record_schema(), record);
+}
+
+std::vector<std::string> record_columns(const std::vector<RunRecord>& records) {
+  return columns_of(record_schema(), records);
+}
+
+const std::vector<Column<OrderRecord>>& order_schema() {
+  using Cell = std::optional<std::string>;
+  static const std::vector<Column<OrderRecord>> schema = {
+      {"label", [](const OrderRecord& r) { return r.label; }},
+      {"problem", [](const OrderRecord& r) { return Cell(r.problem); }},
+      {"method", [](const OrderRecord& r) { return Cell(r.method); }},
+      {"order",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         return r.order ? fmt::format("{:.3f}", *r.order) : "";
+       }},
+      {"declared_order",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         return std::to_string(r.declared_order);
+       }},
+      {"points_used",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.ran) return std::nullopt;
+         std::vector<std::string> dts;
+         for (double dt : r.points_used) dts.push_back(format_number(dt));
+         return fmt::format("{}", fmt::join(dts, " "));
+       }},
+      {"status", [](const OrderRecord& r) { return Cell(r.status); }},
+      {"message", [](const OrderRecord& r) { return r.message; }},
+      {"t_end",
+       [](const OrderRecord& r) -> Cell {
+         if (!r.t_end) return std::nullopt;
+         return format_number(*r.t_end);
+       }},
+  };
+  return schema;
+}
+
+Row to_row(const OrderRecord& record) { return row_of(order_schema(), record); }
+
+std::string records_to_csv(const std::vector<RunRecord>& records,
+                           const std::vector<std::pair<std::string, std::string>>& lines) {
+  return to_csv(to_rows(records), record_columns(records), lines);
+}
+
+}  // namespace geomint
