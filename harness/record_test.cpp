@@ -97,11 +97,11 @@ TEST(RunRecord, TablesListOnlyTheColumnsSomeRecordSets) {
   run.metrics["energy_err_max"] = 0.25;
   run.counters = Counters{};
   run.counters->force_evals = 40;
-  const std::vector<std::string> expected = {"label",        "problem",       "method",
-                                             "dt",           "t_end",         "status",
-                                             "message",      "steps",         "energy_err_max",
-                                             "force_evals",  "energy_evals",  "hessian_evals",
-                                             "newton_iters", "linear_solves", "rejected"};
+  const std::vector<std::string> expected = {
+      "label",          "problem",       "method",         "dt",
+      "t_end",          "status",        "message",        "steps",
+      "energy_err_max", "force_evals",   "energy_evals",   "hessian_evals",
+      "newton_iters",   "linear_solves", "factorizations", "rejected"};
   EXPECT_EQ(record_columns({failed, run}), expected);
   const Row row = to_row(run);
   EXPECT_EQ(row.at("dt"), "0.1");
