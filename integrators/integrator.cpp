@@ -52,9 +52,15 @@ std::vector<std::string> integrator_test_specs() {
 
 std::vector<std::string> flag_names(unsigned flags) {
   static const std::pair<MethodFlag, const char*> kNames[] = {
-      {kExplicit, "explicit"},       {kImplicit, "implicit"},          {kSymplectic, "symplectic"},
-      {kSymmetric, "symmetric"},     {kVariational, "variational"},    {kAdaptive, "adaptive"},
-      {kConstrained, "constrained"}, {kNeedsHessian, "needs_hessian"},
+      {kExplicit, "explicit"},
+      {kImplicit, "implicit"},
+      {kSymplectic, "symplectic"},
+      {kSymmetric, "symmetric"},
+      {kVariational, "variational"},
+      {kAdaptive, "adaptive"},
+      {kConstrained, "constrained"},
+      {kNeedsHessian, "needs_hessian"},
+      {kConstraintsOnly, "constraints_only"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -100,7 +106,27 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
     return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
                                info.name, problem.name())};
   }
+  if (problem.has(kConstraints) && !(info.flags & kConstrained)) {
+    return {false,
+            fmt::format("method '{}' does not handle holonomic constraints, which problem "
+                        "'{}' has; methods that do: {}",
+                        method.spec(), problem.name(), fmt::join(constrained_methods(), ", "))};
+  }
+  if ((info.flags & kConstraintsOnly) && !problem.has(kConstraints)) {
+    return {false, fmt::format("method '{}' is for problems with holonomic constraints; problem "
+                               "'{}' has none (use an unconstrained method)",
+                               method.spec(), problem.name())};
+  }
   return {};
+}
+
+std::vector<std::string> constrained_methods() {
+  std::vector<std::string> specs;
+  for (const auto& spec : integrator_test_specs()) {
+    if (make_integrator(spec)->info().flags & kConstrained) specs.push_back(spec);
+  }
+  if (specs.empty()) specs.push_back("(none registered yet)");
+  return specs;
 }
 
 StabilityPrediction alpha_rule_stability(double alpha) {

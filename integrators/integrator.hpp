@@ -16,12 +16,13 @@ namespace geomint {
 enum MethodFlag : unsigned {
   kExplicit = 1u << 0,
   kImplicit = 1u << 1,
-  kSymplectic = 1u << 2,    // canonical symplectic one-step map
-  kSymmetric = 1u << 3,     // Φ_{−h} ∘ Φ_h = id
-  kVariational = 1u << 4,   // derived from a discrete Lagrangian: discrete Noether holds
-  kAdaptive = 1u << 5,      // error-controlled; use advance_to()
-  kConstrained = 1u << 6,   // handles holonomic constraints
-  kNeedsHessian = 1u << 7,  // needs Problem::hessian
+  kSymplectic = 1u << 2,       // canonical symplectic one-step map
+  kSymmetric = 1u << 3,        // Φ_{−h} ∘ Φ_h = id
+  kVariational = 1u << 4,      // derived from a discrete Lagrangian: discrete Noether holds
+  kAdaptive = 1u << 5,         // error-controlled; use advance_to()
+  kConstrained = 1u << 6,      // handles holonomic constraints (Problem kConstraints)
+  kNeedsHessian = 1u << 7,     // needs Problem::hessian
+  kConstraintsOnly = 1u << 8,  // only for problems with constraints (rattle, penalty, ida:index)
 };
 std::vector<std::string> flag_names(unsigned flags);
 
@@ -73,7 +74,7 @@ struct Counters {
   long newton_iters = 0;
   long linear_solves = 0;
   long factorizations = 0;  // numeric factorisations of Newton matrices (NewtonResult)
-  long rejected = 0;  // rejected steps (adaptive solvers)
+  long rejected = 0;        // rejected steps (adaptive solvers)
 };
 
 class Integrator {
@@ -130,6 +131,8 @@ struct Applicability {
   std::string reason;
 };
 Applicability applicable(const Integrator& method, const Problem& problem);
+// The registry test specs whose methods handle holonomic constraints (for messages and tests).
+std::vector<std::string> constrained_methods();
 
 // CVODE's "too much accuracy" test (tolsf, CVODE user guide §2.1): unit roundoff times the
 // weighted RMS norm of y with weights 1/(rtol|y_i| + atol). Above 1 the tolerances ask for less

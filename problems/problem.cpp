@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Cholesky>
+
 namespace geomint {
 
 #define GEOMINT_PROBLEM(name, factory, variants, summary) std::unique_ptr<Problem> factory(Params&);
@@ -41,6 +43,8 @@ std::unique_ptr<Problem> make_problem(const std::string& spec_text) {
     params.finish();
     problem->name_ = entry.name;
     problem->spec_ = params.canonical();
+    if (problem->has(kConstraints))
+      problem->check_consistent(problem->initial_state(), "initial state");
     return problem;
   }
   throw InputError(
@@ -57,6 +61,7 @@ std::vector<std::string> capability_names(unsigned capabilities) {
       {kPeriod, "period"},
       {kOmegaMax, "omega_max"},
       {kForceJacobian, "force_jacobian"},
+      {kConstraints, "constraints"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -81,6 +86,88 @@ Vec Problem::linear_momentum(const Vec&, const Vec&) const { missing(*this, "lin
 Vec Problem::angular_momentum(const Vec&, const Vec&) const { missing(*this, "angular momentum"); }
 double Problem::period() const { missing(*this, "period"); }
 double Problem::omega_max(const Vec&) const { missing(*this, "omega_max"); }
+int Problem::constraint_count() const { missing(*this, "constraints"); }
+void Problem::constraint(const Vec&, Vec&) const { missing(*this, "constraints"); }
+void Problem::constraint_jacobian(const Vec&, SparseMatrix&) const {
+  missing(*this, "constraint Jacobian");
+}
+void Problem::constraint_curvature(const Vec&, const Vec&, Vec&) const {
+  missing(*this, "constraint curvature");
+}
+void Problem::constraint_hessian(const Vec&, const Vec&, SparseMatrix&) const {
+  missing(*this, "constraint Hessian");
+}
+
+std::vector<std::string> Problem::multiplier_names() const {
+  std::vector<std::string> names;
+  for (int i = 1; i <= constraint_count(); ++i) names.push_back(fmt::format("lambda{}", i));
+  return names;
+}
+
+Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
+  const Vec v = inverse_mass_.cwiseProduct(p);
+  Vec force_total;
+  gradient(q, force_total);
+  force_total = -force_total;
+  if (has(kForce)) {
+    Vec f;
+    force(q, v, t, f);
+    force_total += f;
+  }
+  SparseMatrix G;
+  constraint_jacobian(q, G);
+  Vec c;
+  constraint_curvature(q, v, c);
+  // m is small for every catalogue problem (rods, pins), so a dense solve of G M⁻¹ Gᵀ is the
+  // simplest correct choice; LDLT copes with the semidefinite case of redundant constraints.
+  const Eigen::MatrixXd GMinv = Eigen::MatrixXd(G) * inverse_mass_.asDiagonal();
+  const Eigen::MatrixXd S = GMinv * Eigen::MatrixXd(G).transpose();
+  const Vec rhs = GMinv * force_total + c;
+  return S.ldlt().solve(rhs);
+}
+
+double Problem::constraint_residual(const Vec& q) const {
+  Vec g;
+  constraint(q, g);
+  return g.size() > 0 ? g.cwiseAbs().maxCoeff() : 0.0;
+}
+
+double Problem::constraint_velocity_residual(const Vec& q, const Vec& p) const {
+  SparseMatrix G;
+  constraint_jacobian(q, G);
+  const Vec Gv = G * inverse_mass_.cwiseProduct(p);
+  return Gv.size() > 0 ? Gv.cwiseAbs().maxCoeff() : 0.0;
+}
+
+void Problem::check_consistent(const State& state, const std::string& what, double tol) const {
+  SparseMatrix G;
+  constraint_jacobian(state.q, G);
+  // ‖G‖∞: the largest absolute row sum, the scale that turns a position error into g.
+  Vec row_sums = Vec::Zero(G.rows());
+  for (int k = 0; k < G.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(G, k); it; ++it) row_sums[it.row()] += std::abs(it.value());
+  }
+  const double G_norm = row_sums.size() > 0 ? row_sums.maxCoeff() : 0.0;
+  const Vec v = inverse_mass_.cwiseProduct(state.p);
+  const double q_norm = state.q.size() > 0 ? state.q.cwiseAbs().maxCoeff() : 0.0;
+  const double v_norm = v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0;
+  const double position = constraint_residual(state.q);
+  const double velocity = constraint_velocity_residual(state.q, state.p);
+  const double position_allowed = tol * G_norm * q_norm;
+  const double velocity_allowed = tol * G_norm * v_norm;
+  if (!(position <= position_allowed)) {
+    throw InputError(fmt::format(
+        "problem '{}': inconsistent {}: constraint residual max|g(q)| = {:.3g} (allowed <= {:.3g}, "
+        "{:g} relative to |G||q|); give a state on the constraint manifold",
+        spec(), what, position, position_allowed, tol));
+  }
+  if (!(velocity <= velocity_allowed)) {
+    throw InputError(fmt::format(
+        "problem '{}': inconsistent {}: velocity constraint residual max|G(q) v| = {:.3g} (allowed "
+        "<= {:.3g}, {:g} relative to |G||v|); give a velocity tangent to the constraint manifold",
+        spec(), what, velocity, velocity_allowed, tol));
+  }
+}
 
 void Problem::set_mass(const Vec& mass) {
   mass_ = mass;

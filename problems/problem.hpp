@@ -35,6 +35,7 @@ enum Capability : unsigned {
   kPeriod = 1u << 5,           // period()
   kOmegaMax = 1u << 6,         // omega_max(q)
   kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
+  kConstraints = 1u << 8,      // holonomic constraints g(q) = 0: constraint_* (PAPER.md §3)
 };
 
 // Capability names for `geomint list` and error messages.
@@ -78,6 +79,34 @@ class Problem {
   virtual double period() const;
   // Highest linearised frequency at q (for stability reports). Only when has(kOmegaMax).
   virtual double omega_max(const Vec& q) const;
+
+  // Holonomic constraints g(q) = 0 (PAPER.md §3, docs/METHOD.md "Constraints"). Only when
+  // has(kConstraints). The motion is M q̈ = −∇V(q) + F − G(q)ᵀλ, G = ∂g/∂q, with m =
+  // constraint_count() multipliers λ. Problems whose initial state comes from user parameters
+  // get it checked by make_problem (an inconsistent state is an InputError naming the residual).
+  virtual int constraint_count() const;
+  // g = g(q) ∈ Rᵐ; g is resized by the callee.
+  virtual void constraint(const Vec& q, Vec& g) const;
+  // G = ∂g/∂q, m × n, compressed.
+  virtual void constraint_jacobian(const Vec& q, SparseMatrix& G) const;
+  // c = (∂G/∂q · v) v ∈ Rᵐ, so that d²g/dt² = G(q) q̈ + c(q, v): the term index reduction needs.
+  virtual void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const;
+  // K = Σᵢ λᵢ ∇²gᵢ(q), n × n, symmetric, compressed: the constraint part of the Hessian of the
+  // Lagrangian V + λᵀg that Newton/KKT solves of constrained steps need.
+  virtual void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const;
+  // Names of the multipliers for series columns ("tension"); default lambda1 … lambdam.
+  virtual std::vector<std::string> multiplier_names() const;
+
+  // The exact motion's multipliers through (q, p) at time t: the λ that keeps d²g/dt² = 0,
+  // (G M⁻¹ Gᵀ) λ = G M⁻¹ (−∇V + F) + c(q, v). Only when has(kConstraints).
+  Vec multipliers(double t, const Vec& q, const Vec& p) const;
+  // ‖g(q)‖∞ and ‖G(q) M⁻¹p‖∞ (position- and velocity-level constraint residuals).
+  double constraint_residual(const Vec& q) const;
+  double constraint_velocity_residual(const Vec& q, const Vec& p) const;
+  // Throws InputError unless `state` is consistent to round-off relative to its own scale:
+  // ‖g(q)‖∞ ≤ tol·‖G‖∞‖q‖∞ and ‖G v‖∞ ≤ tol·‖G‖∞‖v‖∞ (no absolute floor). `what` names the
+  // state in the message ("initial state").
+  void check_consistent(const State& state, const std::string& what, double tol = 1e-10) const;
 
   // Extra problem-specific quantities for time series (e.g. the FPU oscillatory energies).
   virtual std::vector<std::string> series_names() const { return {}; }
