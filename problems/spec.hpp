@@ -66,7 +66,8 @@ class Params {
 
   // Leaves `key` (already read) out of canonical() while it has its default value: for options
   // that choose how a result is computed, not what (a linear solver run to the same Newton
-  // tolerance), so that adding one does not rename every committed run of the method.
+  // tolerance), or for a parameter added later whose default is the problem as it was (a driving
+  // amplitude of 0), so that adding one does not rename every committed run.
   void omit_default_from_canonical(const std::string& key);
 
   // Throws InputError naming any key that no getter read, with the list of valid keys.
