@@ -69,25 +69,47 @@ class Composition final : public Integrator {
   long steps_ = 0;
 };
 
+// The valid bases: registry names whose default instance is a fixed-step symmetric method of
+// order 2, which is what the composition order conditions assume (GNI §V.3.2), plus the
+// hp_midpoint alias; a method added to the registry is a valid base the day it lands. The base is
+// a name, its parameters at their defaults: a nested spec would collide with the composition's own
+// "key=value," syntax.
+const std::vector<std::string>& symmetric_second_order_methods() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> found;
+    for (const auto& entry : integrator_registry()) {
+      if (entry.name == "composition") continue;
+      const MethodInfo info = make_integrator(entry.name)->info();
+      if ((info.flags & kSymmetric) && info.order == 2 && !(info.flags & kAdaptive)) {
+        found.push_back(entry.name);
+      }
+    }
+    found.emplace_back("hp_midpoint");
+    return found;
+  }();
+  return names;
+}
+
 }  // namespace
 
 std::unique_ptr<Integrator> make_composition(Params& params) {
   const std::string base = params.choice(
-      "base", "stormer_verlet", {"stormer_verlet", "hp_midpoint"},
-      "symmetric second-order base step: stormer_verlet, or hp_midpoint = hp:alpha=0.5");
+      "base", "stormer_verlet", symmetric_second_order_methods(),
+      "symmetric second-order base step: any registered method whose defaults are a fixed-step "
+      "symmetric method of order 2, or hp_midpoint = hp:alpha=0.5");
   std::vector<std::string> scheme_names;
   for (const auto& scheme : coefficients::kCompositionSchemes) {
     scheme_names.emplace_back(scheme.name);
   }
   const std::string scheme_name =
       params.choice("scheme", "yoshida4", scheme_names,
-                    "coefficients: yoshida4 (order 4, s=3), suzuki4 (4, s=5), kahan_li6 (6, s=9), "
-                    "kahan_li8 (8, s=17), mclachlan8 (8, s=15)");
+                    "coefficients: yoshida4 (order 4, s=3), suzuki4 (4, s=5), yoshida6 (6, s=7), "
+                    "kahan_li6 (6, s=9), kahan_li8 (8, s=17), mclachlan8 (8, s=15)");
   const coefficients::CompositionScheme* scheme = nullptr;
   for (const auto& candidate : coefficients::kCompositionSchemes) {
     if (candidate.name == scheme_name) scheme = &candidate;
   }
-  const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : "stormer_verlet";
+  const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : base;
   return std::make_unique<Composition>(*scheme, base_spec, make_integrator(base_spec));
 }
 

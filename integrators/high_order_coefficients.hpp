@@ -43,6 +43,17 @@ inline constexpr std::array<long double, 9> kKahanLi6 = {
     -0.70624617255763935980996482L, 0.33259913678935943859974864L, 0.39216144400731413927925056L,
 };
 
+// Yoshida (1990), solution A: the 7-stage order-6 scheme (w₃ w₂ w₁ w₀ w₁ w₂ w₃). Yoshida prints 15
+// digits; these are the root of Σγ = 1, Σγ³ = Σγ⁵ = 0 and the nested order-6 condition (the
+// conditions PowerSumConditions checks) found by Newton in 60-digit decimal arithmetic from his
+// digits, which they reproduce.
+inline constexpr long double kYoshida6W1 = -1.177679984178871006946415680964315735L;
+inline constexpr long double kYoshida6W2 = 0.2355732133593581336847931829785346017L;
+inline constexpr long double kYoshida6W3 = 0.7845136104775572638194976338663498758L;
+inline constexpr long double kYoshida6W0 = 1.315186320683911218884249728238862514L;
+inline constexpr std::array<long double, 7> kYoshida6 = {
+    kYoshida6W3, kYoshida6W2, kYoshida6W1, kYoshida6W0, kYoshida6W1, kYoshida6W2, kYoshida6W3};
+
 // Kahan & Li (1997), method s17odr8a: order 8, s = 17 (also in GNI §V.3.2).
 inline constexpr std::array<long double, 17> kKahanLi8 = {
     0.13020248308889008087881763L,  0.56116298177510838456196441L,  -0.38947496264484728640807860L,
@@ -70,9 +81,10 @@ struct CompositionScheme {
   std::string_view source;
 };
 
-inline constexpr std::array<CompositionScheme, 5> kCompositionSchemes = {{
+inline constexpr std::array<CompositionScheme, 6> kCompositionSchemes = {{
     {"yoshida4", 4, kYoshida4, "Yoshida 1990, s=3"},
     {"suzuki4", 4, kSuzuki4, "Suzuki 1990, s=5"},
+    {"yoshida6", 6, kYoshida6, "Yoshida 1990 solution A, s=7"},
     {"kahan_li6", 6, kKahanLi6, "Kahan & Li 1997, s=9"},
     {"kahan_li8", 8, kKahanLi8, "Kahan & Li 1997, s=17"},
     {"mclachlan8", 8, kMcLachlan8, "McLachlan 1995, s=15"},

@@ -68,14 +68,13 @@ TEST(HighOrderEquivalence, NegativeControlHigherStagesDiffer) {
 }
 
 // A composition step is its base's substeps γ_i h, bit for bit (the base is the registry's
-// stormer_verlet / hp:alpha=0.5, not a copy).
+// method, hp_midpoint = hp:alpha=0.5, not a copy).
 TEST(Composition, IsTheBaseMethodsSubsteps) {
-  for (const char* base : {"stormer_verlet", "hp_midpoint"}) {
+  for (const char* base : {"stormer_verlet", "hp_midpoint", "position_verlet", "del"}) {
     SCOPED_TRACE(base);
     const auto problem = make_problem("kepler:e=0.6");
     auto composition = make_integrator(std::string("composition:scheme=suzuki4,base=") + base);
-    auto step =
-        make_integrator(std::string(base) == "hp_midpoint" ? "hp:alpha=0.5" : "stormer_verlet");
+    auto step = make_integrator(std::string(base) == "hp_midpoint" ? "hp:alpha=0.5" : base);
     const double h = 0.05;
     State composed = problem->initial_state();
     State by_hand = composed;
@@ -172,14 +171,26 @@ TEST(HighOrderStartingGuess, ExtrapolationSavesIterationsNotAccuracy) {
 
 TEST(HighOrderInput, BadParametersNameTheKeyAndTheChoices) {
   try {
-    make_integrator("composition:scheme=yoshida6");
+    make_integrator("composition:scheme=yoshida8");
     FAIL() << "no InputError";
   } catch (const InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("scheme"), std::string::npos) << what;
     EXPECT_NE(what.find("kahan_li8"), std::string::npos) << what;
   }
-  EXPECT_THROW(make_integrator("composition:base=rk4"), InputError);
+  // Bases: fixed-step symmetric methods of order 2 only, named without parameters.
+  for (const char* bad :
+       {"composition:base=rk4", "composition:base=gauss", "composition:base=symplectic_euler_a",
+        "composition:base=odeint_dopri5", "composition:base=composition"}) {
+    try {
+      make_integrator(bad);
+      ADD_FAILURE() << bad << ": no InputError";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("base"), std::string::npos) << what;
+      EXPECT_NE(what.find("position_verlet"), std::string::npos) << what;
+    }
+  }
   EXPECT_THROW(make_integrator("gauss:s=4"), InputError);
   EXPECT_THROW(make_integrator("gauss:s=0"), InputError);
   EXPECT_THROW(make_integrator("lobatto3ab:s=1"), InputError);
