@@ -444,9 +444,9 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
   fs::create_directories(logs);  // Slurm does not create the folder of --output
   const auto header = [&](const std::string& what, const std::string& job) {
     std::string text = fmt::format(
-        "#!/bin/bash\n# {} of {} (written by `geomint slurm`; README \"Running on a cluster\").\n"
-        "#SBATCH --job-name=geomint-{}-{}\n#SBATCH --output={}/{}-{}.out\n",
-        what, options.scene_path, job, scene_name, logs.string(), job,
+        "#!/bin/bash\n# {} job of {} (written by `geomint slurm`; README \"Running on a "
+        "cluster\").\n# {}\n#SBATCH --job-name=geomint-{}-{}\n#SBATCH --output={}/{}-{}.out\n",
+        job, options.scene_path, what, job, scene_name, logs.string(), job,
         job == "sweep" ? "%A_%a" : "%j");
     if (!options.partition.empty())
       text += fmt::format("#SBATCH --partition={}\n", options.partition);
