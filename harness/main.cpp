@@ -467,7 +467,10 @@ int main(int argc, char** argv) {
       const bool merge_quick = variant == "quick";
       options.variant = variant;
       namespace fs = std::filesystem;
-      const fs::path folder = merge_quick ? fs::path(merge_dir).parent_path() : fs::path(merge_dir);
+      // "results/x/quick/" names the folder quick, as "results/x/quick" does.
+      fs::path dir = fs::path(merge_dir).lexically_normal();
+      if (dir.filename().empty()) dir = dir.parent_path();
+      const fs::path folder = merge_quick ? fs::absolute(dir).parent_path() : dir;
       const std::string scene_file =
           !merge_scene.empty() ? merge_scene : (folder / "scene.toml").string();
       const Scene scene = load_scene(scene_file, merge_quick);
@@ -496,7 +499,8 @@ int main(int argc, char** argv) {
       options.partition = slurm_partition;
       options.time_limit = slurm_time;
       options.geomint_path = std::filesystem::canonical("/proc/self/exe").string();
-      check_output_dir(std::filesystem::path(slurm_scene).parent_path().string(), "scene folder");
+      check_output_dir(std::filesystem::absolute(slurm_scene).parent_path().string(),
+                       "scene folder");
       const auto scripts = write_slurm_scripts(options);
       for (const auto& path : scripts) fmt::print("{}\n", path);
       if (slurm_submit) {
