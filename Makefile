@@ -6,7 +6,8 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
-        format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables
+        format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables \
+        test-cluster
 
 all: build
 
@@ -25,6 +26,12 @@ build: configure
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
+
+# Sweeps on a real Slurm (README "Running on a cluster"): as root, installs slurmctld, slurmd and
+# munge, starts them on this machine, runs a scene through `geomint slurm --submit` in 8 shards,
+# merges, times, injects a failing shard and resubmits it; stops every daemon it started.
+test-cluster: build
+	@bash scripts/test-cluster.sh $(BUILD_DIR)/geomint
 
 # Everything: slow tests too, the sanitizer suite, the fuzzers (FUZZ_SECONDS each) and the whole
 # mutation list.

@@ -1,4 +1,5 @@
-// geomint command line (docs/DESIGN.md §4): list, run, order, sweep, reference, gate. Exit codes:
+// geomint command line (docs/DESIGN.md §4): list, run, order, sweep, merge, slurm, reference, gate
+// (merge and slurm: README "Running on a cluster"). Exit codes:
 // 0 ok, 1 a run or gate failed, 2 bad input (the message names the offending option, key or
 // value; checked before any computing, outputs included), 3 an internal error (a defect, or an
 // I/O failure after the up-front checks, e.g. a full disk).
@@ -15,6 +16,7 @@
 #include "harness/paths.hpp"
 #include "harness/reference_generator.hpp"
 #include "harness/run.hpp"
+#include "harness/shard.hpp"
 #include "harness/sweep.hpp"
 
 using namespace geomint;
@@ -25,7 +27,8 @@ constexpr int kExitFailed = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 3;
 
-const std::vector<std::string> kCommands = {"list", "run", "order", "sweep", "reference", "gate"};
+const std::vector<std::string> kCommands = {"list",  "run",   "order",     "sweep",
+                                            "merge", "slurm", "reference", "gate"};
 
 // CLI11 says "A subcommand is required" for a missing or unknown verb; say which verbs exist.
 // Returns false (message printed) when argv[1] is not an option and not a command.
@@ -201,6 +204,49 @@ int main(int argc, char** argv) {
                   "run nothing: rewrite table.md from the CSVs already in the output folder");
   sweep->add_option("--out", sweep_out,
                     "output folder (default: the scene's folder; with --quick: <folder>/quick)");
+  bool no_timing = false, timing_only = false, shard_env = false;
+  std::string shard_text;
+  int shard_count = 0;
+  sweep->add_flag("--no-timing", no_timing, "accuracy runs only: no timing passes, no wall_s");
+  sweep->add_option("--shard", shard_text,
+                    "i/N: only the units k (runs, order studies, stability searches in scene "
+                    "order) with k mod N == i, written to <out>/shards/ for `geomint merge`; "
+                    "implies --no-timing; a complete shard on disk is skipped");
+  sweep->add_flag("--shard-from-env", shard_env,
+                  "take i/N from SLURM_ARRAY_TASK_ID and --shards, or from "
+                  "OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE");
+  sweep->add_option("--shards", shard_count, "N for --shard-from-env")
+      ->check(CLI::Range(1, 1000000));
+  sweep->add_flag("--timing-only", timing_only,
+                  "run only the timing passes, one at a time, into the merged tables of the "
+                  "output folder (after `geomint merge`), with this node's CPU in provenance");
+
+  std::string merge_dir, merge_scene;
+  auto* merge = app.add_subcommand(
+      "merge",
+      "Merge the shards in SCENE_DIR/shards into the scene's tables (exit 1, naming the missing "
+      "or mismatched shards and the resubmission command, when the set is incomplete)");
+  merge->add_option("scene_dir", merge_dir, "the folder a sweep writes to (results/<scene>)")
+      ->required();
+  merge->add_option("--scene", merge_scene,
+                    "the scene file (default: SCENE_DIR/scene.toml, or ../scene.toml for quick)");
+
+  std::string slurm_scene, slurm_partition, slurm_time;
+  int slurm_shards = 0, slurm_max_parallel = 0;
+  bool slurm_submit = false, slurm_quick = false;
+  auto* slurm = app.add_subcommand(
+      "slurm",
+      "Write sweep.sbatch, merge.sbatch and timing.sbatch next to the scene (and submit them)");
+  slurm->add_option("scene", slurm_scene, "results/<scene>/scene.toml")->required();
+  slurm->add_option("--shards", slurm_shards, "array size N (default: min(units, 1000))")
+      ->check(CLI::Range(1, 1000000));
+  slurm->add_option("--max-parallel", slurm_max_parallel, "at most K array tasks at once")
+      ->check(CLI::Range(1, 1000000));
+  slurm->add_option("--partition", slurm_partition, "Slurm partition");
+  slurm->add_option("--time", slurm_time, "time limit of each job (Slurm format, e.g. 1:00:00)");
+  slurm->add_flag("--quick", slurm_quick, "the scene's CI-sized variant (into <folder>/quick)");
+  slurm->add_flag("--submit", slurm_submit,
+                  "submit the three scripts with sbatch, chained by --dependency=afterok");
 
   double reference_every = 0;
   auto* reference = app.add_subcommand(
@@ -374,9 +420,97 @@ int main(int argc, char** argv) {
         rewrite_scene_markdown(scene, options.out_dir);
         return 0;
       }
+      if (timing_only) {
+        if (no_timing || !shard_text.empty() || shard_env) {
+          throw InputError(
+              "--timing-only runs only the timing passes: leave out --no-timing, "
+              "--shard and --shard-from-env");
+        }
+        run_timing_only(scene, options);
+        fmt::print(stderr, "geomint: timing passes of '{}' written into {}\n", scene.title,
+                   options.out_dir);
+        return 0;
+      }
+      options.timing = !no_timing;
+      if (!shard_text.empty() || shard_env) {
+        if (!shard_text.empty() && shard_env) {
+          throw InputError("give either --shard i/N or --shard-from-env, not both");
+        }
+        const ShardId id = shard_env ? shard_from_env(shard_count) : parse_shard(shard_text);
+        options.shard_index = id.index;
+        options.shard_count = id.count;
+        options.scene_hash = scene_content_hash(scene_path, quick);
+        const SceneUnits units = scene_units(scene);
+        const auto tables = shard_tables(units.runs, units.orders, units.stability);
+        if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
+          fmt::print(stderr, "geomint: shard {}/{} of '{}' is complete on disk; skipped\n",
+                     id.index, id.count, scene.title);
+          return 0;
+        }
+        if (shard_fails_on_purpose(id)) {
+          fmt::print(stderr, "geomint: GEOMINT_FAIL_SHARD={}: shard {}/{} fails on purpose\n",
+                     id.index, id.index, id.count);
+          return kExitFailed;
+        }
+      } else if (shard_count) {
+        throw InputError("--shards N goes with --shard-from-env");
+      }
       const int failed = run_sweep(scene, options);
       fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
                  scene.title, failed, options.out_dir);
+      return 0;
+    }
+    if (*merge) {
+      MergeOptions options;
+      options.out_dir = merge_dir;
+      const std::string variant = shards_variant(merge_dir);
+      const bool merge_quick = variant == "quick";
+      options.variant = variant;
+      namespace fs = std::filesystem;
+      // "results/x/quick/" names the folder quick, as "results/x/quick" does.
+      fs::path dir = fs::path(merge_dir).lexically_normal();
+      if (dir.filename().empty()) dir = dir.parent_path();
+      const fs::path folder = merge_quick ? fs::absolute(dir).parent_path() : dir;
+      const std::string scene_file =
+          !merge_scene.empty() ? merge_scene : (folder / "scene.toml").string();
+      const Scene scene = load_scene(scene_file, merge_quick);
+      options.scene_hash = scene_content_hash(scene_file, merge_quick);
+      options.scene_name = fs::absolute(scene_file).parent_path().filename().string();
+      options.sbatch_path = (fs::path(scene_file).parent_path() / "sweep.sbatch").string();
+      check_output_dir(merge_dir, "scene_dir");
+      try {
+        merge_shards(scene, options);
+      } catch (const MergeRefused& refused) {
+        fmt::print(stderr, "geomint: merge: {}\n", refused.what());
+        return kExitFailed;
+      }
+      fmt::print(stderr, "geomint: merged the shards of '{}' into {}\n", scene.title, merge_dir);
+      return 0;
+    }
+    if (*slurm) {
+      const Scene scene = load_scene(slurm_scene, slurm_quick);
+      SlurmOptions options;
+      options.scene_path = slurm_scene;
+      options.quick = slurm_quick;
+      options.shards =
+          slurm_shards ? slurm_shards
+                       : static_cast<int>(std::clamp<size_t>(scene_units(scene).total(), 1, 1000));
+      options.max_parallel = slurm_max_parallel;
+      options.partition = slurm_partition;
+      options.time_limit = slurm_time;
+      options.geomint_path = std::filesystem::canonical("/proc/self/exe").string();
+      check_output_dir(std::filesystem::absolute(slurm_scene).parent_path().string(),
+                       "scene folder");
+      const auto scripts = write_slurm_scripts(options);
+      for (const auto& path : scripts) fmt::print("{}\n", path);
+      if (slurm_submit) {
+        std::string dependency;
+        for (const auto& path : scripts) {
+          const std::string id = submit_sbatch(path, dependency);
+          fmt::print(stderr, "geomint: submitted {} as job {}\n", path, id);
+          dependency = id;
+        }
+      }
       return 0;
     }
   } catch (const InputError& error) {

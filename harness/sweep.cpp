@@ -20,6 +20,7 @@
 #include "harness/order.hpp"
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
+#include "harness/shard.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
@@ -145,13 +146,32 @@ std::vector<Row> with_short_specs(std::vector<Row> rows) {
   return rows;
 }
 
-}  // namespace
+struct OrderJob {
+  std::string label, problem, method;
+  const OrderBlock* block;
+  OrderStudy study;
+};
 
-int run_sweep(const Scene& scene, const SweepOptions& options) {
-  namespace fs = std::filesystem;
-  check_output_dir(options.out_dir, "output folder");
-  std::set<std::string> series_paths;
+struct StabilityJob {
+  std::string label, problem, method;
+  const StabilityOptions* options;
+  Row row;
+};
+
+// The scene's units in the canonical expansion order: [[runs]] blocks × problems × methods × dt,
+// then [[orders]] blocks × problems × methods, then [[stability]] blocks × problems × methods.
+// A shard and a merge count units in this order, so it must not depend on anything but the scene.
+struct Plan {
   std::vector<Job> jobs;
+  std::vector<OrderJob> order_jobs;
+  std::vector<StabilityJob> stability_jobs;
+};
+
+Plan expand_scene(const Scene& scene, const SweepOptions& options) {
+  namespace fs = std::filesystem;
+  std::set<std::string> series_paths;
+  Plan plan;
+  auto& jobs = plan.jobs;
   for (const auto& block : scene.runs) {
     const std::vector<double> dts = block.dts.empty() ? std::vector<double>{0.0} : block.dts;
     for (const auto& problem : block.problems) {
@@ -189,12 +209,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       }
     }
   }
-  struct OrderJob {
-    std::string label, problem, method;
-    const OrderBlock* block;
-    OrderStudy study;
-  };
-  std::vector<OrderJob> order_jobs;
+  auto& order_jobs = plan.order_jobs;
   for (const auto& block : scene.orders) {
     for (const auto& problem : block.problems) {
       for (const auto& method : block.methods) {
@@ -202,12 +217,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       }
     }
   }
-  struct StabilityJob {
-    std::string label, problem, method;
-    const StabilityOptions* options;
-    Row row;
-  };
-  std::vector<StabilityJob> stability_jobs;
+  auto& stability_jobs = plan.stability_jobs;
   for (const auto& block : scene.stability) {
     for (const auto& problem : block.problems) {
       for (const auto& method : block.methods) {
@@ -215,13 +225,113 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       }
     }
   }
+  return plan;
+}
+
+// A shard's tables (see SweepOptions::shard_count): the rows of its units with their canonical
+// index, each table over the columns its own rows set; `geomint merge` unites them.
+int write_shard(const Plan& plan, const std::vector<size_t>& accuracy_units,
+                const std::vector<size_t>& stability_units,
+                const std::vector<std::pair<std::string, std::string>>& lines,
+                const SweepOptions& options) {
+  const ShardId id{options.shard_index, options.shard_count};
+  const size_t runs = plan.jobs.size(), orders = plan.order_jobs.size();
+  int failed = 0;
+  std::vector<RunRecord> summary, points;
+  std::vector<OrderRecord> order;
+  std::vector<size_t> summary_k, points_k, order_k, stability_k;
+  for (size_t k : accuracy_units) {
+    if (k < runs) {
+      summary.push_back(plan.jobs[k].record);
+      summary_k.push_back(k);
+      failed += !plan.jobs[k].ok;
+      continue;
+    }
+    const OrderJob& job = plan.order_jobs[k - runs];
+    order.push_back(job.study.record);
+    order.back().label = job.label;
+    order_k.push_back(k);
+    failed += job.study.record.status == "error";
+    for (const auto& point : job.study.runs) {
+      points.push_back(point.record);
+      points.back().label = job.label;
+      points_k.push_back(k);
+    }
+  }
+  std::vector<Row> stability;
+  for (size_t s : stability_units) {
+    stability.push_back(plan.stability_jobs[s].row);
+    stability_k.push_back(runs + orders + s);
+  }
+  const std::string& out = options.out_dir;
+  const std::string& hash = options.scene_hash;
+  if (runs) {
+    write_shard_table(out, "summary", id, hash, to_rows(summary), summary_k,
+                      record_columns(summary), lines);
+  }
+  if (orders) {
+    write_shard_table(out, "order", id, hash, to_rows(order), order_k,
+                      columns_of(order_schema(), order), lines);
+    write_shard_table(out, "order_points", id, hash, to_rows(points), points_k,
+                      record_columns(points), lines);
+  }
+  if (!plan.stability_jobs.empty()) {
+    write_shard_table(out, "stability", id, hash, stability, stability_k,
+                      column_union(stability, stability_columns()), lines);
+  }
+  return failed;
+}
+
+std::string read_table_text(const std::filesystem::path& path) {
+  std::ifstream stream(path);
+  std::stringstream text;
+  text << stream.rdbuf();
+  if (!stream) throw InputError(fmt::format("cannot read '{}'", path.string()));
+  return text.str();
+}
+
+// The CSV text after its `#` provenance lines.
+std::string without_provenance(const std::string& text) {
+  size_t start = 0;
+  while (start < text.size() && text[start] == '#') {
+    const size_t end = text.find('\n', start);
+    if (end == std::string::npos) return "";
+    start = end + 1;
+  }
+  return text.substr(start);
+}
+
+}  // namespace
+
+int run_sweep(const Scene& scene, const SweepOptions& options) {
+  namespace fs = std::filesystem;
+  check_output_dir(options.out_dir, "output folder");
+  Plan plan = expand_scene(scene, options);
+  auto& jobs = plan.jobs;
+  auto& order_jobs = plan.order_jobs;
+  auto& stability_jobs = plan.stability_jobs;
+  const bool sharded = options.shard_count > 0;
+  const ShardId shard{options.shard_index, options.shard_count};
+  // The units of this sweep by canonical index k (runs, order studies, stability searches):
+  // all of them, or a shard's k mod N == i (round-robin, so long runs spread over the shards).
+  const auto mine = [&](size_t k) {
+    return !sharded || k % static_cast<size_t>(shard.count) == static_cast<size_t>(shard.index);
+  };
+  std::vector<size_t> accuracy_units, stability_units;
+  for (size_t k = 0; k < jobs.size() + order_jobs.size(); ++k) {
+    if (mine(k)) accuracy_units.push_back(k);
+  }
+  for (size_t s = 0; s < stability_jobs.size(); ++s) {
+    if (mine(jobs.size() + order_jobs.size() + s)) stability_units.push_back(s);
+  }
+  const bool timing = options.timing && !sharded;
   size_t timed = 0;
-  for (const auto& job : jobs) timed += job.timing_repeats > 0;
-  Progress progress(jobs.size() + order_jobs.size() + stability_jobs.size() + timed,
-                    options.progress);
+  for (const auto& job : jobs) timed += timing && job.timing_repeats > 0;
+  Progress progress(accuracy_units.size() + stability_units.size() + timed, options.progress);
 
   // Accuracy runs (parallel); specs were validated when the scene was loaded.
-  parallel_for(jobs.size() + order_jobs.size(), options.jobs, [&](size_t i) {
+  parallel_for(accuracy_units.size(), options.jobs, [&](size_t unit) {
+    const size_t i = accuracy_units[unit];
     if (i < jobs.size()) {
       Job& job = jobs[i];
       try {
@@ -246,8 +356,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     progress.tick();
   });
   // Stability searches (parallel; each is a sequence of short runs without observers).
-  parallel_for(stability_jobs.size(), options.jobs, [&](size_t i) {
-    StabilityJob& job = stability_jobs[i];
+  parallel_for(stability_units.size(), options.jobs, [&](size_t unit) {
+    StabilityJob& job = stability_jobs[stability_units[unit]];
     try {
       job.row = stability_search(job.problem, job.method, *job.options).row;
     } catch (const std::exception& error) {
@@ -259,7 +369,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   });
   // Timing runs, one at a time so they do not compete for cores.
   for (auto& job : jobs) {
-    if (job.timing_repeats == 0) continue;
+    if (!timing || job.timing_repeats == 0) continue;
     if (job.ok) {
       try {
         job.record.wall_s = time_run(job.problem, job.method, job.config, job.timing_repeats);
@@ -273,6 +383,9 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   auto lines = provenance(options.command_line);
   if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
   lines.emplace_back("variant", options.variant);
+  if (sharded) {
+    return write_shard(plan, accuracy_units, stability_units, lines, options);
+  }
   int failed = 0;
   std::vector<RunRecord> summary_records, order_point_records;
   std::vector<OrderRecord> order_records;
@@ -299,16 +412,9 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   if (!order_records.empty()) {
     write_file_atomic((out / "order.csv").string(),
                       to_csv(tables.order, columns_of(order_schema(), order_records), lines));
-    // order_points.csv lists the ladder level right after the label, where a reader looks first.
-    std::vector<std::string> point_columns = record_columns(order_point_records);
-    const auto level = std::find(point_columns.begin(), point_columns.end(), "order_level");
-    if (level != point_columns.end()) {
-      point_columns.erase(level);
-      point_columns.insert(point_columns.begin() + (point_columns.front() == "label"),
-                           "order_level");
-    }
     write_file_atomic((out / "order_points.csv").string(),
-                      to_csv(to_rows(order_point_records), point_columns, lines));
+                      to_csv(to_rows(order_point_records),
+                             order_points_columns(record_columns(order_point_records)), lines));
   }
   if (!stability_jobs.empty()) {
     for (const auto& job : stability_jobs) tables.stability.push_back(job.row);
@@ -319,6 +425,114 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   write_file_atomic((out / "table.md").string(),
                     scene_markdown(scene, tables, options.command_line));
   return failed;
+}
+
+std::vector<std::string> order_points_columns(std::vector<std::string> columns) {
+  // order_points.csv lists the ladder level right after the label, where a reader looks first.
+  const auto level = std::find(columns.begin(), columns.end(), "order_level");
+  if (level != columns.end()) {
+    columns.erase(level);
+    columns.insert(columns.begin() + (columns.front() == "label"), "order_level");
+  }
+  return columns;
+}
+
+SceneUnits scene_units(const Scene& scene) {
+  const Plan plan = expand_scene(scene, SweepOptions{});
+  return {plan.jobs.size(), plan.order_jobs.size(), plan.stability_jobs.size()};
+}
+
+void run_timing_only(const Scene& scene, const SweepOptions& options) {
+  namespace fs = std::filesystem;
+  check_output_dir(options.out_dir, "output folder");
+  Plan plan = expand_scene(scene, options);
+  const fs::path out(options.out_dir);
+  const fs::path summary_path = out / "summary.csv";
+  if (!fs::exists(summary_path)) {
+    throw InputError(fmt::format(
+        "--timing-only: '{}' does not exist: run `geomint merge {}` (or a --no-timing sweep) "
+        "first",
+        summary_path.string(), options.out_dir));
+  }
+  const std::string summary_text = read_table_text(summary_path);
+  SceneTables tables;
+  std::vector<std::string> columns;
+  try {
+    tables.summary = parse_csv(summary_text);
+    columns = csv_header(summary_text);
+  } catch (const std::runtime_error& error) {
+    throw InputError(fmt::format("'{}': {}", summary_path.string(), error.what()));
+  }
+  std::string command;
+  for (const auto& [key, value] : csv_provenance(summary_text)) {
+    if (key == "command") command = value;
+  }
+  if (tables.summary.size() != plan.jobs.size()) {
+    throw InputError(fmt::format(
+        "--timing-only: '{}' has {} rows, the scene {} runs: merge or sweep this scene again",
+        summary_path.string(), tables.summary.size(), plan.jobs.size()));
+  }
+  for (size_t k = 0; k < plan.jobs.size(); ++k) {
+    const auto label = tables.summary[k].find("label");
+    if (label == tables.summary[k].end() || label->second != plan.jobs[k].label) {
+      throw InputError(fmt::format(
+          "--timing-only: row {} of '{}' is not the scene's run {} (block '{}'): merge or sweep "
+          "this scene again",
+          k + 1, summary_path.string(), k + 1, plan.jobs[k].label));
+    }
+  }
+  // Timing runs one at a time on this node, as in a single-machine sweep.
+  size_t timed = 0;
+  for (const auto& job : plan.jobs) timed += job.timing_repeats > 0;
+  Progress progress(timed, options.progress);
+  std::set<std::string> present(columns.begin(), columns.end());
+  for (size_t k = 0; k < plan.jobs.size(); ++k) {
+    const Job& job = plan.jobs[k];
+    if (job.timing_repeats == 0) continue;
+    Row& row = tables.summary[k];
+    const auto status = row.find("status");
+    if (status != row.end() && status->second == "ok") {
+      RunRecord timing;
+      try {
+        timing.wall_s = time_run(job.problem, job.method, job.config, job.timing_repeats);
+      } catch (const std::exception& error) {
+        timing.message = fmt::format("timing pass failed: {}", error.what());
+      }
+      for (const auto& [column, cell] : to_row(timing)) {
+        if (column != "problem" && column != "method" && column != "status") {
+          row[column] = cell;
+          present.insert(column);
+        }
+      }
+    }
+    progress.tick();
+  }
+  std::vector<std::string> ordered;
+  for (const auto& column : record_schema()) {
+    if (present.count(column.name)) ordered.push_back(column.name);
+  }
+  // The tables now hold what a timed single-machine sweep writes: its command, this node's CPU.
+  const std::string timed_command = [&] {
+    const std::string flag = " --no-timing";
+    const auto at = command.find(flag);
+    return at == std::string::npos ? command
+                                   : command.substr(0, at) + command.substr(at + flag.size());
+  }();
+  auto lines = provenance(timed_command);
+  if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
+  lines.emplace_back("variant", options.variant);
+  std::string header;
+  for (const auto& [key, value] : lines) header += fmt::format("# {}: {}\n", key, value);
+  for (const char* name : {"order.csv", "order_points.csv", "stability.csv"}) {
+    const fs::path path = out / name;
+    if (!fs::exists(path)) continue;
+    const std::string text = read_table_text(path);
+    if (std::string(name) == "order.csv") tables.order = parse_csv(text);
+    if (std::string(name) == "stability.csv") tables.stability = parse_csv(text);
+    write_file_atomic(path.string(), header + without_provenance(text));
+  }
+  write_file_atomic(summary_path.string(), to_csv(tables.summary, ordered, lines));
+  write_file_atomic((out / "table.md").string(), scene_markdown(scene, tables, timed_command));
 }
 
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,

@@ -18,6 +18,13 @@ struct SweepOptions {
   std::string scene_name;
   std::string variant = "full";  // "full" or "quick"
   bool progress = true;          // progress on stderr when it is a terminal
+  bool timing = true;            // false: accuracy runs only (--no-timing)
+  // Sharded sweep (--shard i/N, README "Running on a cluster"): only the units k of the
+  // canonical expansion (runs, then order studies, then stability searches) with k mod N == i,
+  // written to <out_dir>/shards/<table>.i-of-N.csv with a canonical_index column; never timed.
+  // shard_count 0: an ordinary sweep.
+  int shard_index = 0, shard_count = 0;
+  std::string scene_hash;  // scene_content_hash() of the scene file, for the shard provenance
 };
 
 // Runs the scene; returns the number of failed runs (failure rows are results, not errors).
@@ -26,10 +33,27 @@ struct SweepOptions {
 // becomes a row with status `error` and the exception's text as message.
 int run_sweep(const Scene& scene, const SweepOptions& options);
 
+// How many units of each kind the scene expands to (the canonical order of a sharded sweep).
+struct SceneUnits {
+  size_t runs = 0, orders = 0, stability = 0;
+  size_t total() const { return runs + orders + stability; }
+};
+SceneUnits scene_units(const Scene& scene);
+
+// `geomint sweep --timing-only`: reads the summary.csv of <out_dir> (a merge or a --no-timing
+// sweep of this scene), runs the timing passes one at a time, writes wall_s into it and the
+// command, CPU and date of this node into every table's provenance, and rewrites table.md, so
+// the tables equal those of a timed single-machine sweep. InputError when summary.csv is missing
+// or does not list the scene's runs in order.
+void run_timing_only(const Scene& scene, const SweepOptions& options);
+
 // The rows of a scene's tables, as run_sweep produces them or parse_csv reads them back.
 struct SceneTables {
   std::vector<Row> summary, order, stability;
 };
+
+// order_points.csv's columns: the record columns with the ladder level moved after the label.
+std::vector<std::string> order_points_columns(std::vector<std::string> record_columns);
 
 // table.md: the scene's title and description, then a Markdown table per non-empty table.
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,

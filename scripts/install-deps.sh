@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages geomint builds with (docs/DESIGN.md §8). Idempotent: installs only
 # what is missing, waits for the dpkg lock, never pulls recommends. As non-root it prints the
-# exact command to run and exits 1.
+# exact command to run and exits 1. `install-deps.sh cluster` installs the local single-node Slurm
+# that `make test-cluster` runs (README "Running on a cluster") instead.
 set -euo pipefail
 
 PACKAGES=(
@@ -12,6 +13,10 @@ PACKAGES=(
   libsuitesparse-dev libmetis-dev libopenblas-dev
   clang libclang-rt-14-dev python3
 )
+if [ "${1:-}" = cluster ]; then
+  shift
+  PACKAGES=(slurmctld slurmd slurm-client munge)
+fi
 
 missing=()
 for pkg in "${PACKAGES[@]}"; do

@@ -281,5 +281,50 @@ TEST(Cli, HelpListsEveryExitCode) {
   }
 }
 
+// README "Running on a cluster": the CLI of sharded sweeps. Two shards of a scene's quick
+// variant merge (exit 0) into <folder>/quick; without shard 1, merge exits 1 and names the
+// resubmission; `geomint slurm` writes the three scripts next to the scene.
+TEST(Cli, ShardMergeAndSlurmScripts) {
+  const fs::path folder = scratch("cluster_scene");
+  fs::create_directories(folder);
+  std::ofstream(folder / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic\"]\n"
+         "methods = [\"stormer_verlet\", \"rk4\", \"hp\"]\ndt = 0.1\nt_end = 1.0\n"
+         "quick_t_end = 0.5\n";
+  const std::string scene = (folder / "scene.toml").string();
+  const fs::path out = folder / "quick";
+  ASSERT_EQ(geomint("sweep " + scene + " --quick --shard 0/2").exit_code, 0);
+  const Outcome refused = geomint("merge " + out.string());
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_NE(refused.output.find("shard 1/2: summary.1-of-2.csv is missing"), std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("sbatch --array=1 " + (folder / "sweep.sbatch").string()),
+            std::string::npos)
+      << refused.output;
+  ASSERT_EQ(geomint("sweep " + scene + " --quick --shard 1/2").exit_code, 0);
+  const Outcome merged = geomint("merge " + out.string());
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
+  std::ifstream summary(out / "summary.csv");
+  const std::string text{std::istreambuf_iterator<char>(summary), {}};
+  EXPECT_NE(text.find("# command: geomint sweep " + scene + " --quick --no-timing\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("# variant: quick\n"), std::string::npos) << text;
+  const Outcome slurm = geomint("slurm " + scene + " --shards 2 --max-parallel 1 --time 0:10:00");
+  EXPECT_EQ(slurm.exit_code, 0) << slurm.output;
+  std::ifstream sweep(folder / "sweep.sbatch");
+  const std::string script{std::istreambuf_iterator<char>(sweep), {}};
+  for (const char* line : {"#SBATCH --array=0-1%1\n", "#SBATCH --requeue\n",
+                           "#SBATCH --time=0:10:00\n", "--shard-from-env --shards 2 --no-timing"}) {
+    EXPECT_NE(script.find(line), std::string::npos) << line << " in\n" << script;
+  }
+  EXPECT_TRUE(fs::exists(folder / "merge.sbatch"));
+  std::ifstream timing(folder / "timing.sbatch");
+  const std::string timing_script{std::istreambuf_iterator<char>(timing), {}};
+  EXPECT_NE(timing_script.find("#SBATCH --exclusive"), std::string::npos) << timing_script;
+  EXPECT_NE(timing_script.find("srun --cpu-bind=cores"), std::string::npos) << timing_script;
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace geomint

@@ -1,0 +1,108 @@
+// Sweeps beyond one machine (README "Running on a cluster", docs/DESIGN.md §3, §5): shard ids
+// and their file names, the provenance a shard carries, `geomint merge` (tables byte-identical
+// to a single-machine sweep) and the Slurm scripts of `geomint slurm`.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "harness/scene.hpp"
+#include "harness/table.hpp"
+
+namespace geomint {
+
+struct ShardId {
+  int index = 0, count = 0;  // shard index of count shards: units k with k mod count == index
+};
+
+// A CSV's `# key: value` provenance lines and its header's column names (parse_csv drops empty
+// cells, so a column whose cells are all empty is known only from the header).
+std::vector<std::pair<std::string, std::string>> csv_provenance(const std::string& text);
+std::vector<std::string> csv_header(const std::string& text);
+
+// "i/N" with 0 <= i < N (InputError naming --shard otherwise).
+ShardId parse_shard(const std::string& text);
+
+// The shard of this process from the environment (`--shard-from-env`): SLURM_ARRAY_TASK_ID with
+// `count` (the count written into sweep.sbatch; a resubmitted --array=3 sees a task count of 1),
+// else OMPI_COMM_WORLD_RANK/OMPI_COMM_WORLD_SIZE or PMI_RANK/PMI_SIZE (mpirun, srun). `count`
+// 0 means not given. InputError naming the variables when none is set or they disagree.
+ShardId shard_from_env(int count);
+
+// Hash of the scene file's bytes and the variant ("fnv1a64:<16 hex digits>"): the shards of one
+// merge must come from the same scene text. InputError when the file cannot be read.
+std::string scene_content_hash(const std::string& scene_path, bool quick);
+
+// <out_dir>/shards/<table>.<i>-of-<N>.csv
+std::string shard_file(const std::string& out_dir, const std::string& table, ShardId id);
+
+// The tables a shard of a scene with these unit counts writes (summary; order and order_points;
+// stability), whether or not the shard holds a unit of them, so completeness is file presence.
+std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability);
+
+// The column that carries a row's unit index k in the canonical expansion order.
+inline const char* const kCanonicalIndexColumn = "canonical_index";
+
+// The command of the single-machine sweep a merge reproduces: the shard command without
+// --shard, --shard-from-env and --shards, with --no-timing (a shard is never timed).
+std::string merged_sweep_command(const std::string& shard_command);
+
+// Writes one shard table atomically: `lines` plus host, scene hash and `shard: i/N`, then the
+// rows with their canonical index first.
+void write_shard_table(const std::string& out_dir, const std::string& table, ShardId id,
+                       const std::string& scene_hash, std::vector<Row> rows,
+                       const std::vector<size_t>& indices, std::vector<std::string> columns,
+                       std::vector<std::pair<std::string, std::string>> lines);
+
+// True when every table of the shard is on disk with this binary's version, this scene hash and
+// this shard id: a rerun (a requeued array task) then has nothing to do.
+bool shard_complete(const std::string& out_dir, const std::vector<std::string>& tables, ShardId id,
+                    const std::string& scene_hash);
+
+// Test hook of `make test-cluster`: a sharded sweep whose index equals GEOMINT_FAIL_SHARD exits
+// 1 without writing, as a crashed node would.
+bool shard_fails_on_purpose(ShardId id);
+
+// `geomint merge`: refused (exit 1) because shards are missing, of another scene or version, or
+// duplicated; what() names the files and ends with the resubmission command.
+class MergeRefused : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct MergeOptions {
+  std::string out_dir;      // the folder holding shards/; receives the tables and hosts.csv
+  std::string scene_hash;   // of the scene file as it is now
+  std::string scene_name;   // `# scene:` line
+  std::string variant;      // `# variant:` line (shards_variant())
+  std::string sbatch_path;  // sweep.sbatch named by the resubmission command
+};
+
+// The variant (`full`/`quick`) the shards in <out_dir>/shards were run with; InputError when
+// the folder holds no shard.
+std::string shards_variant(const std::string& out_dir);
+
+// Checks that <out_dir>/shards holds exactly one complete matching set of shards of `scene`, then
+// writes summary.csv, order.csv, order_points.csv, stability.csv and table.md byte-identical to
+// `geomint sweep --no-timing` (date line aside) and hosts.csv (shard, host, cpu, date).
+void merge_shards(const Scene& scene, const MergeOptions& options);
+
+// `geomint slurm`: sweep.sbatch (array of `count` shards, at most max_parallel at once,
+// --requeue), merge.sbatch and timing.sbatch (--exclusive, srun --cpu-bind=cores), written next
+// to the scene file. Returns their paths in submission order.
+struct SlurmOptions {
+  std::string scene_path, geomint_path;
+  bool quick = false;
+  int shards = 0, max_parallel = 0;  // max_parallel 0: no limit
+  std::string partition, time_limit;
+  int jobs = 1;  // --jobs of each shard (cpus-per-task)
+};
+std::vector<std::string> write_slurm_scripts(const SlurmOptions& options);
+
+// `sbatch --parsable [--dependency=afterok:<after>] <script>`; returns the job id. InputError
+// when sbatch cannot be run or refuses the script (its message included).
+std::string submit_sbatch(const std::string& script, const std::string& after);
+
+}  // namespace geomint
