@@ -88,11 +88,56 @@ TEST(ConstrainedProblems, DerivativesMatchFiniteDifferences) {
   }
 }
 
+// Rheonomic constraints: along the path (q + sv, t + s), dg/ds = G v + g_t and d²g/ds² = c(q, v) +
+// a_t, both against central differences at a few times.
+TEST(ConstrainedProblems, TimeTermsMatchFiniteDifferences) {
+  unsigned seed = 77;
+  int checked = 0;
+  for (const auto& spec : constrained_specs()) {
+    const auto problem = make_problem(spec);
+    if (!problem->has(kTimeDependentConstraints)) continue;
+    SCOPED_TRACE(spec);
+    ++checked;
+    const int n = problem->dof();
+    const Vec q0 = problem->initial_state().q;
+    for (double t : {0.0, 0.37, 1.9}) {
+      const Vec q = q0 + 0.05 * test::random_vector(n, ++seed);
+      const Vec v = test::random_vector(n, ++seed);
+      const auto g_at = [&](double s) {
+        Vec g;
+        problem->constraint_at(t + s, q + s * v, g);
+        return g;
+      };
+      SparseMatrix G;
+      problem->constraint_jacobian_at(t, q, G);
+      Vec c, g_t, a_t;
+      problem->constraint_curvature(q, v, c);
+      problem->constraint_time_terms(t, q, v, g_t, a_t);
+      const double h = 1e-4;
+      const Vec rate = G * v + g_t;
+      const Vec rate_fd = (g_at(h) - g_at(-h)) / (2 * h);
+      EXPECT_LE(inf_norm(rate - rate_fd), 1e-7 * (inf_norm(rate) + 1)) << "t = " << t;
+      const Vec second = c + a_t;
+      const Vec second_fd = (g_at(h) - 2 * g_at(0) + g_at(-h)) / (h * h);
+      EXPECT_LE(inf_norm(second - second_fd), 1e-5 * (inf_norm(second) + 1)) << "t = " << t;
+      // G(q, t) is the q-derivative of g(q, t) at that t.
+      const Vec w = test::random_vector(n, ++seed);
+      const auto g_q = [&](const Vec& x) {
+        Vec g;
+        problem->constraint_at(t, x, g);
+        return g;
+      };
+      EXPECT_LE(inf_norm(G * w - directional_difference(g_q, q, w, 1e-5)), 1e-7) << "t = " << t;
+    }
+  }
+  EXPECT_GT(checked, 0) << "no problem with time-dependent constraints in the registry";
+}
+
 // The exact motion stays on the rod at position and velocity level, to round-off.
 TEST(ConstrainedProblems, ExactMotionIsConsistent) {
   for (const auto& spec : constrained_specs()) {
     const auto problem = make_problem(spec);
-    if (!problem->has(kExact)) continue;
+    if (!problem->has(kExact)) continue;  // (and rheonomic problems have none)
     SCOPED_TRACE(spec);
     for (double t : {0.0, 0.7, 3.1, 41.0}) {
       const State at = problem->exact(t);
