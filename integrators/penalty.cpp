@@ -75,12 +75,14 @@ class Penalty final : public Integrator {
   Penalty(double stiffness, std::string base_name, std::unique_ptr<Integrator> base)
       : stiffness_(stiffness), base_name_(std::move(base_name)), base_(std::move(base)) {}
 
-  // Order 0: at fixed k the error does not go to zero with h (it levels off at the O(1/k) rod
-  // stretch). The base's symplecticity and symmetry hold for the penalised Lagrangian, not on
-  // the constraint manifold, so they are not declared: the registry suites check declared flags.
+  // The base's order, which holds for the penalised system: against the constrained motion the
+  // error levels off at the O(1/k) rod stretch as h → 0. The base's symplecticity and symmetry
+  // also hold for the penalised Lagrangian only, so they are not declared (the registry suites
+  // check declared flags).
   MethodInfo info() const override {
     const unsigned kept = kExplicit | kImplicit | kAdaptive | kNeedsHessian;
-    return {"penalty", 0, (base_->info().flags & kept) | kConstrained | kConstraintsOnly,
+    return {"penalty", base_->info().order,
+            (base_->info().flags & kept) | kConstrained | kConstraintsOnly,
             fmt::format("quadratic penalty k/2 |g(q)|^2 (k = {:g}) integrated by {} (PAPER.md §3 "
                         "contrast; Hairer, Lubich & Wanner, GNI §VII.1)",
                         stiffness_, base_name_)};
