@@ -61,6 +61,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kConstrained, "constrained"},
       {kNeedsHessian, "needs_hessian"},
       {kConstraintsOnly, "constraints_only"},
+      {kRheonomic, "rheonomic"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -111,6 +112,11 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
             fmt::format("method '{}' does not handle holonomic constraints, which problem "
                         "'{}' has; methods that do: {}",
                         method.spec(), problem.name(), fmt::join(constrained_methods(), ", "))};
+  }
+  if (problem.has(kTimeDependentConstraints) && !(info.flags & kRheonomic)) {
+    return {false, fmt::format("method '{}' handles only time-free constraints; problem '{}' has "
+                               "time-dependent ones (ida:index=2 or ida:index=3 solve it)",
+                               method.spec(), problem.name())};
   }
   if ((info.flags & kConstraintsOnly) && !problem.has(kConstraints)) {
     return {false, fmt::format("method '{}' is for problems with holonomic constraints; problem "

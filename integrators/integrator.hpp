@@ -23,6 +23,7 @@ enum MethodFlag : unsigned {
   kConstrained = 1u << 6,      // handles holonomic constraints (Problem kConstraints)
   kNeedsHessian = 1u << 7,     // needs Problem::hessian
   kConstraintsOnly = 1u << 8,  // only for problems with constraints (rattle, penalty, ida:index)
+  kRheonomic = 1u << 9,        // also time-dependent constraints (kTimeDependentConstraints)
 };
 std::vector<std::string> flag_names(unsigned flags);
 

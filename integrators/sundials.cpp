@@ -102,12 +102,14 @@ class SundialsIntegrator : public AdaptiveIntegrator {
   SundialsIntegrator(const AdaptiveSettings& settings, std::string library)
       : AdaptiveIntegrator(settings, "SUNDIALS wrappers"), library_(std::move(library)) {}
 
-  // Base reset, a fresh context and y0 = (q, p). Returns false (setup_status_ set) on failure.
-  bool begin_reset(const Problem& problem, const State& state) {
+  // Base reset, a fresh context and y0 = (q, p, 0 …): `extra` zero components after (q, p) for
+  // DAE unknowns (multipliers). Returns false (setup_status_ set) on failure.
+  bool begin_reset(const Problem& problem, const State& state, int extra = 0) {
     begin_adaptive_reset(problem, state, 0.0);
     library_message_.clear();
     extra_rhs_evals_ = extra_jacobian_evals_ = 0;
-    n_ = 2 * problem.dof();
+    dof_ = problem.dof();
+    n_ = 2 * dof_ + extra;
     y_.reset();  // before the context it was created in
     context_.reset();
     SUNContext context = nullptr;
@@ -118,8 +120,9 @@ class SundialsIntegrator : public AdaptiveIntegrator {
     y_.reset(N_VNew_Serial(n_, context_.get()));
     if (!y_) return setup_failed(-1, "N_VNew_Serial failed");
     auto y = view_mutable(y_.get());
-    y.head(problem.dof()) = state.q;
-    y.tail(problem.dof()) = state.p;
+    y.setZero();
+    y.head(dof_) = state.q;
+    y.segment(dof_, dof_) = state.p;
     return true;
   }
 
@@ -158,9 +161,8 @@ class SundialsIntegrator : public AdaptiveIntegrator {
   // stamped with t_stop exactly, so the caller's loop ends on it without a sliver step.
   void publish(N_Vector y, double t_returned, double t_stop, bool at_stop, State& state) {
     const auto values = view(y);
-    const int dof = n_ / 2;
-    state.q = values.head(dof);
-    state.p = values.tail(dof);
+    state.q = values.head(dof_);
+    state.p = values.segment(dof_, dof_);
     t_ = at_stop ? t_stop : t_returned;
     state.t = t_;
   }
@@ -201,6 +203,7 @@ class SundialsIntegrator : public AdaptiveIntegrator {
   }
 
   std::string library_;  // flag prefix: "cvode", "ida", "arkode"
+  int dof_ = 0;
   int n_ = 0;
   std::string library_message_;
   long extra_rhs_evals_ = 0;       // evaluations made outside the library (IDA's y'(0))
@@ -415,17 +418,37 @@ class Cvode final : public SundialsIntegrator {
 };
 
 // ---------------------------------------------------------------------------------------------
-// IDA on F(t, y, y') = y' − f(t, y) = 0 (no algebraic part yet; constraints come later). The
-// initial y'(0) = f(0, y0) is consistent by construction, so IDACalcIC is not needed. Newton
-// matrix dF/dy + c_j dF/dy' = c_j I − ∂f/∂y, dense.
+// IDA on F(t, y, y') = y' − f(t, y) = 0 (`index=ode`, the default). The initial y'(0) =
+// f(0, y0) is consistent by construction, so IDACalcIC is not needed. Newton matrix dF/dy +
+// c_j dF/dy' = c_j I − ∂f/∂y, dense.
+//
+// On a constrained problem (docs/METHOD.md §3, Hairer & Wanner II §VII.1, Brenan, Campbell &
+// Petzold 1996 §6.2) `index=3` solves the DAE itself in y = (q, p, λ):
+//   q' = M⁻¹p,  p' = −∇V + F − Gᵀλ,  0 = g(q);
+// `index=2` the stabilised Gear–Gupta–Leimkuhler form in y = (q, p, λ, μ):
+//   q' = M⁻¹(p − Gᵀμ),  p' = −∇V + F − Gᵀλ,  0 = G M⁻¹p,  0 = g(q)
+// (μ = 0 on exact solutions; it projects q' back onto g = 0). Time-dependent constraints
+// (car_axis) use g(q, t), G(q, t) and, at index 2, G M⁻¹p + ∂g/∂t = 0. The error test leaves out
+// what the index makes unreliable (IDASetId + IDASetSuppressAlg): λ, μ, and at index 3 also p,
+// whose local error estimate is O(h^(k−1)) there. Consistent (y, y') at t0 come from the problem's
+// own multipliers (Problem::multipliers, μ = 0), exact to round-off: IDACalcIC only treats
+// index-1 systems (IDA user guide §2.1), so it does not apply to either form. The Newton
+// Jacobian is IDA's dense difference quotient.
 class Ida final : public SundialsIntegrator {
  public:
-  Ida(const AdaptiveSettings& settings, int max_order)
-      : SundialsIntegrator(settings, "ida"), max_order_(max_order) {}
+  Ida(const AdaptiveSettings& settings, int max_order, int index)
+      : SundialsIntegrator(settings, "ida"), max_order_(max_order), index_(index) {}
 
   MethodInfo info() const override {
-    return {"ida", max_order_, kImplicit | kAdaptive,
-            "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
+    if (index_ == 0) {
+      return {"ida", max_order_, kImplicit | kAdaptive,
+              "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
+    }
+    return {"ida", max_order_, kImplicit | kAdaptive | kConstrained | kConstraintsOnly | kRheonomic,
+            index_ == 3 ? "SUNDIALS IDA, BDF on the index-3 constrained equations of motion "
+                          "(Brenan, Campbell & Petzold 1996 §6.2)"
+                        : "SUNDIALS IDA, BDF on the stabilised index-2 (Gear-Gupta-Leimkuhler "
+                          "1985) constrained equations of motion"};
   }
 
   void reset(const Problem& problem, const State& state, double) override {
@@ -433,14 +456,18 @@ class Ida final : public SundialsIntegrator {
     linear_solver_.reset();
     matrix_.reset();
     yp_.reset();
-    if (!begin_reset(problem, state)) return;
+    id_.reset();
+    constraint_count_ = index_ == 0 ? 0 : problem.constraint_count();
+    const int multipliers = index_ == 3 ? constraint_count_ : 2 * constraint_count_;
+    if (!begin_reset(problem, state, multipliers)) return;
     yp_.reset(N_VNew_Serial(n_, context_.get()));
     if (!yp_) {
       setup_failed(-1, "N_VNew_Serial failed");
       return;
     }
+    if (index_ != 0 && !consistent_start(problem, state)) return;
     ++extra_rhs_evals_;
-    if (evaluate_rhs(state.t, y_.get(), yp_.get()) != 0) {
+    if (evaluate_residual(state.t, y_.get(), nullptr, yp_.get()) != 0) {
       setup_failed(-1, "f(t0, y0) is not finite or threw " + callback_error_);
       return;
     }
@@ -457,6 +484,7 @@ class Ida final : public SundialsIntegrator {
         !check_setup(IDASetMaxOrd(ida, max_order_), "IDASetMaxOrd")) {
       return;
     }
+    if (index_ != 0 && !exclude_from_error_test(ida)) return;
     matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
     if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
     if (!matrix_ || !linear_solver_) {
@@ -467,7 +495,7 @@ class Ida final : public SundialsIntegrator {
                      "IDASetLinearSolver")) {
       return;
     }
-    analytic_jacobian_ = problem.has(kHessian);
+    analytic_jacobian_ = index_ == 0 && problem.has(kHessian);
     if (analytic_jacobian_) check_setup(IDASetJacFn(ida, &jacobian), "IDASetJacFn");
   }
 
@@ -477,7 +505,7 @@ class Ida final : public SundialsIntegrator {
     // IDA's own too-much-accuracy test (unit roundoff times the weighted RMS norm of y above 1)
     // comes after its initial-step estimate, which overflows first at such tolerances and then
     // reports "tstop is behind current t". The same test here names the real cause.
-    status = check_tolerances_above_roundoff(N_VGetArrayPointer(y_.get()), n_, "ida_flag_-2",
+    status = check_tolerances_above_roundoff(N_VGetArrayPointer(y_.get()), 2 * dof_, "ida_flag_-2",
                                              "ida (IDA_TOO_MUCH_ACC)");
     if (!status.ok) return status;
     void* ida = memory_.get();
@@ -491,13 +519,85 @@ class Ida final : public SundialsIntegrator {
   }
 
  private:
-  // F = y' − f(t, y).
+  // λ(t0) from the problem (the multipliers that keep d²g/dt² = 0), μ = 0, and y'(t0) from the
+  // differential equations; the algebraic components of y' are not used by the residual.
+  bool consistent_start(const Problem& problem, const State& state) {
+    try {
+      auto y = view_mutable(y_.get());
+      y.segment(2 * dof_, constraint_count_) = problem.multipliers(state.t, state.q, state.p);
+      return true;
+    } catch (const std::exception& error) {
+      return setup_failed(-1, std::string("initial multipliers: ") + error.what());
+    }
+  }
+
+  // id = 1 for the components in the error test, 0 for the rest (suppressed).
+  bool exclude_from_error_test(void* ida) {
+    id_.reset(N_VNew_Serial(n_, context_.get()));
+    if (!id_) return setup_failed(-1, "N_VNew_Serial failed");
+    auto id = view_mutable(id_.get());
+    id.setZero();
+    id.head(index_ == 3 ? dof_ : 2 * dof_).setOnes();
+    return check_setup(IDASetId(ida, id_.get()), "IDASetId") &&
+           check_setup(IDASetSuppressAlg(ida, SUNTRUE), "IDASetSuppressAlg");
+  }
+
+  // The residual F(t, y, y'); with yp == nullptr it writes the derivative part alone (F with
+  // y' = 0, negated: the y' that zeroes the differential rows) into `out`.
+  int evaluate_residual(double t, N_Vector y_vector, N_Vector yp_vector, N_Vector out) noexcept {
+    if (index_ == 0) {
+      const int flag = evaluate_rhs(t, y_vector, out);
+      if (flag != 0 || yp_vector == nullptr) return flag;
+      view_mutable(out) = view(yp_vector) - view(out);
+      return 0;
+    }
+    try {
+      const auto y = view(y_vector);
+      const int n = dof_, m = constraint_count_;
+      const Problem& problem = *problem_;
+      q_ = y.head(n);
+      p_ = y.segment(n, n);
+      const Vec v = problem.inverse_mass().cwiseProduct(p_);
+      problem.gradient(q_, force_);
+      force_ = -force_;
+      if (problem.has(kForce)) {
+        problem.force(q_, v, t, applied_);
+        force_ += applied_;
+      }
+      problem.constraint_jacobian_at(t, q_, G_);
+      force_ -= G_.transpose() * y.segment(2 * n, m);
+      rate_.resize(2 * n);
+      rate_.head(n) = v;
+      if (index_ == 2) {
+        rate_.head(n) -= problem.inverse_mass().cwiseProduct(G_.transpose() * y.tail(m));
+      }
+      rate_.tail(n) = force_;
+      if (!rate_.allFinite()) return 1;
+      auto r = view_mutable(out);
+      r.setZero();
+      if (yp_vector == nullptr) {
+        r.head(2 * n) = rate_;
+        return 0;
+      }
+      r.head(2 * n) = view(yp_vector).head(2 * n) - rate_;
+      problem.constraint_at(t, q_, g_);
+      if (index_ == 3) {
+        r.tail(m) = g_;
+      } else {
+        // dg/dt = G v + ∂g/∂t (rheonomic constraints; zero otherwise).
+        problem.constraint_time_terms(t, q_, v, g_time_, a_time_);
+        r.segment(2 * n, m) = G_ * v + g_time_;
+        r.tail(m) = g_;
+      }
+      return r.allFinite() ? 0 : 1;
+    } catch (const std::exception& error) {
+      callback_error_ = error.what();
+      return -1;
+    }
+  }
+
   static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void* self) {
-    auto& ida = *static_cast<Ida*>(self);
-    const int flag = ida.evaluate_rhs(t, y, r);
-    if (flag != 0) return flag;
-    view_mutable(r) = view(yp) - view(r);
-    return 0;
+    return static_cast<Ida*>(self)->evaluate_residual(t, y, yp, r);
   }
 
   static int jacobian(sunrealtype t, sunrealtype c_j, N_Vector y, N_Vector, N_Vector,
@@ -529,8 +629,13 @@ class Ida final : public SundialsIntegrator {
   }
 
   int max_order_;
+  int index_;  // 0: the ODE residual; 2 or 3: the constrained DAE of that index
+  int constraint_count_ = 0;
   bool analytic_jacobian_ = false;
+  Vec q_, p_, force_, applied_, rate_, g_, g_time_, a_time_;
+  SparseMatrix G_;
   VectorPtr yp_;
+  VectorPtr id_;
   MatrixPtr matrix_;
   LinearSolverPtr linear_solver_;
   MemoryPtr<IdaDeleter> memory_;
@@ -726,7 +831,14 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
   const AdaptiveSettings settings = read_settings(params);
   const auto max_order = static_cast<int>(
       params.integer("max_order", 5, "maximum order of the variable-order BDF formulas", 1, 5));
-  return std::make_unique<Ida>(settings, max_order);
+  const std::string index = params.choice(
+      "index", "ode", {"ode", "2", "3"},
+      "what IDA solves: the unconstrained first-order ODE, or on a constrained problem the DAE "
+      "of index 3 (q, p, lambda; g = 0) or the stabilised index-2 GGL form (q, p, lambda, mu; "
+      "G v = 0 and g = 0)");
+  // Plain `ida` keeps its canonical spec (and the names of its committed runs).
+  params.omit_default_from_canonical("index");
+  return std::make_unique<Ida>(settings, max_order, index == "ode" ? 0 : std::stoi(index));
 }
 
 std::unique_ptr<Integrator> make_arkode_erk(Params& params) {

@@ -2,6 +2,8 @@
 // functions (DLMF §22.19(i)): librating, sin(θ/2) = k sn(u0 + ω0 t | k²); rotating (k > 1),
 // θ/2 = am(u0 ± k ω0 t | 1/k²). Modulus and complementary modulus are kept apart so that the
 // solution stays exact to rounding next to the separatrix k = 1.
+#include "problems/pendulum.hpp"
+
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_mode.h>
 #include <gsl/gsl_sf_ellint.h>
@@ -77,47 +79,76 @@ Jacobi jacobi_elliptic(double u, double m, double complementary_m) {
   return {phi, sn, cn, std::sqrt(cn * cn + complementary_m * sn * sn)};
 }
 
+}  // namespace
+
+PendulumMotion::PendulumMotion(double theta0, double omega0, double v0) : omega0_(omega0) {
+  // k² = E / (2 ω0²) with E = ½ θ̇² + 2 ω0² sin²(θ/2); the motion librates iff k < 1. With
+  // s = sin(θ0/2), c = |cos(θ0/2)|, w = |v0|/(2ω0): k² = s² + w² and 1 − k² = (c − w)(c + w),
+  // which keeps its relative accuracy at θ0 = π − 1e-6 where 1 − k² ~ 1e-13.
+  const double reduced_theta0 = std::remainder(theta0, 2 * kPi);  // in [−π, π]
+  // The formulas live on [−π, π]; whole turns in θ0 are carried as an offset.
+  turns_offset_ = theta0 - reduced_theta0;
+  const double s = std::sin(reduced_theta0 / 2);
+  const double c = std::cos(reduced_theta0 / 2);
+  const double w = std::abs(v0) / (2 * omega0);
+  const double modulus_squared = s * s + w * w;
+  const double one_minus_k2 = (c - w) * (c + w);
+  modulus_ = std::sqrt(modulus_squared);
+  // On the separatrix itself (and within k' < 1e-10 of it) the period is infinite or too
+  // ill-conditioned to call anything exact.
+  has_exact_ = std::abs(one_minus_k2) >= 1e-20;
+  librating_ = one_minus_k2 > 0;
+  if (has_exact_ && librating_) {
+    parameter_ = modulus_squared;
+    complementary_parameter_ = one_minus_k2;
+    quarter_period_ = complete_elliptic_k(complementary_parameter_);
+    // am(u0) = φ0 with k sn(u0) = sin(θ0/2) and 2 k ω0 cn(u0) = v0; from rest at θ0 > 0
+    // this gives φ0 = π/2 and u0 = K.
+    const double phi0 = std::atan2(s, v0 / (2 * omega0));
+    phase0_ = incomplete_elliptic_f(phi0, complementary_parameter_, quarter_period_);
+  } else if (has_exact_) {
+    // Rotation: θ/2 = am(u0 + σ k ω0 t | 1/k²), σ = sign(v0), u0 = F(θ0/2 | 1/k²);
+    // 1 − 1/k² = (w − c)(w + c)/k².
+    parameter_ = 1 / modulus_squared;
+    complementary_parameter_ = -one_minus_k2 / modulus_squared;
+    quarter_period_ = complete_elliptic_k(complementary_parameter_);
+    direction_ = v0 < 0 ? -1.0 : 1.0;
+    phase0_ = incomplete_elliptic_f(reduced_theta0 / 2, complementary_parameter_, quarter_period_);
+  }
+}
+
+PendulumMotion::Angle PendulumMotion::at(double t) const {
+  if (librating_) {
+    // sn, cn are 4K-periodic; reducing the argument exactly (std::remainder) keeps the
+    // Landen iteration accurate at large t.
+    const double u = std::remainder(phase0_ + omega0_ * t, 4 * quarter_period_);
+    const Jacobi f = jacobi_elliptic(u, parameter_, complementary_parameter_);
+    // cos(θ/2) = dn, so atan2 stays well conditioned near θ = ±π where arcsin is not.
+    return {turns_offset_ + 2 * std::atan2(modulus_ * f.sn, f.dn), 2 * modulus_ * omega0_ * f.cn};
+  }
+  // am(u + 2K) = am(u) + π: whole half-periods of am are counted, the rest is reduced.
+  const double u = phase0_ + direction_ * modulus_ * omega0_ * t;
+  const double half_turns = std::round(u / (2 * quarter_period_));
+  const double reduced_u = u - half_turns * 2 * quarter_period_;
+  const Jacobi f = jacobi_elliptic(reduced_u, parameter_, complementary_parameter_);
+  return {turns_offset_ + 2 * f.am + 2 * kPi * half_turns,
+          2 * direction_ * modulus_ * omega0_ * f.dn};
+}
+
+// Libration: 4K(k)/ω0; rotation: the time of one revolution, 2K(1/k)/(k ω0).
+double PendulumMotion::period() const {
+  if (librating_) return 4 * quarter_period_ / omega0_;
+  return 2 * quarter_period_ / (modulus_ * omega0_);
+}
+
+namespace {
+
 class Pendulum final : public Problem {
  public:
-  Pendulum(double theta0, double omega0, double v0) : theta0_(theta0), omega0_(omega0), v0_(v0) {
-    // k² = E / (2 ω0²) with E = ½ θ̇² + 2 ω0² sin²(θ/2); the motion librates iff k < 1. With
-    // s = sin(θ0/2), c = |cos(θ0/2)|, w = |v0|/(2ω0): k² = s² + w² and 1 − k² = (c − w)(c + w),
-    // which keeps its relative accuracy at θ0 = π − 1e-6 where 1 − k² ~ 1e-13.
-    const double reduced_theta0 = std::remainder(theta0, 2 * kPi);  // in [−π, π]
-    // The formulas live on [−π, π]; whole turns in θ0 are carried as an offset.
-    turns_offset_ = theta0 - reduced_theta0;
-    const double s = std::sin(reduced_theta0 / 2);
-    const double c = std::cos(reduced_theta0 / 2);
-    const double w = std::abs(v0) / (2 * omega0);
-    const double modulus_squared = s * s + w * w;
-    const double one_minus_k2 = (c - w) * (c + w);
-    modulus_ = std::sqrt(modulus_squared);
-    // On the separatrix itself (and within k' < 1e-10 of it) the period is infinite or too
-    // ill-conditioned to call anything exact.
-    const bool has_exact = std::abs(one_minus_k2) >= 1e-20;
-    librating_ = one_minus_k2 > 0;
-
+  Pendulum(double theta0, double omega0, double v0)
+      : theta0_(theta0), omega0_(omega0), v0_(v0), motion_(theta0, omega0, v0) {
     unsigned capabilities = kHessian | kOmegaMax;
-    if (has_exact && librating_) {
-      capabilities |= kExact | kPeriod;
-      parameter_ = modulus_squared;
-      complementary_parameter_ = one_minus_k2;
-      quarter_period_ = complete_elliptic_k(complementary_parameter_);
-      // am(u0) = φ0 with k sn(u0) = sin(θ0/2) and 2 k ω0 cn(u0) = v0; from rest at θ0 > 0
-      // this gives φ0 = π/2 and u0 = K.
-      const double phi0 = std::atan2(s, v0 / (2 * omega0));
-      phase0_ = incomplete_elliptic_f(phi0, complementary_parameter_, quarter_period_);
-    } else if (has_exact) {
-      // Rotation: θ/2 = am(u0 + σ k ω0 t | 1/k²), σ = sign(v0), u0 = F(θ0/2 | 1/k²);
-      // 1 − 1/k² = (w − c)(w + c)/k².
-      capabilities |= kExact | kPeriod;
-      parameter_ = 1 / modulus_squared;
-      complementary_parameter_ = -one_minus_k2 / modulus_squared;
-      quarter_period_ = complete_elliptic_k(complementary_parameter_);
-      direction_ = v0 < 0 ? -1.0 : 1.0;
-      phase0_ =
-          incomplete_elliptic_f(reduced_theta0 / 2, complementary_parameter_, quarter_period_);
-    }
+    if (motion_.has_exact()) capabilities |= kExact | kPeriod;
     set_mass(Vec::Ones(1));
     set_capabilities(capabilities);
     // Same steps per small-amplitude period for every ω0 (explicit stability needs h ω0 < 2).
@@ -145,29 +176,12 @@ class Pendulum final : public Problem {
 
   State exact(double t) const override {
     if (!has(kExact)) return Problem::exact(t);
-    if (librating_) {
-      // sn, cn are 4K-periodic; reducing the argument exactly (std::remainder) keeps the
-      // Landen iteration accurate at large t.
-      const double u = std::remainder(phase0_ + omega0_ * t, 4 * quarter_period_);
-      const Jacobi f = jacobi_elliptic(u, parameter_, complementary_parameter_);
-      // cos(θ/2) = dn, so atan2 stays well conditioned near θ = ±π where arcsin is not.
-      const double theta = turns_offset_ + 2 * std::atan2(modulus_ * f.sn, f.dn);
-      return {t, Vec::Constant(1, theta), Vec::Constant(1, 2 * modulus_ * omega0_ * f.cn)};
-    }
-    // am(u + 2K) = am(u) + π: whole half-periods of am are counted, the rest is reduced.
-    const double u = phase0_ + direction_ * modulus_ * omega0_ * t;
-    const double half_turns = std::round(u / (2 * quarter_period_));
-    const double reduced_u = u - half_turns * 2 * quarter_period_;
-    const Jacobi f = jacobi_elliptic(reduced_u, parameter_, complementary_parameter_);
-    const double theta = turns_offset_ + 2 * f.am + 2 * kPi * half_turns;
-    return {t, Vec::Constant(1, theta),
-            Vec::Constant(1, 2 * direction_ * modulus_ * omega0_ * f.dn)};
+    const PendulumMotion::Angle angle = motion_.at(t);
+    return {t, Vec::Constant(1, angle.theta), Vec::Constant(1, angle.theta_dot)};
   }
-  // Libration: 4K(k)/ω0; rotation: the time of one revolution, 2K(1/k)/(k ω0).
   double period() const override {
     if (!has(kPeriod)) return Problem::period();
-    if (librating_) return 4 * quarter_period_ / omega0_;
-    return 2 * quarter_period_ / (modulus_ * omega0_);
+    return motion_.period();
   }
   // The linearised frequency ω0 √(cos θ) is largest at the bottom (on the upper half the
   // linearisation is unstable, not oscillatory), so ω0 bounds it for every θ.
@@ -177,14 +191,7 @@ class Pendulum final : public Problem {
   double theta0_;
   double omega0_;
   double v0_;
-  double modulus_ = 0;  // k = √(E / 2ω0²); the motion librates iff k < 1
-  bool librating_ = false;
-  // Parameter m of the elliptic functions (k² librating, 1/k² rotating) and m' = 1 − m.
-  double parameter_ = 0, complementary_parameter_ = 1;
-  double quarter_period_ = 0;  // K(m)
-  double phase0_ = 0;          // u0
-  double direction_ = 1;       // sign of the rotation
-  double turns_offset_ = 0;    // θ0 minus its representative in [−π, π]
+  PendulumMotion motion_;
 };
 
 }  // namespace

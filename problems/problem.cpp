@@ -62,6 +62,7 @@ std::vector<std::string> capability_names(unsigned capabilities) {
       {kOmegaMax, "omega_max"},
       {kForceJacobian, "force_jacobian"},
       {kConstraints, "constraints"},
+      {kTimeDependentConstraints, "time_dependent_constraints"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -98,6 +99,15 @@ void Problem::constraint_hessian(const Vec&, const Vec&, SparseMatrix&) const {
   missing(*this, "constraint Hessian");
 }
 
+void Problem::constraint_at(double, const Vec& q, Vec& g) const { constraint(q, g); }
+void Problem::constraint_jacobian_at(double, const Vec& q, SparseMatrix& G) const {
+  constraint_jacobian(q, G);
+}
+void Problem::constraint_time_terms(double, const Vec&, const Vec&, Vec& g_t, Vec& a_t) const {
+  g_t = Vec::Zero(constraint_count());
+  a_t = Vec::Zero(constraint_count());
+}
+
 std::vector<std::string> Problem::multiplier_names() const {
   std::vector<std::string> names;
   for (int i = 1; i <= constraint_count(); ++i) names.push_back(fmt::format("lambda{}", i));
@@ -115,9 +125,11 @@ Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
     force_total += f;
   }
   SparseMatrix G;
-  constraint_jacobian(q, G);
-  Vec c;
+  constraint_jacobian_at(t, q, G);
+  Vec c, g_t, a_t;
   constraint_curvature(q, v, c);
+  constraint_time_terms(t, q, v, g_t, a_t);
+  c += a_t;
   // m is small for every catalogue problem (rods, pins), so a dense solve of G M⁻¹ Gᵀ is the
   // simplest correct choice; LDLT copes with the semidefinite case of redundant constraints.
   const Eigen::MatrixXd GMinv = Eigen::MatrixXd(G) * inverse_mass_.asDiagonal();
@@ -126,22 +138,44 @@ Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
   return S.ldlt().solve(rhs);
 }
 
+namespace {
+void require_time_free(const Problem& problem) {
+  if (problem.has(kTimeDependentConstraints)) {
+    throw std::logic_error("problem '" + problem.spec() +
+                           "' has time-dependent constraints: the residual needs the time t");
+  }
+}
+}  // namespace
+
 double Problem::constraint_residual(const Vec& q) const {
-  Vec g;
-  constraint(q, g);
-  return g.size() > 0 ? g.cwiseAbs().maxCoeff() : 0.0;
+  require_time_free(*this);
+  return constraint_residual(0.0, q);
 }
 
 double Problem::constraint_velocity_residual(const Vec& q, const Vec& p) const {
+  require_time_free(*this);
+  return constraint_velocity_residual(0.0, q, p);
+}
+
+double Problem::constraint_residual(double t, const Vec& q) const {
+  Vec g;
+  constraint_at(t, q, g);
+  return g.size() > 0 ? g.cwiseAbs().maxCoeff() : 0.0;
+}
+
+double Problem::constraint_velocity_residual(double t, const Vec& q, const Vec& p) const {
   SparseMatrix G;
-  constraint_jacobian(q, G);
-  const Vec Gv = G * inverse_mass_.cwiseProduct(p);
-  return Gv.size() > 0 ? Gv.cwiseAbs().maxCoeff() : 0.0;
+  constraint_jacobian_at(t, q, G);
+  const Vec v = inverse_mass_.cwiseProduct(p);
+  Vec g_t, a_t;
+  constraint_time_terms(t, q, v, g_t, a_t);
+  const Vec rate = G * v + g_t;
+  return rate.size() > 0 ? rate.cwiseAbs().maxCoeff() : 0.0;
 }
 
 void Problem::check_consistent(const State& state, const std::string& what, double tol) const {
   SparseMatrix G;
-  constraint_jacobian(state.q, G);
+  constraint_jacobian_at(state.t, state.q, G);
   // ‖G‖∞: the largest absolute row sum, the scale that turns a position error into g.
   Vec row_sums = Vec::Zero(G.rows());
   for (int k = 0; k < G.outerSize(); ++k) {
@@ -151,8 +185,8 @@ void Problem::check_consistent(const State& state, const std::string& what, doub
   const Vec v = inverse_mass_.cwiseProduct(state.p);
   const double q_norm = state.q.size() > 0 ? state.q.cwiseAbs().maxCoeff() : 0.0;
   const double v_norm = v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0;
-  const double position = constraint_residual(state.q);
-  const double velocity = constraint_velocity_residual(state.q, state.p);
+  const double position = constraint_residual(state.t, state.q);
+  const double velocity = constraint_velocity_residual(state.t, state.q, state.p);
   const double position_allowed = tol * G_norm * q_norm;
   const double velocity_allowed = tol * G_norm * v_norm;
   if (!(position <= position_allowed)) {

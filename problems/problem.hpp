@@ -36,6 +36,7 @@ enum Capability : unsigned {
   kOmegaMax = 1u << 6,         // omega_max(q)
   kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
   kConstraints = 1u << 8,      // holonomic constraints g(q) = 0: constraint_* (PAPER.md §3)
+  kTimeDependentConstraints = 1u << 9,  // rheonomic g(q, t) = 0: constraint_*_at (car_axis)
 };
 
 // Capability names for `geomint list` and error messages.
@@ -97,12 +98,27 @@ class Problem {
   // Names of the multipliers for series columns ("tension"); default lambda1 … lambdam.
   virtual std::vector<std::string> multiplier_names() const;
 
+  // Rheonomic constraints g(q, t) = 0 (has(kTimeDependentConstraints), e.g. a driven joint): g
+  // and G at time t, and the explicit time terms g_t = ∂g/∂t and a_t = 2(∂G/∂t)v + ∂²g/∂t², so
+  // that dg/dt = G v + g_t and d²g/dt² = G q̈ + c(q, v) + a_t (c and K above carry no explicit t).
+  // Defaults: the time-free functions and zero terms. Only methods that declare
+  // kTimeDependentConstraints see such problems (applicable()); the time-free functions of a
+  // rheonomic problem give g and G at t = 0.
+  virtual void constraint_at(double t, const Vec& q, Vec& g) const;
+  virtual void constraint_jacobian_at(double t, const Vec& q, SparseMatrix& G) const;
+  virtual void constraint_time_terms(double t, const Vec& q, const Vec& v, Vec& g_t,
+                                     Vec& a_t) const;
+
   // The exact motion's multipliers through (q, p) at time t: the λ that keeps d²g/dt² = 0,
-  // (G M⁻¹ Gᵀ) λ = G M⁻¹ (−∇V + F) + c(q, v). Only when has(kConstraints).
+  // (G M⁻¹ Gᵀ) λ = G M⁻¹ (−∇V + F) + c(q, v) + a_t. Only when has(kConstraints).
   Vec multipliers(double t, const Vec& q, const Vec& p) const;
-  // ‖g(q)‖∞ and ‖G(q) M⁻¹p‖∞ (position- and velocity-level constraint residuals).
+  // ‖g(q)‖∞ and ‖G(q) M⁻¹p‖∞ (position- and velocity-level constraint residuals); the versions
+  // with t evaluate g(q, t) and G(q, t)v + g_t, and are the ones that hold for rheonomic
+  // constraints (the time-free ones throw std::logic_error on such a problem).
   double constraint_residual(const Vec& q) const;
   double constraint_velocity_residual(const Vec& q, const Vec& p) const;
+  double constraint_residual(double t, const Vec& q) const;
+  double constraint_velocity_residual(double t, const Vec& q, const Vec& p) const;
   // Throws InputError unless `state` is consistent to round-off relative to its own scale:
   // ‖g(q)‖∞ ≤ tol·‖G‖∞‖q‖∞ and ‖G v‖∞ ≤ tol·‖G‖∞‖v‖∞ (no absolute floor). `what` names the
   // state in the message ("initial state").

@@ -86,7 +86,8 @@ std::vector<Vec> sample_configurations(const Problem& problem) {
   return points;
 }
 
-// Right-hand side of Hamilton's equations (q̇, ṗ) = (M⁻¹p, −∇V(q) + F(q, v, t)).
+// Right-hand side of Hamilton's equations (q̇, ṗ) = (M⁻¹p, −∇V(q) + F(q, v, t) − G(q)ᵀλ), the
+// constraint force only for constrained problems (λ from Problem::multipliers).
 Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
   const int n = problem.dof();
   Vec rhs(2 * n);
@@ -99,6 +100,11 @@ Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
     Vec f;
     problem.force(q, v, t, f);
     rhs.tail(n) += f;
+  }
+  if (problem.has(kConstraints)) {
+    SparseMatrix G;
+    problem.constraint_jacobian(q, G);
+    rhs.tail(n) -= G.transpose() * problem.multipliers(t, q, p);
   }
   return rhs;
 }
