@@ -73,8 +73,9 @@ class Composition final : public Integrator {
 
 std::unique_ptr<Integrator> make_composition(Params& params) {
   const std::string base = params.choice(
-      "base", "stormer_verlet", {"stormer_verlet", "hp_midpoint"},
-      "symmetric second-order base step: stormer_verlet, or hp_midpoint = hp:alpha=0.5");
+      "base", "stormer_verlet", {"stormer_verlet", "hp_midpoint", "rattle"},
+      "symmetric second-order base step: stormer_verlet, hp_midpoint = hp:alpha=0.5, or rattle "
+      "(constrained problems)");
   std::vector<std::string> scheme_names;
   for (const auto& scheme : coefficients::kCompositionSchemes) {
     scheme_names.emplace_back(scheme.name);
@@ -87,7 +88,9 @@ std::unique_ptr<Integrator> make_composition(Params& params) {
   for (const auto& candidate : coefficients::kCompositionSchemes) {
     if (candidate.name == scheme_name) scheme = &candidate;
   }
-  const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : "stormer_verlet";
+  // RATTLE's substeps each end on the constraint manifold with tangent momenta, so the
+  // composition stays on it too (checked in tests/constraints_test.cpp).
+  const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : base;
   return std::make_unique<Composition>(*scheme, base_spec, make_integrator(base_spec));
 }
 

@@ -24,7 +24,7 @@ class RodChain final : public Problem {
     double total_length = 0;
     for (const auto& rod : rods_) total_length += rod.length;
     const double time_unit = std::sqrt(total_length / gravity_);
-    set_defaults(0.001 * time_unit, 100.0 * time_unit);
+    set_defaults(0.01 * time_unit, 100.0 * time_unit);
   }
 
   State initial_state() const override { return initial_; }
