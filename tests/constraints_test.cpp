@@ -198,6 +198,48 @@ TEST(Constraints, DeclaredOrderOnTheConicalSphericalPendulum) {
   }
 }
 
+// The position solve has a budget: exhausted, the run ends as a failure row at the step that
+// failed, with the residual in the message — never a hang or an exception.
+TEST(Constraints, NewtonBudgetEndsTheRunAsAFailureRow) {
+  RunConfig config;
+  config.dt = 0.05;
+  config.t_end = 1;
+  config.timing_repeats = 0;
+  const RunResult result = run_one("rod_chain", "rattle:max_iter=1", config);
+  EXPECT_FALSE(result.ok);
+  EXPECT_EQ(result.record.status, "rattle_max_iter");
+  EXPECT_NE(result.record.message.value_or("").find("not converged in 1 Newton iterations"),
+            std::string::npos)
+      << result.record.message.value_or("");
+  EXPECT_EQ(result.record.t_reached, 0.0);
+}
+
+// Time series of a constrained run carry the residuals and the multipliers by name; on the
+// conical spherical pendulum the tension is m g / cos θ₀ at every step point.
+TEST(Constraints, SeriesHaveResidualAndMultiplierColumns) {
+  const fs::path path = fs::temp_directory_path() / "geomint_constraints_series_test.csv";
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 1;
+  config.timing_repeats = 0;
+  config.series_path = path.string();
+  config.series_every = 10;
+  const RunResult result =
+      run_one("spherical_pendulum:gravity=3,mass=0.4,theta0=0.7", "rattle", config);
+  ASSERT_TRUE(result.ok);
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto rows = parse_csv(text.str());
+  ASSERT_EQ(rows.size(), 11u);
+  for (const auto& row : rows) {
+    EXPECT_LE(std::abs(std::stod(row.at("constraint_err"))), 1e-14);
+    EXPECT_LE(std::abs(std::stod(row.at("constraint_vel_err"))), 1e-14);
+    EXPECT_NEAR(std::stod(row.at("tension")), 0.4 * 3 / std::cos(0.7), 1e-3) << row.at("t");
+  }
+  fs::remove(path);
+}
+
 TEST(Constraints, InapplicablePairsAreRefusedByRun) {
   RunConfig config;
   config.dt = 0.01;
