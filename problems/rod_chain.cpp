@@ -11,10 +11,10 @@
 namespace geomint {
 namespace {
 
-class RodChain final : public Problem {
+class RodChain final : public rods::RodProblem {
  public:
   RodChain(const Vec& node_mass, std::vector<rods::Rod> chain, double gravity, State initial)
-      : rods_(std::move(chain)), gravity_(gravity), initial_(std::move(initial)) {
+      : RodProblem(std::move(chain), 2), gravity_(gravity), initial_(std::move(initial)) {
     Vec mass(2 * node_mass.size());
     for (int i = 0; i < node_mass.size(); ++i) mass.segment(2 * i, 2).setConstant(node_mass[i]);
     set_mass(mass);
@@ -22,7 +22,7 @@ class RodChain final : public Problem {
     // no momentum capability; the motion is chaotic for n >= 2, so no exact solution either.
     set_capabilities(kHessian | kConstraints);
     double total_length = 0;
-    for (const auto& rod : rods_) total_length += rod.length;
+    for (const auto& rod : rods()) total_length += rod.length;
     const double time_unit = std::sqrt(total_length / gravity_);
     set_defaults(0.01 * time_unit, 100.0 * time_unit);
   }
@@ -45,25 +45,13 @@ class RodChain final : public Problem {
     H.makeCompressed();
   }
 
-  int constraint_count() const override { return static_cast<int>(rods_.size()); }
-  void constraint(const Vec& q, Vec& g) const override { rods::residuals(rods_, 2, q, g); }
-  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
-    rods::jacobian(rods_, 2, q, G);
-  }
-  void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override {
-    rods::curvature(rods_, 2, q, v, c);
-  }
-  void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
-    rods::hessian(rods_, 2, q, lambda, K);
-  }
   std::vector<std::string> multiplier_names() const override {
     std::vector<std::string> names;
-    for (size_t i = 1; i <= rods_.size(); ++i) names.push_back(fmt::format("tension{}", i));
+    for (size_t i = 1; i <= rods().size(); ++i) names.push_back(fmt::format("tension{}", i));
     return names;
   }
 
  private:
-  std::vector<rods::Rod> rods_;
   double gravity_;
   State initial_;
 };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <utility>
 #include <vector>
 
 #include "problems/problem.hpp"
@@ -93,5 +94,30 @@ inline void hessian(const std::vector<Rod>& rods, int dim, const Vec& q, const V
   K.setFromTriplets(entries.begin(), entries.end());
   K.makeCompressed();
 }
+
+// A problem whose constraints are rods between its nodes (dim coordinates each): the constraint
+// capability from the functions above, once for every rod problem.
+class RodProblem : public Problem {
+ public:
+  int constraint_count() const override { return static_cast<int>(rods_.size()); }
+  void constraint(const Vec& q, Vec& g) const override { rods::residuals(rods_, dim_, q, g); }
+  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
+    rods::jacobian(rods_, dim_, q, G);
+  }
+  void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override {
+    rods::curvature(rods_, dim_, q, v, c);
+  }
+  void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
+    rods::hessian(rods_, dim_, q, lambda, K);
+  }
+
+ protected:
+  RodProblem(std::vector<Rod> rods, int dim) : rods_(std::move(rods)), dim_(dim) {}
+  const std::vector<Rod>& rods() const { return rods_; }
+
+ private:
+  std::vector<Rod> rods_;
+  int dim_;
+};
 
 }  // namespace geomint::rods

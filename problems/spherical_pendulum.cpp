@@ -19,10 +19,10 @@ struct SphericalParameters {
   bool conical;  // θ̇₀ = 0 and φ̇₀ the conical rate: uniform circular motion, exact
 };
 
-class SphericalPendulum final : public Problem {
+class SphericalPendulum final : public rods::RodProblem {
  public:
   explicit SphericalPendulum(const SphericalParameters& parameters)
-      : parameters_(parameters), rods_{{rods::kPivot, 0, parameters.length}} {
+      : RodProblem({{rods::kPivot, 0, parameters.length}}, 3), parameters_(parameters) {
     set_mass(Vec::Constant(3, parameters.mass));
     unsigned capabilities = kHessian | kAngularMomentum | kConstraints;
     if (parameters.conical) capabilities |= kExact | kPeriod;
@@ -58,17 +58,6 @@ class SphericalPendulum final : public Problem {
     return Vec::Constant(1, q[0] * p[1] - q[1] * p[0]);
   }
 
-  int constraint_count() const override { return 1; }
-  void constraint(const Vec& q, Vec& g) const override { rods::residuals(rods_, 3, q, g); }
-  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
-    rods::jacobian(rods_, 3, q, G);
-  }
-  void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override {
-    rods::curvature(rods_, 3, q, v, c);
-  }
-  void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
-    rods::hessian(rods_, 3, q, lambda, K);
-  }
   std::vector<std::string> multiplier_names() const override { return {"tension"}; }
 
  private:
@@ -90,7 +79,6 @@ class SphericalPendulum final : public Problem {
   }
 
   SphericalParameters parameters_;
-  std::vector<rods::Rod> rods_;
 };
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "harness/run.hpp"
 #include "harness/sweep.hpp"
 #include "harness/table.hpp"
+#include "tests/method_checks.hpp"
 
 namespace geomint {
 namespace {
@@ -132,29 +133,11 @@ TEST_P(ConstrainedPair, SymplecticMeansNoEnergyDrift) {
   EXPECT_LT(err_max, 0.01);
 }
 
-// Symmetric ⇒ Φ_{−h} ∘ Φ_h = id on the manifold: 20 steps forward and back.
-double reversibility_defect(const std::string& method, const std::string& problem_spec, double h) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
-  const State start = problem->initial_state();
-  State state = start;
-  integrator->reset(*problem, state, h);
-  for (int k = 0; k < 20; ++k) {
-    if (!integrator->step(*problem, state, h).ok) return INFINITY;
-  }
-  integrator->reset(*problem, state, -h);
-  for (int k = 0; k < 20; ++k) {
-    if (!integrator->step(*problem, state, -h).ok) return INFINITY;
-  }
-  const double scale = std::sqrt(start.q.squaredNorm() + start.p.squaredNorm());
-  return std::sqrt((state.q - start.q).squaredNorm() + (state.p - start.p).squaredNorm()) / scale;
-}
-
 TEST_P(ConstrainedPair, SymmetricMeansReversible) {
   const auto& [method, problem] = GetParam();
   if (!(make_integrator(method)->info().flags & kSymmetric)) GTEST_SKIP() << "not symmetric";
   const double h = make_problem(problem)->default_dt() * 5;
-  EXPECT_LT(reversibility_defect(method, problem, h), 1e-12);
+  EXPECT_LT(test::reversibility_defect(method, problem, h), 1e-12);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, ConstrainedPair, testing::ValuesIn(pairs()), pair_name);
@@ -180,7 +163,7 @@ TEST(NegativeControl, ShakeVelocitiesLeaveTheVelocityConstraintAtFirstOrder) {
   // The positions still satisfy g = 0: only the velocity level fails.
   EXPECT_LE(coarse.record.metrics.at("constraint_err_max"), 1e-13 * scales_of(problem).length);
   const double h = make_problem(problem)->default_dt() * 5;
-  EXPECT_GT(reversibility_defect(shake, problem, h), 1e-6);
+  EXPECT_GT(test::reversibility_defect(shake, problem, h), 1e-6);
 }
 
 // Order on a nonlinear constrained problem with an exact solution (the conical spherical
