@@ -80,6 +80,29 @@ class MomentumObserver : public Observer {
   double err_max_ = 0;
 };
 
+// constraint_err_max = max_k ‖g(q_k)‖∞ and constraint_vel_err_max = max_k ‖G(q_k) M⁻¹p_k‖∞ on
+// problems with holonomic constraints (docs/METHOD.md §3). Absolute, in the units of g (a length
+// for the rod problems: the rod-length error) and of dg/dt: g = 0 is the reference, so there is
+// no initial value to divide by as for the energy, and the problem's g already fixes the scale
+// (README "Constraints"). The initial state counts: it is consistent to round-off.
+class ConstraintObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State& state, double) override {
+    observe(problem, state);
+  }
+  void observe(const Problem& problem, const State& state) override {
+    position_ = std::max(position_, problem.constraint_residual(state.t, state.q));
+    velocity_ = std::max(velocity_, problem.constraint_velocity_residual(state.t, state.q, state.p));
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    metrics["constraint_err_max"] = position_;
+    metrics["constraint_vel_err_max"] = velocity_;
+  }
+
+ private:
+  double position_ = 0, velocity_ = 0;
+};
+
 // error_max, error_final: ‖(q_k − q(t_k), p_k − p(t_k))‖₂ against the exact solution.
 class ExactErrorObserver : public Observer {
  public:
@@ -277,6 +300,7 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
     observers.push_back(
         std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
   }
+  if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
   if (problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce)) {
     observers.push_back(std::make_unique<PhaseObserver>());

@@ -45,6 +45,12 @@ class SeriesWriter {
       }
     }
     for (const auto& name : problem.series_names()) columns.push_back(name);
+    // Constrained problems: the residuals and the exact motion's multipliers through the state.
+    if (problem.has(kConstraints)) {
+      columns.push_back("constraint_err");
+      columns.push_back("constraint_vel_err");
+      for (const auto& name : problem.multiplier_names()) columns.push_back(name);
+    }
     if (with_state_) {
       for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("q_{}", i));
       for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("p_{}", i));
@@ -67,6 +73,11 @@ class SeriesWriter {
     if (problem.has(kAngularMomentum)) append(problem.angular_momentum(state.q, state.p));
     problem.series_values(state.q, state.p, extras_);
     for (double v : extras_) line_ += "," + format_number(v);
+    if (problem.has(kConstraints)) {
+      line_ += "," + format_number(problem.constraint_residual(state.t, state.q));
+      line_ += "," + format_number(problem.constraint_velocity_residual(state.t, state.q, state.p));
+      append(problem.multipliers(state.t, state.q, state.p));
+    }
     if (with_state_) {
       append(state.q);
       append(state.p);

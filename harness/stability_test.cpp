@@ -88,6 +88,9 @@ TEST(Stability, EveryMethodPredictsItsLimitOrSaysWhyNot) {
         << spec << ": a limit or a reason, not both, not neither (reason '" << prediction.reason
         << "')";
     if (!prediction.predicted() || (integrator->info().flags & kAdaptive)) continue;
+    // rattle predicts Störmer–Verlet's limit for the tangent oscillation, but is for constrained
+    // problems only: the harmonic search cannot run it.
+    if (!applicable(*integrator, *make_problem("harmonic")).ok) continue;
     ++compared;
     const auto result = stability_search("harmonic", spec, options);
     EXPECT_EQ(result.predicted, prediction.homega_limit) << spec;

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -99,6 +100,13 @@ Record error_record(const std::string& problem, const std::string& method,
   record.status = "error";
   record.message = what;
   return record;
+}
+
+// Why `method` cannot run on `problem` (applicable(): constraints, a needed Hessian), if so.
+std::optional<std::string> inapplicable(const std::string& problem, const std::string& method) {
+  const Applicability fit = applicable(*make_integrator(method), *make_problem(problem));
+  if (fit.ok) return std::nullopt;
+  return fit.reason;
 }
 
 std::string series_name(const RunBlock& block, const std::string& problem,
@@ -335,6 +343,16 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (i < jobs.size()) {
       Job& job = jobs[i];
       try {
+        if (const auto reason = inapplicable(job.problem, job.method)) {
+          // A scene's problems × methods product may pair an unconstrained method with a
+          // constrained problem (or the reverse): a row that says why, not a run.
+          job.record = error_record(job.problem, job.method, *reason);
+          job.record.status = "skipped";
+          job.ok = false;
+          job.record.label = job.label;
+          progress.tick();
+          return;
+        }
         RunResult result = run_one(job.problem, job.method, job.config);
         job.record = std::move(result.record);
         job.ok = result.ok;

@@ -109,6 +109,8 @@ std::unique_ptr<Integrator> make_composition(Params& params) {
   for (const auto& candidate : coefficients::kCompositionSchemes) {
     if (candidate.name == scheme_name) scheme = &candidate;
   }
+  // RATTLE's substeps each end on the constraint manifold with tangent momenta, so the
+  // composition stays on it too (checked in tests/constraints_test.cpp).
   const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : base;
   return std::make_unique<Composition>(*scheme, base_spec, make_integrator(base_spec));
 }

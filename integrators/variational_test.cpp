@@ -189,7 +189,9 @@ std::vector<std::string> symplectic_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
     const unsigned flags = make_integrator(spec)->info().flags;
-    if ((flags & kSymplectic) && !(flags & kAdaptive)) out.push_back(spec);
+    // Constrained-only methods cannot run on the unconstrained test problem (applicable());
+    // tests/constraints_test.cpp checks them on the constraint manifold.
+    if ((flags & kSymplectic) && !(flags & (kAdaptive | kConstraintsOnly))) out.push_back(spec);
   }
   // Forcing options do not touch an unforced step, but the spec must still give a symplectic map.
   out.push_back("hp:alpha=0.75,solver=newton");
@@ -253,7 +255,7 @@ std::vector<std::string> variational_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
     const unsigned flags = make_integrator(spec)->info().flags;
-    if ((flags & kVariational) && !(flags & kAdaptive)) out.push_back(spec);
+    if ((flags & kVariational) && !(flags & (kAdaptive | kConstraintsOnly))) out.push_back(spec);
   }
   return out;
 }

@@ -7,6 +7,7 @@
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
+#include "tests/method_checks.hpp"
 
 namespace geomint {
 namespace {
@@ -147,34 +148,16 @@ TEST(NegativeControl, DriftCheckFailsForRk4AndExplicitEuler) {
       << "explicit_euler ratio " << ratio;
 }
 
-// Symmetric: Φ_{−h} ∘ Φ_h = id, checked over 20 steps forward and back.
-double reversibility_defect(const std::string& method, const std::string& problem_spec, double h) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
-  const State start = problem->initial_state();
-  State state = start;
-  integrator->reset(*problem, state, h);
-  for (int k = 0; k < 20; ++k) {
-    if (!integrator->step(*problem, state, h).ok) return INFINITY;
-  }
-  integrator->reset(*problem, state, -h);
-  for (int k = 0; k < 20; ++k) {
-    if (!integrator->step(*problem, state, -h).ok) return INFINITY;
-  }
-  const double scale = std::sqrt(start.q.squaredNorm() + start.p.squaredNorm());
-  return std::sqrt((state.q - start.q).squaredNorm() + (state.p - start.p).squaredNorm()) / scale;
-}
-
 TEST_P(EveryMethod, SymmetricMeansReversible) {
   if (!(info().flags & kSymmetric)) GTEST_SKIP() << "not declared symmetric";
   // 40 steps of round-off at ~1e-16 each, with implicit solves at 1e-12 relative tolerance.
-  EXPECT_LT(reversibility_defect(GetParam(), "pendulum:theta0=1.5", 0.1), 1e-11);
-  EXPECT_LT(reversibility_defect(GetParam(), "kepler:e=0.6", 0.01), 1e-11);
+  EXPECT_LT(test::reversibility_defect(GetParam(), "pendulum:theta0=1.5", 0.1), 1e-11);
+  EXPECT_LT(test::reversibility_defect(GetParam(), "kepler:e=0.6", 0.01), 1e-11);
 }
 
 TEST(NegativeControl, ReversibilityCheckFailsForNonSymmetricMethods) {
-  EXPECT_GT(reversibility_defect("symplectic_euler_a", "pendulum:theta0=1.5", 0.1), 1e-6);
-  EXPECT_GT(reversibility_defect("rk4", "pendulum:theta0=1.5", 0.1), 1e-9);
+  EXPECT_GT(test::reversibility_defect("symplectic_euler_a", "pendulum:theta0=1.5", 0.1), 1e-6);
+  EXPECT_GT(test::reversibility_defect("rk4", "pendulum:theta0=1.5", 0.1), 1e-9);
 }
 
 // Central force: a variational/symplectic method with a rotation-invariant discrete Lagrangian
