@@ -1,6 +1,7 @@
 // Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
 // F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
 // Not symplectic: the negative control of docs/METHOD.md §7.
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -17,28 +18,40 @@ class Rk4 final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    stages(problem, state, h);
+    return StepStatus::success();
+  }
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) override {
+    return run_grid(state, grid, visit, [&](double h) { stages(problem, state, h); });
+  }
+
+ private:
+  void stages(const Problem& problem, State& state, double h) {
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
-    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i.
+    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i. The stage points go
+    // into stage_q_/stage_p_ so that no step allocates.
     rhs(problem, t, q, p, dq_[0], dp_[0]);
-    rhs(problem, t + h / 2, q + (h / 2) * dq_[0], p + (h / 2) * dp_[0], dq_[1], dp_[1]);
-    rhs(problem, t + h / 2, q + (h / 2) * dq_[1], p + (h / 2) * dp_[1], dq_[2], dp_[2]);
-    rhs(problem, t + h, q + h * dq_[2], p + h * dp_[2], dq_[3], dp_[3]);
+    stage_q_ = q + (h / 2) * dq_[0], stage_p_ = p + (h / 2) * dp_[0];
+    rhs(problem, t + h / 2, stage_q_, stage_p_, dq_[1], dp_[1]);
+    stage_q_ = q + (h / 2) * dq_[1], stage_p_ = p + (h / 2) * dp_[1];
+    rhs(problem, t + h / 2, stage_q_, stage_p_, dq_[2], dp_[2]);
+    stage_q_ = q + h * dq_[2], stage_p_ = p + h * dp_[2];
+    rhs(problem, t + h, stage_q_, stage_p_, dq_[3], dp_[3]);
     state.q += (h / 6) * (dq_[0] + 2 * dq_[1] + 2 * dq_[2] + dq_[3]);
     state.p += (h / 6) * (dp_[0] + 2 * dp_[1] + 2 * dp_[2] + dp_[3]);
     state.t = t + h;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
- private:
   void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
     dq = problem.inverse_mass().cwiseProduct(p);
     eval_total_force(problem, q, dq, t, dp);
   }
 
-  Vec dq_[4], dp_[4];
+  Vec dq_[4], dp_[4], stage_q_, stage_p_;
 };
 
 }  // namespace

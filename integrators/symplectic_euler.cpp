@@ -1,6 +1,7 @@
 // Symplectic Euler, kick first (L_d = h L(q_k, v)) and drift first (L_d = h L(q_{k+1}, v)):
 // docs/METHOD.md §1 table; Hairer, Lubich & Wanner, GNI §VI.3, Theorem 3.3 and its adjoint. Forces
 // enter as discrete Lagrange–d'Alembert impulses h·F (docs/METHOD.md §2).
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -21,17 +22,25 @@ class SymplecticEulerA final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
-                     force_);
+    kick_drift(problem, state, h);
+    return StepStatus::success();
+  }
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) override {
+    return run_grid(state, grid, visit, [&](double h) { kick_drift(problem, state, h); });
+  }
+
+ private:
+  void kick_drift(const Problem& problem, State& state, double h) {
+    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
     state.q += h * problem.inverse_mass().cwiseProduct(state.p);
     state.t += h;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
- private:
-  Vec force_;
+  Vec velocity_, force_;
 };
 
 // Drift then kick: q⁺ = q + h M⁻¹p, p⁺ = p + h[−∇V(q⁺) + F(q⁺, v, t + h)]. The force takes the
@@ -49,16 +58,24 @@ class SymplecticEulerB final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    drift_kick(problem, state, h);
+    return StepStatus::success();
+  }
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) override {
+    return run_grid(state, grid, visit, [&](double h) { drift_kick(problem, state, h); });
+  }
+
+ private:
+  void drift_kick(const Problem& problem, State& state, double h) {
     velocity_ = problem.inverse_mass().cwiseProduct(state.p);
     state.q += h * velocity_;
     state.t += h;
     eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
- private:
   Vec velocity_, force_;
 };
 
