@@ -26,6 +26,24 @@ AdvanceOutcome run_grid(State& state, const StepGrid& grid, StepVisitor visit, S
   return outcome;
 }
 
+// Base of explicit methods whose step is one non-failing body `Derived::advance_by(problem,
+// state, h)`: step() and advance() both run it, so the two paths cannot drift apart.
+template <class Derived>
+class ExplicitStepper : public Integrator {
+ public:
+  StepStatus step(const Problem& problem, State& state, double h) final {
+    derived().advance_by(problem, state, h);
+    return StepStatus::success();
+  }
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) final {
+    return run_grid(state, grid, visit, [&](double h) { derived().advance_by(problem, state, h); });
+  }
+
+ private:
+  Derived& derived() { return static_cast<Derived&>(*this); }
+};
+
 // Dispatches once per run on the problem's fixed gradient (problems/fixed_gradient.hpp): calls
 // `fixed(gradient)` with the concrete functor, or returns false when the problem offers none.
 template <class Fixed>

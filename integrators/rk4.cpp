@@ -7,7 +7,7 @@
 namespace geomint {
 namespace {
 
-class Rk4 final : public Integrator {
+class Rk4 final : public ExplicitStepper<Rk4> {
  public:
   MethodInfo info() const override {
     return {"rk4", 4, kExplicit, "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
@@ -17,17 +17,8 @@ class Rk4 final : public Integrator {
     return StabilityPrediction::limit(2.0 * std::sqrt(2.0));  // |R(iy)| ≤ 1 iff y ≤ 2√2 (GNI §VI.4)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    stages(problem, state, h);
-    return StepStatus::success();
-  }
-  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
-                         StepVisitor visit) override {
-    return run_grid(state, grid, visit, [&](double h) { stages(problem, state, h); });
-  }
-
- private:
-  void stages(const Problem& problem, State& state, double h) {
+  // One step (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
@@ -46,6 +37,7 @@ class Rk4 final : public Integrator {
     ++counters_.steps;
   }
 
+ private:
   void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
     dq = problem.inverse_mass().cwiseProduct(p);
     eval_total_force(problem, q, dq, t, dp);

@@ -10,7 +10,7 @@ namespace {
 // Kick then drift: p⁺ = p + h[−∇V(q) + F(q, v, t)], q⁺ = q + h M⁻¹p⁺. The force takes the
 // velocity at the start of the step, v = M⁻¹p: the step velocity M⁻¹p⁺ would make a
 // velocity-dependent force implicit, and the method is first order either way.
-class SymplecticEulerA final : public Integrator {
+class SymplecticEulerA final : public ExplicitStepper<SymplecticEulerA> {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_a", 1, kExplicit | kSymplectic | kVariational,
@@ -21,17 +21,8 @@ class SymplecticEulerA final : public Integrator {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    kick_drift(problem, state, h);
-    return StepStatus::success();
-  }
-  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
-                         StepVisitor visit) override {
-    return run_grid(state, grid, visit, [&](double h) { kick_drift(problem, state, h); });
-  }
-
- private:
-  void kick_drift(const Problem& problem, State& state, double h) {
+  // Kick then drift (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
     velocity_ = problem.inverse_mass().cwiseProduct(state.p);
     eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
@@ -40,13 +31,14 @@ class SymplecticEulerA final : public Integrator {
     ++counters_.steps;
   }
 
+ private:
   Vec velocity_, force_;
 };
 
 // Drift then kick: q⁺ = q + h M⁻¹p, p⁺ = p + h[−∇V(q⁺) + F(q⁺, v, t + h)]. The force takes the
 // drift velocity v = M⁻¹p = (q⁺ − q)/h, the discrete velocity of the step, so the impulse is
 // the Lagrange–d'Alembert F_d⁺ = h F(q_{k+1}, v_{k,k+1}) and the scheme stays explicit.
-class SymplecticEulerB final : public Integrator {
+class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_b", 1, kExplicit | kSymplectic | kVariational,
@@ -57,17 +49,8 @@ class SymplecticEulerB final : public Integrator {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    drift_kick(problem, state, h);
-    return StepStatus::success();
-  }
-  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
-                         StepVisitor visit) override {
-    return run_grid(state, grid, visit, [&](double h) { drift_kick(problem, state, h); });
-  }
-
- private:
-  void drift_kick(const Problem& problem, State& state, double h) {
+  // Drift then kick (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
     velocity_ = problem.inverse_mass().cwiseProduct(state.p);
     state.q += h * velocity_;
     state.t += h;
@@ -76,6 +59,7 @@ class SymplecticEulerB final : public Integrator {
     ++counters_.steps;
   }
 
+ private:
   Vec velocity_, force_;
 };
 
