@@ -72,9 +72,11 @@ FUZZ_SECONDS ?= 60
 fuzz: sanitize-build
 	@$(SAN_ENV) bash scripts/fuzz.sh $(SAN_DIR) $(FUZZ_SECONDS)
 
-# Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures.
+# Regenerates every committed scene: tables (CSV + Markdown) and gnuplot figures; then the
+# scaling figure from the benchmarks' reduced sizes (results/scaling/, scripts/scaling.sh).
 reproduce-figures: build
 	@bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
+	@bash scripts/scaling.sh $(BUILD_DIR)
 
 # CI-sized variant: quick_* settings, output under results/<scene>/quick/ (not committed).
 reproduce-quick: build

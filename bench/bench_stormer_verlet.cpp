@@ -1,12 +1,17 @@
 // Cost of the Integrator interface (docs/DESIGN.md §2): a Störmer–Verlet step (GNI §I.1.4) on
 // Kepler and on a 128-dof spring net through Problem/Integrator, against hand-written loops doing
-// the same kick–drift–kick arithmetic with one gradient per step (first same as last).
+// the same kick–drift–kick arithmetic with one gradient per step (first same as last). Interface
+// = Integrator::advance over a grid, the path of the harness's timing pass (issue 9 item 3);
+// StepCall = one virtual step() per step, the path of the metric pass. Prints the ratios.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
@@ -18,8 +23,25 @@ using geomint::Vec;
 constexpr double kStep = 1e-3;
 constexpr int kStepsPerIteration = 1000;
 
-// The library path: virtual Problem::gradient, Integrator::step with its gradient cache check.
+// The harness's path: Integrator::advance over kStepsPerIteration grid steps, no visitor.
 void run_interface(benchmark::State& state, const std::string& problem_spec) {
+  const auto problem = geomint::make_problem(problem_spec);
+  const auto integrator = geomint::make_integrator("stormer_verlet");
+  geomint::State s = problem->initial_state();
+  integrator->reset(*problem, s, kStep);
+  for (auto _ : state) {
+    const geomint::StepGrid grid{s.t, kStep, kStep * kStepsPerIteration, kStepsPerIteration};
+    const geomint::AdvanceOutcome outcome =
+        integrator->advance(*problem, s, grid, geomint::StepVisitor());
+    if (!outcome.status.ok) state.SkipWithError(outcome.status.message.c_str());
+    benchmark::DoNotOptimize(s.q.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * kStepsPerIteration);
+}
+
+// One virtual Integrator::step per step, with its gradient cache check.
+void run_step_calls(benchmark::State& state, const std::string& problem_spec) {
   const auto problem = geomint::make_problem(problem_spec);
   const auto integrator = geomint::make_integrator("stormer_verlet");
   geomint::State s = problem->initial_state();
@@ -37,6 +59,8 @@ void run_interface(benchmark::State& state, const std::string& problem_spec) {
 
 void BM_InterfaceKepler(benchmark::State& state) { run_interface(state, "kepler:e=0.6"); }
 BENCHMARK(BM_InterfaceKepler);
+void BM_StepCallKepler(benchmark::State& state) { run_step_calls(state, "kepler:e=0.6"); }
+BENCHMARK(BM_StepCallKepler);
 
 // Kepler by hand on scalars: V = −1/|q|, M = I, the same initial state as kepler:e=0.6.
 void BM_HandLoopKepler(benchmark::State& state) {
@@ -93,6 +117,8 @@ BENCHMARK(BM_HandLoopKeplerProblemGradient);
 // The hand loop calls the same Problem::gradient, so only the stepping code differs.
 void BM_InterfaceSpringNet(benchmark::State& state) { run_interface(state, "spring_net"); }
 BENCHMARK(BM_InterfaceSpringNet);
+void BM_StepCallSpringNet(benchmark::State& state) { run_step_calls(state, "spring_net"); }
+BENCHMARK(BM_StepCallSpringNet);
 
 void BM_HandLoopSpringNet(benchmark::State& state) {
   const auto problem = geomint::make_problem("spring_net");
@@ -114,6 +140,42 @@ void BM_HandLoopSpringNet(benchmark::State& state) {
 }
 BENCHMARK(BM_HandLoopSpringNet);
 
+// Console output plus each benchmark's CPU time (the median over --benchmark_repetitions when
+// there are repetitions), for the ratios printed at the end.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+      if (run.run_type == Run::RT_Iteration || median) {
+        cpu_[run.run_name.function_name] = run.GetAdjustedCPUTime();
+      }
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  void print_ratio(const std::string& numerator, const std::string& denominator) const {
+    const auto a = cpu_.find(numerator), b = cpu_.find(denominator);
+    if (a == cpu_.end() || b == cpu_.end()) return;
+    std::printf("ratio %s / %s = %.3f\n", numerator.c_str(), denominator.c_str(),
+                a->second / b->second);
+  }
+
+ private:
+  std::map<std::string, double> cpu_;
+};
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  for (const char* scene : {"Kepler", "SpringNet"}) {
+    const std::string hand = std::string("BM_HandLoop") + scene;
+    reporter.print_ratio(std::string("BM_Interface") + scene, hand);
+    reporter.print_ratio(std::string("BM_StepCall") + scene, hand);
+  }
+  benchmark::Shutdown();
+  return 0;
+}

@@ -107,8 +107,8 @@ struct LoopOutcome {
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
 // Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
 // only when dt does not divide t_end. `checked` = false (timing pass) skips the per-step
-// finiteness and divergence checks, which cost an energy evaluation per step; the metric pass
-// has already established that the run succeeds.
+// finiteness and divergence checks, which cost an energy evaluation per step, and `visit` for
+// fixed-step methods; the metric pass has already established that the run succeeds.
 template <typename Visit>
 LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& state,
                       const RunConfig& config, bool adaptive, bool checked, Visit&& visit) {
@@ -119,55 +119,64 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   const bool conservative = !problem.has(kForce);
   const bool divergence = divergence_rule_on(config.diverge_factor);
   outcome.t_reached = t0;
-  auto check = [&](const State& s) -> StepStatus {
-    if (!checked) return StepStatus::success();
-    if (!finite(s)) return StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
-    if (!divergence) return StepStatus::success();
+  // Sets outcome.status and returns false when the state fails the checks; a passing step
+  // builds no status object.
+  auto check = [&](const State& s) {
+    if (!checked) return true;
+    if (!finite(s)) {
+      outcome.status = StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
+      return false;
+    }
+    if (!divergence) return true;
     if (conservative) {
       if (std::abs(problem.energy(s.q, s.p) - energy0) > config.diverge_factor * energy_scale) {
-        return StepStatus::failure("diverged",
-                                   fmt::format("relative energy error above {:g} at t={:.6g}",
-                                               config.diverge_factor, s.t));
+        outcome.status = StepStatus::failure(
+            "diverged", fmt::format("relative energy error above {:g} at t={:.6g}",
+                                    config.diverge_factor, s.t));
+        return false;
       }
     } else if (std::max(s.q.lpNorm<Eigen::Infinity>(), s.p.lpNorm<Eigen::Infinity>()) >
                kDivergedStateNorm) {
-      return StepStatus::failure("diverged",
-                                 fmt::format("state norm above 1e100 at t={:.6g}", s.t));
+      outcome.status =
+          StepStatus::failure("diverged", fmt::format("state norm above 1e100 at t={:.6g}", s.t));
+      return false;
     }
-    return StepStatus::success();
+    return true;
   };
   if (adaptive) {
     const double t_end = t0 + config.t_end;
     while (state.t < t_end) {
       StepStatus status = integrator.adaptive_step(problem, state, t_end);
-      if (status.ok) status = check(state);
       if (!status.ok) {
-        outcome.status = status;
+        outcome.status = std::move(status);
         return outcome;
       }
+      if (!check(state)) return outcome;
       ++outcome.steps;
       outcome.t_reached = state.t;
       visit(state, state.t >= t_end);
     }
     return outcome;
   }
-  const long n = std::max(1L, static_cast<long>(std::ceil(config.t_end / config.dt - 1e-9)));
-  for (long k = 1; k <= n; ++k) {
-    const double t_next = k == n ? t0 + config.t_end : t0 + k * config.dt;
-    const double h = t_next - state.t;
-    StepStatus status = integrator.step(problem, state, h);
-    state.t = t_next;
-    if (status.ok) status = check(state);
-    if (!status.ok) {
-      if (status.message.find("t=") == std::string::npos) {
-        status.message += fmt::format(" (step ending at t={:.6g})", t_next);
-      }
-      outcome.status = status;
-      return outcome;
+  const StepGrid grid{t0, config.dt, config.t_end,
+                      std::max(1L, static_cast<long>(std::ceil(config.t_end / config.dt - 1e-9)))};
+  // The timing pass passes no visitor: explicit methods then run their whole grid in one
+  // statically typed loop (Integrator::advance).
+  auto check_and_visit = [&](const State& s, long k) {
+    if (!check(s)) return false;
+    outcome.t_reached = s.t;
+    visit(s, k == grid.n);
+    return true;
+  };
+  AdvanceOutcome advanced = integrator.advance(
+      problem, state, grid, checked ? StepVisitor(check_and_visit) : StepVisitor());
+  outcome.steps = advanced.steps;
+  if (!advanced.status.ok) {
+    if (advanced.status.message.find("t=") == std::string::npos) {
+      advanced.status.message +=
+          fmt::format(" (step ending at t={:.6g})", grid.time(advanced.steps + 1));
     }
-    ++outcome.steps;
-    outcome.t_reached = state.t;
-    visit(state, k == n);
+    outcome.status = std::move(advanced.status);
   }
   return outcome;
 }

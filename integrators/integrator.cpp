@@ -93,6 +93,19 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
 
 void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }
 
+AdvanceOutcome Integrator::advance(const Problem& problem, State& state, const StepGrid& grid,
+                                   StepVisitor visit) {
+  AdvanceOutcome outcome;
+  for (long k = 1; k <= grid.n; ++k) {
+    const double t_next = grid.time(k);
+    outcome.status = step(problem, state, t_next - state.t);
+    state.t = t_next;
+    if (!outcome.status.ok || (visit && !visit(state, k))) return outcome;
+    outcome.steps = k;
+  }
+  return outcome;
+}
+
 void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatrix& matrix) {
   const Vec& mass = problem.mass();
   if (matrix.rows() != problem.dof() || diagonal != mass) {
@@ -176,9 +189,8 @@ void Integrator::eval_total_force(const Problem& problem, const Vec& q, const Ve
   eval_gradient(problem, q, f);
   f = -f;
   if (problem.has(kForce)) {
-    Vec extra;
-    problem.force(q, v, t, extra);
-    f += extra;
+    problem.force(q, v, t, extra_force_);
+    f += extra_force_;
   }
 }
 

@@ -67,6 +67,43 @@ struct StabilityPrediction {
 // forces (docs/METHOD.md §1), and ¼ − α(1 − α) = (½ − α)², so Newmark's bound gives hω < 1/|½ − α|.
 StabilityPrediction alpha_rule_stability(double alpha);
 
+// The fixed-step grid of a run (harness/run.cpp): t_k = t0 + k·dt for k < n and t_n = t0 + span
+// exactly, so the last step is shortened only when dt does not divide span and t carries no
+// accumulated round-off. Step k advances by h = t_k − t_{k−1} as computed from the state's t.
+struct StepGrid {
+  double t0 = 0;
+  double dt = 0;
+  double span = 0;
+  long n = 0;
+  double time(long k) const { return k == n ? t0 + span : t0 + static_cast<double>(k) * dt; }
+};
+
+// Sees the state after step k (state.t = t_k) and returns false to stop the run there. A
+// function pointer and a context, so it costs no allocation; default-constructed = no visitor
+// (the harness's timing pass), which lets explicit methods keep their state in registers.
+class StepVisitor {
+ public:
+  StepVisitor() = default;
+  template <class Callable>
+  explicit StepVisitor(Callable& callable)
+      : context_(&callable), call_([](void* context, const State& state, long k) {
+          return (*static_cast<Callable*>(context))(state, k);
+        }) {}
+  explicit operator bool() const { return call_ != nullptr; }
+  bool operator()(const State& state, long k) const { return call_(context_, state, k); }
+
+ private:
+  void* context_ = nullptr;
+  bool (*call_)(void*, const State&, long) = nullptr;
+};
+
+// What Integrator::advance did: `steps` steps passed the integrator and the visitor; `status` is
+// the integrator's failure in step steps + 1 (ok when every step ran or the visitor stopped).
+struct AdvanceOutcome {
+  StepStatus status;
+  long steps = 0;
+};
+
 struct Counters {
   long steps = 0;
   long force_evals = 0;   // gradient (and force) evaluations
@@ -92,6 +129,12 @@ class Integrator {
   // Advances state by h (fixed-step methods). Must not throw on numerical trouble: returns a
   // failed status instead. Checks for non-finite results are done by the harness.
   virtual StepStatus step(const Problem& problem, State& state, double h) = 0;
+  // Runs the fixed-step grid from state (at grid.t0) to grid.time(grid.n), calling `visit` after
+  // every step, with the same arithmetic, counters and final state as step() once per grid step
+  // (integrators/integrator.cpp, the default). Explicit methods override it to dispatch once
+  // per run to a loop without per-step status objects, cache checks or allocation (issue 9).
+  virtual AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                                 StepVisitor visit);
   // Adaptive methods (flag kAdaptive): take one internal, error-controlled step without passing
   // t_stop, so observers see the solver's own step points (never interpolated output). The
   // harness calls it until state.t == t_stop.
@@ -116,6 +159,7 @@ class Integrator {
   Counters counters_;
 
  private:
+  Vec extra_force_;  // eval_total_force's F(q, v, t), kept to avoid an allocation per call
   friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
   std::string spec_;
 };

@@ -1,12 +1,13 @@
 // Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
 // F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
 // Not symplectic: the negative control of docs/METHOD.md §7.
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
 namespace {
 
-class Rk4 final : public Integrator {
+class Rk4 final : public ExplicitStepper<Rk4> {
  public:
   MethodInfo info() const override {
     return {"rk4", 4, kExplicit, "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
@@ -16,20 +17,24 @@ class Rk4 final : public Integrator {
     return StabilityPrediction::limit(2.0 * std::sqrt(2.0));  // |R(iy)| ≤ 1 iff y ≤ 2√2 (GNI §VI.4)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
+  // One step (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
-    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i.
+    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i. The stage points go
+    // into stage_q_/stage_p_ so that no step allocates.
     rhs(problem, t, q, p, dq_[0], dp_[0]);
-    rhs(problem, t + h / 2, q + (h / 2) * dq_[0], p + (h / 2) * dp_[0], dq_[1], dp_[1]);
-    rhs(problem, t + h / 2, q + (h / 2) * dq_[1], p + (h / 2) * dp_[1], dq_[2], dp_[2]);
-    rhs(problem, t + h, q + h * dq_[2], p + h * dp_[2], dq_[3], dp_[3]);
+    stage_q_ = q + (h / 2) * dq_[0], stage_p_ = p + (h / 2) * dp_[0];
+    rhs(problem, t + h / 2, stage_q_, stage_p_, dq_[1], dp_[1]);
+    stage_q_ = q + (h / 2) * dq_[1], stage_p_ = p + (h / 2) * dp_[1];
+    rhs(problem, t + h / 2, stage_q_, stage_p_, dq_[2], dp_[2]);
+    stage_q_ = q + h * dq_[2], stage_p_ = p + h * dp_[2];
+    rhs(problem, t + h, stage_q_, stage_p_, dq_[3], dp_[3]);
     state.q += (h / 6) * (dq_[0] + 2 * dq_[1] + 2 * dq_[2] + dq_[3]);
     state.p += (h / 6) * (dp_[0] + 2 * dp_[1] + 2 * dp_[2] + dp_[3]);
     state.t = t + h;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
  private:
@@ -38,7 +43,7 @@ class Rk4 final : public Integrator {
     eval_total_force(problem, q, dq, t, dp);
   }
 
-  Vec dq_[4], dp_[4];
+  Vec dq_[4], dp_[4], stage_q_, stage_p_;
 };
 
 }  // namespace

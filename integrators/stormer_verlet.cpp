@@ -1,9 +1,41 @@
 // Störmer–Verlet, kick–drift–kick (velocity Verlet): the VI of L_d = (h/2)[L(q_k, v) +
 // L(q_{k+1}, v)] (docs/METHOD.md §1; Hairer, Lubich & Wanner, GNI §I.1.4 and §VI.3, eq. (3.4)).
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
 namespace {
+
+// One unforced kick–drift–kick with g = ∇V(q) on entry and ∇V(q⁺) on exit: the arithmetic of
+// step() and of both advance() loops, on dynamic or fixed-size vectors alike.
+template <class V, class Gradient>
+inline void kick_drift_kick(V& q, V& p, V& g, const V& inverse_mass, double h,
+                            Gradient&& gradient) {
+  p -= (h / 2) * g;
+  q += h * inverse_mass.cwiseProduct(p);
+  gradient(q, g);
+  p -= (h / 2) * g;
+}
+
+// The whole grid without a visitor on fixed-size copies of q, p and ∇V that live only in this
+// loop, so that the compiler keeps them in registers and inlines the gradient.
+template <class Gradient>
+void fixed_size_loop(const Gradient& gradient, const Vec& inverse_mass, const StepGrid& grid,
+                     State& state, Vec& g_at_q) {
+  using Fixed = Eigen::Matrix<double, Gradient::kDof, 1>;
+  const Fixed fixed_inverse_mass = inverse_mass;
+  Fixed q = state.q, p = state.p, g = g_at_q;
+  double t = state.t;
+  for (long k = 1; k <= grid.n; ++k) {
+    const double t_next = grid.time(k);
+    kick_drift_kick(q, p, g, fixed_inverse_mass, t_next - t, gradient);
+    t = t_next;
+  }
+  state.t = t;
+  state.q = q;
+  state.p = p;
+  g_at_q = g;
+}
 
 //   p½ = p + (h/2)[−∇V(q) + F(q, M⁻¹p, t)]
 //   q⁺ = q + h M⁻¹p½
@@ -16,7 +48,10 @@ namespace {
 // First same as last: ∇V(q⁺) of one step is ∇V(q) of the next, so after the first step each
 // step costs one gradient. The cached gradient is used only when the incoming q is bitwise the
 // q⁺ it was computed at (and the problem is the same object), so a caller that edits the state
-// between steps gets a fresh evaluation, never a stale one.
+// between steps gets a fresh evaluation, never a stale one. advance() checks the cache once, then
+// carries the gradient from step to step itself; without a visitor (the harness's timing pass), on
+// problems that offer a fixed gradient, it runs the unforced loop on fixed-size vectors with the
+// gradient inlined.
 class StormerVerlet final : public Integrator {
  public:
   MethodInfo info() const override {
@@ -34,39 +69,90 @@ class StormerVerlet final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    const Vec& inverse_mass = problem.inverse_mass();
-    const bool cache_hit =
-        cached_problem_ == &problem && cached_q_.size() == state.q.size() && cached_q_ == state.q;
-    if (!cache_hit) eval_gradient(problem, state.q, gradient_);
-    const bool forced = problem.has(kForce);
-
-    if (forced) {
-      eval_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
-      // eval_force is not counted; it is a force-field evaluation of its own when the gradient
-      // at this point came from the cache.
-      if (cache_hit) ++counters_.force_evals;
+    const bool cache_hit = prime_gradient(problem, state);
+    if (problem.has(kForce)) {
+      forced_step(problem, state, h, cache_hit);
+    } else {
+      kick_drift_kick(state.q, state.p, gradient_, problem.inverse_mass(), h, counted(problem));
+      state.t += h;
     }
-    state.p -= (h / 2) * gradient_;
-    if (forced) state.p += (h / 2) * force_;
-    state.q += h * inverse_mass.cwiseProduct(state.p);
-    state.t += h;
-    eval_gradient(problem, state.q, gradient_);
-    if (forced) {
-      eval_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
-      state.p += (h / 2) * force_;
-    }
-    state.p -= (h / 2) * gradient_;
-
-    cached_problem_ = &problem;
-    cached_q_ = state.q;
+    remember(problem, state);
     ++counters_.steps;
     return StepStatus::success();
   }
 
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) override {
+    AdvanceOutcome outcome;
+    if (problem.has(kForce)) {
+      bool cache_hit = prime_gradient(problem, state);
+      outcome = run_grid(state, grid, visit, [&](double h) {
+        forced_step(problem, state, h, cache_hit);
+        cache_hit = true;  // as step() finds it after a step of its own
+        ++counters_.steps;
+      });
+      remember(problem, state);
+      return outcome;
+    }
+    prime_gradient(problem, state);
+    const bool fixed = !visit && with_fixed_gradient(problem, [&](const auto& gradient) {
+      fixed_size_loop(gradient, problem.inverse_mass(), grid, state, gradient_);
+      counters_.force_evals += grid.n;
+      counters_.steps += grid.n;
+      outcome.steps = grid.n;
+    });
+    if (!fixed) {
+      const Vec& inverse_mass = problem.inverse_mass();
+      outcome = run_grid(state, grid, visit, [&](double h) {
+        kick_drift_kick(state.q, state.p, gradient_, inverse_mass, h, counted(problem));
+        ++counters_.steps;
+      });
+    }
+    remember(problem, state);
+    return outcome;
+  }
+
  private:
+  // Makes gradient_ = ∇V(state.q), from the cache when it holds; returns whether it did.
+  bool prime_gradient(const Problem& problem, const State& state) {
+    const bool cache_hit =
+        cached_problem_ == &problem && cached_q_.size() == state.q.size() && cached_q_ == state.q;
+    if (!cache_hit) eval_gradient(problem, state.q, gradient_);
+    return cache_hit;
+  }
+  void remember(const Problem& problem, const State& state) {
+    cached_problem_ = &problem;
+    cached_q_ = state.q;
+  }
+  // ∇V through eval_gradient, so that the dynamic loops count their evaluations.
+  struct CountedGradient {
+    StormerVerlet* method;
+    const Problem* problem;
+    void operator()(const Vec& q, Vec& g) const { method->eval_gradient(*problem, q, g); }
+  };
+  CountedGradient counted(const Problem& problem) { return {this, &problem}; }
+
+  void forced_step(const Problem& problem, State& state, double h, bool cache_hit) {
+    const Vec& inverse_mass = problem.inverse_mass();
+    velocity_ = inverse_mass.cwiseProduct(state.p);
+    eval_force(problem, state.q, velocity_, state.t, force_);
+    // eval_force is not counted; it is a force-field evaluation of its own when the gradient
+    // at this point came from the cache.
+    if (cache_hit) ++counters_.force_evals;
+    state.p -= (h / 2) * gradient_;
+    state.p += (h / 2) * force_;
+    state.q += h * inverse_mass.cwiseProduct(state.p);
+    state.t += h;
+    eval_gradient(problem, state.q, gradient_);
+    velocity_ = inverse_mass.cwiseProduct(state.p);
+    eval_force(problem, state.q, velocity_, state.t, force_);
+    state.p += (h / 2) * force_;
+    state.p -= (h / 2) * gradient_;
+  }
+
   const Problem* cached_problem_ = nullptr;
   Vec cached_q_;  // q at which gradient_ = ∇V(q) was evaluated
-  Vec gradient_, force_;
+  Vec gradient_, force_, velocity_;
 };
 
 }  // namespace

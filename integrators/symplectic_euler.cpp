@@ -1,6 +1,7 @@
 // Symplectic Euler, kick first (L_d = h L(q_k, v)) and drift first (L_d = h L(q_{k+1}, v)):
 // docs/METHOD.md §1 table; Hairer, Lubich & Wanner, GNI §VI.3, Theorem 3.3 and its adjoint. Forces
 // enter as discrete Lagrange–d'Alembert impulses h·F (docs/METHOD.md §2).
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -9,7 +10,7 @@ namespace {
 // Kick then drift: p⁺ = p + h[−∇V(q) + F(q, v, t)], q⁺ = q + h M⁻¹p⁺. The force takes the
 // velocity at the start of the step, v = M⁻¹p: the step velocity M⁻¹p⁺ would make a
 // velocity-dependent force implicit, and the method is first order either way.
-class SymplecticEulerA final : public Integrator {
+class SymplecticEulerA final : public ExplicitStepper<SymplecticEulerA> {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_a", 1, kExplicit | kSymplectic | kVariational,
@@ -20,24 +21,24 @@ class SymplecticEulerA final : public Integrator {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
-                     force_);
+  // Kick then drift (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
+    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
     state.q += h * problem.inverse_mass().cwiseProduct(state.p);
     state.t += h;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
  private:
-  Vec force_;
+  Vec velocity_, force_;
 };
 
 // Drift then kick: q⁺ = q + h M⁻¹p, p⁺ = p + h[−∇V(q⁺) + F(q⁺, v, t + h)]. The force takes the
 // drift velocity v = M⁻¹p = (q⁺ − q)/h, the discrete velocity of the step, so the impulse is
 // the Lagrange–d'Alembert F_d⁺ = h F(q_{k+1}, v_{k,k+1}) and the scheme stays explicit.
-class SymplecticEulerB final : public Integrator {
+class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
  public:
   MethodInfo info() const override {
     return {"symplectic_euler_b", 1, kExplicit | kSymplectic | kVariational,
@@ -48,14 +49,14 @@ class SymplecticEulerB final : public Integrator {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
+  // Drift then kick (ExplicitStepper runs it for step() and advance()).
+  void advance_by(const Problem& problem, State& state, double h) {
     velocity_ = problem.inverse_mass().cwiseProduct(state.p);
     state.q += h * velocity_;
     state.t += h;
     eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
  private:

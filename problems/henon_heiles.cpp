@@ -21,10 +21,8 @@ class HenonHeiles final : public Problem {
   State initial_state() const override { return initial_; }
 
   double potential(const Vec& q) const override { return value(q[0], q[1]); }
-  void gradient(const Vec& q, Vec& g) const override {
-    g.resize(2);
-    g << q[0] + 2 * q[0] * q[1], q[1] + q[0] * q[0] - q[1] * q[1];
-  }
+  void gradient(const Vec& q, Vec& g) const override { HenonHeilesGradient()(q, g); }
+  FixedGradient fixed_gradient() const override { return HenonHeilesGradient(); }
   void hessian(const Vec& q, SparseMatrix& H) const override {
     H.resize(2, 2);
     H.setZero();

@@ -74,10 +74,8 @@ class Kepler final : public Problem {
   }
 
   double potential(const Vec& q) const override { return -1 / q.norm(); }
-  void gradient(const Vec& q, Vec& g) const override {
-    const double r = q.norm();
-    g = q / (r * r * r);
-  }
+  void gradient(const Vec& q, Vec& g) const override { KeplerGradient()(q, g); }
+  FixedGradient fixed_gradient() const override { return KeplerGradient(); }
   // ∇²V = I/r³ − 3 q qᵀ/r⁵.
   void hessian(const Vec& q, SparseMatrix& H) const override {
     const double r = q.norm();

@@ -164,9 +164,8 @@ class Pendulum final : public Problem {
     const double s = std::sin(q[0] / 2);
     return 2 * omega0_ * omega0_ * s * s;
   }
-  void gradient(const Vec& q, Vec& g) const override {
-    g = Vec::Constant(1, omega0_ * omega0_ * std::sin(q[0]));
-  }
+  void gradient(const Vec& q, Vec& g) const override { PendulumGradient{omega0_}(q, g); }
+  FixedGradient fixed_gradient() const override { return PendulumGradient{omega0_}; }
   void hessian(const Vec& q, SparseMatrix& H) const override {
     H.resize(1, 1);
     H.setZero();

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/fixed_gradient.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -62,6 +63,10 @@ class Problem {
   virtual double potential(const Vec& q) const = 0;
   // g = ∇V(q); g is resized by the callee.
   virtual void gradient(const Vec& q, Vec& g) const = 0;
+  // The same ∇V as an inlineable functor (problems/fixed_gradient.hpp) for problems with a few
+  // dof, so explicit methods can run a statically typed step loop; std::monostate when not
+  // offered. Must round exactly as gradient() does (both call the functor).
+  virtual FixedGradient fixed_gradient() const { return {}; }
   // H = ∇²V(q), symmetric, compressed. Only when has(kHessian).
   virtual void hessian(const Vec& q, SparseMatrix& H) const;
   // Non-conservative generalized force F(q, v, t) (added to −∇V). Only when has(kForce).

@@ -1,0 +1,63 @@
+// The step loop explicit methods run inside Integrator::advance (issue 9 item 3; docs/DESIGN.md
+// §2): the grid of harness/run.cpp with a step body that the compiler can inline, no status
+// object per step, and the visitor called only when there is one.
+#pragma once
+
+#include <type_traits>
+#include <variant>
+
+#include "integrators/integrator.hpp"
+
+namespace geomint {
+
+// Runs `step(h)`, which advances `state` by h, over the grid from state.t.
+template <class Step>
+AdvanceOutcome run_grid(State& state, const StepGrid& grid, StepVisitor visit, Step&& step) {
+  AdvanceOutcome outcome;
+  double t = state.t;
+  for (long k = 1; k <= grid.n; ++k) {
+    const double t_next = grid.time(k);
+    step(t_next - t);
+    t = t_next;
+    state.t = t;  // the grid time, as the per-step path sets it, for bodies that read state.t
+    if (visit && !visit(state, k)) return outcome;
+    outcome.steps = k;
+  }
+  return outcome;
+}
+
+// Base of explicit methods whose step is one non-failing body `Derived::advance_by(problem,
+// state, h)`: step() and advance() both run it, so the two paths cannot drift apart.
+template <class Derived>
+class ExplicitStepper : public Integrator {
+ public:
+  StepStatus step(const Problem& problem, State& state, double h) final {
+    derived().advance_by(problem, state, h);
+    return StepStatus::success();
+  }
+  AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
+                         StepVisitor visit) final {
+    return run_grid(state, grid, visit, [&](double h) { derived().advance_by(problem, state, h); });
+  }
+
+ private:
+  Derived& derived() { return static_cast<Derived&>(*this); }
+};
+
+// Dispatches once per run on the problem's fixed gradient (problems/fixed_gradient.hpp): calls
+// `fixed(gradient)` with the concrete functor, or returns false when the problem offers none.
+template <class Fixed>
+bool with_fixed_gradient(const Problem& problem, Fixed&& fixed) {
+  return std::visit(
+      [&](const auto& gradient) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(gradient)>, std::monostate>) {
+          return false;
+        } else {
+          fixed(gradient);
+          return true;
+        }
+      },
+      problem.fixed_gradient());
+}
+
+}  // namespace geomint
