@@ -78,7 +78,10 @@ const std::vector<std::string>& symmetric_second_order_methods() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> found;
     for (const auto& entry : integrator_registry()) {
-      if (entry.name == "composition") continue;
+      // The wrappers: neither is a symmetric second-order base, and building penalty here would
+      // build composition again while this list is being initialised (penalty lists its bases
+      // the same way).
+      if (entry.name == "composition" || entry.name == "penalty") continue;
       const MethodInfo info = make_integrator(entry.name)->info();
       if ((info.flags & kSymmetric) && info.order == 2 && !(info.flags & kAdaptive)) {
         found.push_back(entry.name);
