@@ -92,7 +92,8 @@ class ConstraintObserver : public Observer {
   }
   void observe(const Problem& problem, const State& state) override {
     position_ = std::max(position_, problem.constraint_residual(state.t, state.q));
-    velocity_ = std::max(velocity_, problem.constraint_velocity_residual(state.t, state.q, state.p));
+    velocity_ =
+        std::max(velocity_, problem.constraint_velocity_residual(state.t, state.q, state.p));
   }
   void finish(std::map<std::string, double>& metrics) const override {
     metrics["constraint_err_max"] = position_;
