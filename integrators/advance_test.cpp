@@ -107,7 +107,8 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"stormer_verlet", "harmonic"}, Case{"stormer_verlet", "pendulum:theta0=1.5"},
         Case{"stormer_verlet", "spring_net"}, Case{"stormer_verlet", "damped_oscillator"},
         Case{"symplectic_euler_a", "damped_oscillator"}, Case{"symplectic_euler_b", "kepler:e=0.6"},
-        Case{"rk4", "kepler:e=0.6"}, Case{"rk4", "damped_oscillator"}, Case{"hp", "kepler:e=0.6"}),
+        Case{"rk4", "kepler:e=0.6"}, Case{"rk4", "damped_oscillator"}, Case{"hp", "kepler:e=0.6"},
+        Case{"position_verlet", "kepler:e=0.6"}, Case{"position_verlet", "damped_oscillator"}),
     [](const ::testing::TestParamInfo<Case>& info) {
       std::string name = info.param.method + "_" + info.param.problem;
       for (char& c : name) {
@@ -136,7 +137,7 @@ TEST(Advance, VisitorStopsTheRun) {
 // (issue 9: no per-step allocation or string construction on the hot path).
 TEST(Advance, ExplicitLoopsDoNotAllocate) {
   for (const char* method_spec :
-       {"stormer_verlet", "symplectic_euler_a", "symplectic_euler_b", "rk4"}) {
+       {"stormer_verlet", "position_verlet", "symplectic_euler_a", "symplectic_euler_b", "rk4"}) {
     for (const char* problem_spec : {"kepler:e=0.6", "spring_net", "damped_oscillator"}) {
       SCOPED_TRACE(std::string(method_spec) + " on " + problem_spec);
       const auto problem = make_problem(problem_spec);

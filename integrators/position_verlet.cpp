@@ -1,6 +1,7 @@
 // Position Verlet, drift–kick–drift: the Strang splitting of the exact flows of T = ½pᵀM⁻¹p and V
 // (Hairer, Lubich & Wanner, GNI §I.1.4 and §II.5, eq. (5.5) with the roles of T and V swapped);
 // the adjoint-ordered sibling of stormer_verlet (docs/METHOD.md §1).
+#include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -14,8 +15,9 @@ namespace {
 // maps of those symmetries are kept exactly (discrete Noether; the map has a type-1 generating
 // function L_d(q, q⁺) for small h, GNI §VI.5). A velocity-dependent force is evaluated at the
 // incoming velocity M⁻¹p, which keeps the step explicit and makes the force coupling first order.
-// One gradient per step: the kick point q½ is never reused, so there is no cache.
-class PositionVerlet final : public Integrator {
+// One gradient per step: the kick point q½ is never reused, so there is no cache. ExplicitStepper
+// runs the same body for step() and for advance()'s allocation-free grid loop.
+class PositionVerlet final : public ExplicitStepper<PositionVerlet> {
  public:
   MethodInfo info() const override {
     return {"position_verlet", 2, kExplicit | kSymplectic | kSymmetric | kVariational,
@@ -27,7 +29,7 @@ class PositionVerlet final : public Integrator {
     return StabilityPrediction::limit(2.0);
   }
 
-  StepStatus step(const Problem& problem, State& state, double h) override {
+  void advance_by(const Problem& problem, State& state, double h) {
     const Vec& inverse_mass = problem.inverse_mass();
     const bool forced = problem.has(kForce);
     if (forced) velocity_ = inverse_mass.cwiseProduct(state.p);
@@ -41,7 +43,6 @@ class PositionVerlet final : public Integrator {
     state.q += (h / 2) * inverse_mass.cwiseProduct(state.p);
     state.t += h;
     ++counters_.steps;
-    return StepStatus::success();
   }
 
  private:

@@ -22,5 +22,14 @@ root=$(cd "$(dirname "$0")/.." && pwd)
       echo "![$(basename "$png" .png)]($scene/$(basename "$png"))"
     done
   done
+  # Benchmark results that are not harness scenes (no scene.toml): written by their own scripts.
+  if [ -f "$root/results/scaling/scaling.csv" ]; then
+    echo
+    echo "## [scaling](scaling/) — cost per step against problem size (scripts/scaling.sh)"
+    echo
+    echo "Data: [scaling/scaling.csv](scaling/scaling.csv)"
+    echo
+    echo "![scaling](scaling/scaling.png)"
+  fi
 } > "$root/results/README.md.tmp"
 mv "$root/results/README.md.tmp" "$root/results/README.md"
