@@ -67,6 +67,7 @@ TEST_P(ConstrainedProblem, JacobianMatchesFiniteDifferences) {
     ASSERT_EQ(G.rows(), m);
     ASSERT_EQ(G.cols(), problem.dof());
     ASSERT_EQ(residual_at(problem, q).size(), m);
+    ASSERT_EQ(static_cast<int>(problem.multiplier_names().size()), m);
     const double scale = inf_norms_of_rows(G).maxCoeff();
     for (int j = 0; j < problem.dof(); ++j) {
       Vec plus = q, minus = q;
