@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -127,6 +128,27 @@ TEST(EnergyGrowthExponent, DriftIsOneAndBoundedIsZero) {
               drift, bounded);
   EXPECT_NEAR(drift, 1.0, 0.1);
   EXPECT_NEAR(bounded, 0.0, 0.1);
+}
+
+// The divergence rule is an option (README "Failure rows"): explicit Euler at h = 0.1 multiplies
+// H by 1.01 per step, so a factor of 10 stops it after ln 11/ln 1.01 ≈ 241 steps, and inf lets it
+// run to t = 300 and report the growth, 1.01³⁰⁰⁰ − 1 = 9.2e12.
+TEST(DivergeFactor, LowFactorStopsAndInfinityRunsToTheEnd) {
+  RunConfig config;
+  config.dt = 0.1;
+  config.t_end = 300;
+  config.timing_repeats = 0;
+  config.diverge_factor = 10;
+  const RunResult stopped = run_one("harmonic", "explicit_euler", config);
+  EXPECT_EQ(stopped.record.status, "diverged");
+  EXPECT_NEAR(*stopped.record.t_reached, 24.0, 1e-9);
+  EXPECT_LE(stopped.record.metrics.at("energy_err_max"), 10.0);
+  config.diverge_factor = std::numeric_limits<double>::infinity();
+  const RunResult finished = run_one("harmonic", "explicit_euler", config);
+  EXPECT_EQ(finished.record.status, "ok");
+  EXPECT_EQ(*finished.record.steps, 3000);
+  EXPECT_NEAR(finished.record.metrics.at("energy_err_max"), std::pow(1.01, 3000) - 1,
+              1e-6 * 9.2e12);
 }
 
 }  // namespace
