@@ -130,6 +130,17 @@ TEST(EnergyGrowthExponent, DriftIsOneAndBoundedIsZero) {
   EXPECT_NEAR(bounded, 0.0, 0.1);
 }
 
+// Every optional metric has its column in the run schema (to_row throws on an unknown metric).
+TEST(OptionalMetrics, EveryOneIsReportedAndHasAColumn) {
+  const RunRecord record =
+      run_with("pendulum:theta0=1", "stormer_verlet", 0.01, 100, optional_metric_names());
+  for (const std::string name :
+       {"symplecticity_defect", "period_measured", "period_err_rel", "energy_growth_exponent"}) {
+    EXPECT_TRUE(record.metrics.count(name)) << name;
+  }
+  EXPECT_NO_THROW(to_row(record));
+}
+
 // The divergence rule is an option (README "Failure rows"): explicit Euler at h = 0.1 multiplies
 // H by 1.01 per step, so a factor of 10 stops it after ln 11/ln 1.01 ≈ 241 steps, and inf lets it
 // run to t = 300 and report the growth, 1.01³⁰⁰⁰ − 1 = 9.2e12.
