@@ -72,7 +72,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
   const long m = G0.rows();
   // ρ turns ‖F₂‖² (a velocity squared) into the units of E_k; any ρ ≥ 0 keeps the SQP direction a
   // descent direction of the merit, ρ > 0 makes the merit reward feasibility.
-  const double rho = problem.mass().maxCoeff();
+  double rho = problem.mass().maxCoeff();
   double threshold = std::max(options.tolerance, kRoundoffFloor) * residual_scale;
   result.threshold = threshold;
 
@@ -217,6 +217,10 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
       result.reason = "line_search_failed";
       break;
     }
+    // Augmented-Lagrangian rule (Nocedal & Wright §17.4): when the constraint violation does not
+    // fall by a quarter, the penalty is too weak against E_k's descent off the manifold (a
+    // concave V makes E_k unbounded below there): stiffen it for the rest of the solve.
+    if (minimise && trial.g_norm > 0.25 * current.g_norm && trial.g_norm > g_threshold) rho *= 10;
     current = trial;
     v = current.v;
   }

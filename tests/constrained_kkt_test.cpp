@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "harness/order.hpp"
@@ -12,6 +13,64 @@
 
 namespace geomint {
 namespace {
+
+// A bead of unit mass on the unit circle in the concave potential V = −(c/4)(x⁴ + y⁴) (four
+// wells at the diagonals on the circle): ∇²V = −3c·diag(x², y²) makes the step's Hessian
+// M + ¼h²∇²V indefinite at large h, the regime where the minimiser's safeguard and line search
+// act — the catalogue's constrained problems all have linear potentials. A test fixture only.
+class BeadInConcaveWells final : public Problem {
+ public:
+  BeadInConcaveWells(double c, double theta0, double speed)
+      : c_(c), theta0_(theta0), speed_(speed) {
+    set_mass(Vec::Ones(2));
+    set_capabilities(kHessian | kConstraints);
+    set_defaults(0.01, 10.0);
+  }
+  State initial_state() const override {
+    State s;
+    s.q = Vec(2);
+    s.q << std::cos(theta0_), std::sin(theta0_);
+    s.p = Vec(2);
+    s.p << -speed_ * std::sin(theta0_), speed_ * std::cos(theta0_);
+    return s;
+  }
+  double potential(const Vec& q) const override {
+    return -0.25 * c_ * (std::pow(q[0], 4) + std::pow(q[1], 4));
+  }
+  void gradient(const Vec& q, Vec& g) const override {
+    g = Vec(2);
+    g << -c_ * std::pow(q[0], 3), -c_ * std::pow(q[1], 3);
+  }
+  void hessian(const Vec& q, SparseMatrix& H) const override {
+    diagonal(-3 * c_ * q.cwiseAbs2(), H);
+  }
+  int constraint_count() const override { return 1; }
+  void constraint(const Vec& q, Vec& g) const override {
+    g = Vec::Constant(1, 0.5 * (q.squaredNorm() - 1));
+  }
+  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
+    G.resize(1, 2);
+    G.setZero();
+    G.insert(0, 0) = q[0];
+    G.insert(0, 1) = q[1];
+    G.makeCompressed();
+  }
+  void constraint_curvature(const Vec&, const Vec& v, Vec& c) const override {
+    c = Vec::Constant(1, v.squaredNorm());
+  }
+  void constraint_hessian(const Vec&, const Vec& lambda, SparseMatrix& K) const override {
+    diagonal(Vec::Constant(2, lambda[0]), K);
+  }
+
+ private:
+  static void diagonal(const Vec& d, SparseMatrix& A) {
+    A.resize(d.size(), d.size());
+    A.setZero();
+    for (int i = 0; i < d.size(); ++i) A.insert(i, i) = d[i];
+    A.makeCompressed();
+  }
+  double c_, theta0_, speed_;
+};
 
 // Fixed steps of h from the problem's initial state; the worst |q − q_ref|, |p − p_ref| is taken
 // by the caller.
@@ -107,6 +166,66 @@ TEST(ConstrainedKkt, ApplicabilityOfTheVariants) {
   }
   for (const char* spec : {"hp:alpha=0.25", "del:rule=trapezoid", "del:rule=left"}) {
     EXPECT_FALSE(applicable(*make_integrator(spec), *pendulum).ok) << spec;
+  }
+}
+
+// On a nonlinear potential, where the constrained midpoint step is not RATTLE: both solvers keep
+// g and G M⁻¹p at round-off and agree, the energy error does not grow over 10⁴ steps, the step
+// is reversible (h → −h) and of order 2 by self-convergence. Measured (h = 0.05, c = 10):
+// energy error 3.6e-3 over the first and the last 2000 of 20000 steps alike.
+TEST(ConstrainedKkt, BeadInConcaveWellsIsKeptSymmetricAndSecondOrder) {
+  const BeadInConcaveWells problem(10.0, 0.3, 2.0);
+  const double h = 0.05;
+  const State start = problem.initial_state();
+  const double energy = problem.energy(start.q, start.p);
+  State reference;
+  for (const char* spec : {"hp", "hp:solver=newton", "del:rule=midpoint"}) {
+    SCOPED_TRACE(spec);
+    const auto method = make_integrator(spec);
+    State state = start;
+    method->reset(problem, state, h);
+    double early = 0, late = 0, g_max = 0, gv_max = 0;
+    const long steps = 20000;
+    for (long k = 0; k < steps; ++k) {
+      const StepStatus status = method->step(problem, state, h);
+      ASSERT_TRUE(status.ok) << status.message;
+      const double error = std::abs(problem.energy(state.q, state.p) - energy);
+      if (k < 2000) early = std::max(early, error);
+      if (k >= steps - 2000) late = std::max(late, error);
+      g_max = std::max(g_max, problem.constraint_residual(state.q));
+      gv_max = std::max(gv_max, problem.constraint_velocity_residual(state.q, state.p));
+    }
+    std::printf("%s on the bead: energy error %.3g (first 2000 steps), %.3g (last 2000)\n", spec,
+                early, late);
+    EXPECT_LE(g_max, 1e-14);
+    EXPECT_LE(gv_max, 1e-14 * 2.0);
+    EXPECT_LT(late, 1.5 * early) << early;
+    EXPECT_GT(early, 1e-4);  // the step is not exact: the comparison above means something
+    if (reference.q.size() == 0) {
+      reference = state;
+    } else {
+      EXPECT_LT(distance(state, reference), 1e-8);
+    }
+    // Reversibility: 50 steps forward, 50 with −h.
+    State there = start;
+    method->reset(problem, there, h);
+    for (int k = 0; k < 50; ++k) ASSERT_TRUE(method->step(problem, there, h).ok);
+    method->reset(problem, there, -h);
+    for (int k = 0; k < 50; ++k) ASSERT_TRUE(method->step(problem, there, -h).ok);
+    EXPECT_LT(distance(there, start), 1e-12);
+    // Self-convergence at t = 2: |x_h − x_{h/2}| / |x_{h/2} − x_{h/4}| = 4.
+    double differences[2];
+    State previous;
+    for (int level = 0; level < 3; ++level) {
+      const double step = 0.02 / (1 << level);
+      State at = start;
+      method->reset(problem, at, step);
+      for (long k = 0; k < std::lround(2.0 / step); ++k)
+        ASSERT_TRUE(method->step(problem, at, step).ok);
+      if (level > 0) differences[level - 1] = distance(at, previous);
+      previous = at;
+    }
+    EXPECT_NEAR(std::log2(differences[0] / differences[1]), 2.0, 0.15);
   }
 }
 
