@@ -25,7 +25,8 @@ struct ConstrainedStepResult {
 // position test), then one polishing correction. The options choose the globalisation:
 //  - line_search with system.objective: SQP; H gets the SPD safeguard (system.spd_shift) and the
 //    step is line-searched on the augmented Lagrangian φ(v) = E_k(v) + Λ⁺ᵀG(q_k)v + (ρ/2)‖F₂‖²
-//    at the new multiplier Λ⁺ = Λ + ΔΛ (ρ = max M), for which the SQP direction always descends;
+//    at the new multiplier Λ⁺ = Λ + ΔΛ, for which the SQP direction always descends (ρ starts at
+//    max M and grows ×10 when an iteration does not cut max|g| by a quarter);
 //  - line_search without an objective: Newton backtracked on ½(‖F₁‖² + ρ²‖F₂‖²);
 //  - no line search: plain Newton on (F₁, F₂), full steps, no safeguard (solver=newton).
 // Each KKT solve goes through the Schur complement: the sparse LDLᵀ of H (as the unconstrained

@@ -42,7 +42,9 @@ namespace {
 // M + h² Σ_j w_j a_j(1 − a_j)∇²V(q^j) (+ the impulse's hC), symmetric → sparse LDLT, globalised
 // by backtracking on ½‖R‖² (hp adds the minimisation form), then evaluates p_{k+1} = D₂L_d + F_d⁺.
 // An explicit rule with an impulse in the minus slot still solves (M + hC)v = … by Newton (one
-// iteration for a force linear in v), without the Hessian.
+// iteration for a force linear in v), without the Hessian. Constraints (rule=midpoint only,
+// docs/METHOD.md §3): p_k = −D₁L_d − G(q_k)ᵀΛ with g(q_{k+1}) = 0, by
+// integrators/constrained_step.hpp, then p_{k+1} projected onto the tangent space.
 struct Node {
   double a;  // position along the step, in [0, 1]
   double w;  // weight, Σ w = 1

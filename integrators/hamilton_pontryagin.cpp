@@ -54,6 +54,10 @@ namespace {
 // merit). The default (force_slot=split, force_at=midpoint, as in discrete_lagrangian.cpp) is such
 // a case: on a forced problem minimize is a line-searched Newton on R; force_at=node keeps the
 // exact objective.
+//
+// Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
+// G(q_k)ᵀΛ and g(q_k + hv) = 0, solved by integrators/constrained_step.hpp, then p_{k+1}
+// projected onto the tangent space at q_{k+1}.
 class HamiltonPontryagin final : public Integrator {
  public:
   HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, const NewtonOptions& newton)
