@@ -19,8 +19,14 @@ set(GEOMINT_SLOW_TESTS
 # gtest_discover_tests for one test executable, twice: its slow tests (GEOMINT_SLOW_TESTS) with
 # the label `slow`, the others without. Takes gtest_discover_tests' DISCOVERY_TIMEOUT and
 # PROPERTIES.
+# Tests write scratch files under std::filesystem::temp_directory_path(); TMPDIR points it into
+# this build tree so that two builds testing at the same time (clones, CI and a developer) never
+# share /tmp/geomint_* folders.
+file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/test-tmp)
+
 function(geomint_discover_tests target)
   cmake_parse_arguments(PARSE_ARGV 1 ARG "" "DISCOVERY_TIMEOUT" "PROPERTIES")
+  list(APPEND ARG_PROPERTIES ENVIRONMENT "TMPDIR=${CMAKE_BINARY_DIR}/test-tmp")
   set(common ${target})
   if(ARG_DISCOVERY_TIMEOUT)
     list(APPEND common DISCOVERY_TIMEOUT ${ARG_DISCOVERY_TIMEOUT})
