@@ -7,16 +7,15 @@
 #include <cmath>
 #include <numbers>
 
-#include "problems/problem.hpp"
+#include "problems/oscillator_base.hpp"
 
 namespace geomint {
 namespace {
 
-class ParametricOscillator final : public Problem {
+class ParametricOscillator final : public OscillatorBase {
  public:
   ParametricOscillator(double omega, double epsilon, double nu, double mass, double q0, double v0)
-      : omega_(omega), epsilon_(epsilon), nu_(nu), mass_(mass), q0_(q0), v0_(v0) {
-    set_mass(Vec::Constant(1, mass));
+      : OscillatorBase(omega, mass, q0, v0), epsilon_(epsilon), nu_(nu) {
     // kForceJacobian would claim ∂F/∂v is the whole force derivative; F depends on q here, so
     // the implicit solvers difference it instead.
     set_capabilities(kHessian | kForce | kOmegaMax);
@@ -24,19 +23,6 @@ class ParametricOscillator final : public Problem {
     set_defaults(0.05 / omega, 20 * std::numbers::pi / omega);
   }
 
-  State initial_state() const override {
-    return {0.0, Vec::Constant(1, q0_), Vec::Constant(1, mass_ * v0_)};
-  }
-
-  double potential(const Vec& q) const override { return 0.5 * stiffness() * q[0] * q[0]; }
-  void gradient(const Vec& q, Vec& g) const override { HarmonicGradient{stiffness()}(q, g); }
-  FixedGradient fixed_gradient() const override { return HarmonicGradient{stiffness()}; }
-  void hessian(const Vec&, SparseMatrix& H) const override {
-    H.resize(1, 1);
-    H.setZero();
-    H.insert(0, 0) = stiffness();
-    H.makeCompressed();
-  }
   void force(const Vec& q, const Vec&, double t, Vec& f) const override {
     f = Vec::Constant(1, -stiffness() * epsilon_ * std::cos(nu_ * t) * q[0]);
   }
@@ -44,9 +30,7 @@ class ParametricOscillator final : public Problem {
   double omega_max(const Vec&) const override { return omega_ * std::sqrt(1 + std::abs(epsilon_)); }
 
  private:
-  double stiffness() const { return mass_ * omega_ * omega_; }
-
-  double omega_, epsilon_, nu_, mass_, q0_, v0_;
+  double epsilon_, nu_;
 };
 
 }  // namespace
