@@ -182,6 +182,11 @@ int main(int argc, char** argv) {
   run->add_option("--metric", extra_metrics,
                   "also compute an optional metric (repeatable): symplecticity_defect, "
                   "period_measured (with period_err_rel), energy_growth_exponent");
+  std::string initial_path;
+  const std::string initial_help =
+      "start from the state in this CSV (rows q,p, or q,v under a 'q,v' header; one per dof): "
+      "the problem spec key initial=FILE";
+  run->add_option("--initial", initial_path, initial_help);
 
   double dt0 = 0;
   long levels = 6;
@@ -195,6 +200,7 @@ int main(int argc, char** argv) {
   order->add_option("--t-end", t_end, "horizon")->required();
   order->add_option("--out", out_path, "write the ladder runs as CSV");
   order->add_option("--diverge-factor", diverge_factor, diverge_help);
+  order->add_option("--initial", initial_path, initial_help);
 
   std::string scene_path, sweep_out;
   int jobs = 1;
@@ -295,6 +301,15 @@ int main(int argc, char** argv) {
       if (list_what == "all") fmt::print("\n");
       if (list_what != "methods") print_problems(list_markdown);
       return 0;
+    }
+    if (!initial_path.empty()) {
+      // A comma would end the spec item; the spec (and so every CSV row) records the file.
+      if (initial_path.find(',') != std::string::npos) {
+        throw InputError(
+            fmt::format("--initial: the path '{}' may not contain a comma", initial_path));
+      }
+      problem_spec += (problem_spec.find(':') == std::string::npos ? ":" : ",") +
+                      std::string(kInitialStateKey) + "=" + initial_path;
     }
     if (*run) {
       const auto problem = make_problem(problem_spec);

@@ -3,34 +3,18 @@
 #include <cmath>
 #include <numbers>
 
-#include "problems/problem.hpp"
+#include "problems/oscillator_base.hpp"
 
 namespace geomint {
 namespace {
 
-class Harmonic final : public Problem {
+class Harmonic final : public OscillatorBase {
  public:
-  Harmonic(double omega, double mass, double q0, double v0)
-      : omega_(omega), mass_(mass), q0_(q0), v0_(v0) {
-    set_mass(Vec::Constant(1, mass));
+  Harmonic(double omega, double mass, double q0, double v0) : OscillatorBase(omega, mass, q0, v0) {
     set_capabilities(kHessian | kExact | kPeriod | kOmegaMax);
     // The step scales with 1/ω so that every ω gets the same 125 steps per period and stays
     // inside the explicit methods' stability limits (hω < 2 for Störmer–Verlet); ten periods.
     set_defaults(0.05 / omega, 10 * period());
-  }
-
-  State initial_state() const override {
-    return {0.0, Vec::Constant(1, q0_), Vec::Constant(1, mass_ * v0_)};
-  }
-
-  double potential(const Vec& q) const override { return 0.5 * stiffness() * q[0] * q[0]; }
-  void gradient(const Vec& q, Vec& g) const override { HarmonicGradient{stiffness()}(q, g); }
-  FixedGradient fixed_gradient() const override { return HarmonicGradient{stiffness()}; }
-  void hessian(const Vec&, SparseMatrix& H) const override {
-    H.resize(1, 1);
-    H.setZero();
-    H.insert(0, 0) = stiffness();
-    H.makeCompressed();
   }
 
   State exact(double t) const override {
@@ -42,14 +26,6 @@ class Harmonic final : public Problem {
   }
   double period() const override { return 2 * std::numbers::pi / omega_; }
   double omega_max(const Vec&) const override { return omega_; }
-
- private:
-  double stiffness() const { return mass_ * omega_ * omega_; }
-
-  double omega_;
-  double mass_;
-  double q0_;
-  double v0_;
 };
 
 }  // namespace

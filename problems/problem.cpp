@@ -30,8 +30,18 @@ std::vector<std::string> problem_test_specs() {
   return specs;
 }
 
+// problems/given_initial_state.cpp
+std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> problem,
+                                                 const std::string& path);
+
 std::unique_ptr<Problem> make_problem(const std::string& spec_text) {
-  const Spec spec = Spec::parse(spec_text);
+  Spec spec = Spec::parse(spec_text);
+  // `initial=FILE.csv` belongs to every problem: it replaces the start after construction.
+  std::string initial_file;
+  if (const auto it = spec.values.find(kInitialStateKey); it != spec.values.end()) {
+    initial_file = it->second;
+    spec.values.erase(it);
+  }
   std::vector<std::string> names;
   for (const auto& entry : problem_registry()) {
     if (entry.name != spec.name) {
@@ -43,6 +53,18 @@ std::unique_ptr<Problem> make_problem(const std::string& spec_text) {
     params.finish();
     problem->name_ = entry.name;
     problem->spec_ = params.canonical();
+    if (!initial_file.empty()) {
+      problem = with_initial_state_file(std::move(problem), initial_file);
+      problem->name_ = entry.name;
+      Spec canonical = Spec::parse(params.canonical());
+      canonical.values[kInitialStateKey] = initial_file;
+      problem->spec_ = entry.name;
+      char separator = ':';
+      for (const auto& [key, value] : canonical.values) {
+        problem->spec_ += separator + key + "=" + value;
+        separator = ',';
+      }
+    }
     if (problem->has(kConstraints))
       problem->check_consistent(problem->initial_state(), "initial state");
     return problem;

@@ -169,6 +169,11 @@ class Problem {
   double default_t_end_ = 10.0;
 };
 
+// Spec key every problem accepts: `initial=FILE.csv` starts the problem from the state in the
+// file (rows q,p or, under a header "q,v", q,v; one per dof) instead of its own, and drops its
+// exact solution and period. A wrong row count is an InputError naming n.
+inline constexpr const char* kInitialStateKey = "initial";
+
 // Registry (problems/registry.def). Throws InputError for unknown names/keys/values.
 std::unique_ptr<Problem> make_problem(const std::string& spec_text);
 

@@ -162,6 +162,43 @@ bool Params::flag(const std::string& key, bool default_value, const std::string&
   return value;
 }
 
+std::vector<double> Params::reals(const std::string& key, const std::string& help) {
+  std::vector<double> values;
+  std::vector<std::string> formatted;
+  if (const std::string* text = raw(key)) {
+    size_t start = 0;
+    while (true) {
+      const auto slash = text->find('/', start);
+      const std::string item =
+          text->substr(start, slash == std::string::npos ? slash : slash - start);
+      char* end = nullptr;
+      const double value = std::strtod(item.c_str(), &end);
+      if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(value) ||
+          !(std::abs(value) <= kMaxParameterMagnitude)) {
+        throw InputError(
+            fmt::format("{}: parameter {}='{}' is not a list of finite numbers a/b/c (entry '{}')",
+                        context_, key, *text, item));
+      }
+      values.push_back(value);
+      formatted.push_back(format_number(value));
+      if (slash == std::string::npos) break;
+      start = slash + 1;
+    }
+  }
+  record(key, "", help, fmt::format("{}", fmt::join(formatted, "/")));
+  if (values.empty()) omitted_at_default_.insert(key);
+  return values;
+}
+
+std::string Params::text(const std::string& key, const std::string& default_value,
+                         const std::string& help) {
+  const std::string* given_text = raw(key);
+  const std::string value = given_text ? *given_text : default_value;
+  record(key, default_value, help, value);
+  if (value.empty()) omitted_at_default_.insert(key);
+  return value;
+}
+
 void Params::finish() const {
   for (const auto& [key, value] : spec_.values) {
     if (canonical_values_.count(key) == 0) {

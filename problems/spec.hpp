@@ -60,6 +60,12 @@ class Params {
   std::string choice(const std::string& key, const std::string& default_value,
                      const std::vector<std::string>& choices, const std::string& help);
   bool flag(const std::string& key, bool default_value, const std::string& help);
+  // A list of reals written "a/b/c" (a comma would end the spec item); each entry obeys the
+  // bound of real(). Empty when the key is absent.
+  std::vector<double> reals(const std::string& key, const std::string& help);
+  // Free text (a file path), no commas.
+  std::string text(const std::string& key, const std::string& default_value,
+                   const std::string& help);
 
   // True when the user wrote this key (for parameters whose default depends on others).
   bool given(const std::string& key) const { return spec_.values.count(key) > 0; }

@@ -23,7 +23,8 @@ struct SpringChainConfig {
   double stiffness = 1;
   double alpha = 0;  // cubic coefficient of φ (fpu_alpha only)
   double beta = 0;   // quartic coefficient of φ (fpu_beta only)
-  int mode = 1;
+  int mode = 1;      // the initial displacement is amplitude · mode shape …
+  int node = 0;      // … or, when node ≥ 1, amplitude at that single node (1-based)
   double amplitude = 0.5;
   double velocity = 0;
 };
@@ -44,7 +45,12 @@ class SpringChain final : public Problem {
     // oscillating one.
     const double omega_bound = 2 * std::sqrt(config.stiffness / config.mass);
     set_defaults(0.3 / omega_bound, 10 * 2 * std::numbers::pi / mode_frequency(1));
-    initial_.q = config.amplitude * mode_shape(config.mode);
+    if (config.node > 0) {
+      initial_.q = Vec::Zero(config.n);
+      initial_.q[config.node - 1] = config.amplitude;
+    } else {
+      initial_.q = config.amplitude * mode_shape(config.mode);
+    }
     initial_.p = Vec::Constant(config.n, config.mass * config.velocity);
     if (exact) project_initial_state();
   }
@@ -207,16 +213,30 @@ std::unique_ptr<Problem> make_spring_chain(Params& params) {
       params.real("beta", 1.0, "quartic coefficient (model=fpu_beta only)", positive, "> 0");
   config.alpha = model == "fpu_alpha" ? alpha : 0.0;
   config.beta = model == "fpu_beta" ? beta : 0.0;
-  // Fixed chains have modes 1..n; free chains 1..n-1 (mode 0 is the translation).
-  const long max_mode = config.fixed ? config.n : config.n - 1;
-  config.mode = static_cast<int>(
-      params.integer("mode", 1, "normal mode shaping the initial displacement", 1, 10'000'000));
-  if (config.mode > max_mode) {
-    throw InputError(fmt::format(
-        "problem 'spring_chain': parameter mode={} must be in [1, {}] for n={}, ends={}",
-        config.mode, max_mode, config.n, ends));
+  const std::string init = params.choice("init", "mode", {"mode", "node"},
+                                         "initial displacement: a normal mode, or a single node");
+  params.omit_default_from_canonical("init");
+  if (init == "node") {
+    config.node =
+        static_cast<int>(params.integer("node", 1, "the displaced node (1-based)", 1, 10'000'000));
+    if (config.node > config.n) {
+      throw InputError(
+          fmt::format("problem 'spring_chain': parameter node={} must be in [1, {}] for n={}",
+                      config.node, config.n, config.n));
+    }
+  } else {
+    // Fixed chains have modes 1..n; free chains 1..n-1 (mode 0 is the translation).
+    const long max_mode = config.fixed ? config.n : config.n - 1;
+    config.mode = static_cast<int>(
+        params.integer("mode", 1, "normal mode shaping the initial displacement", 1, 10'000'000));
+    if (config.mode > max_mode) {
+      throw InputError(fmt::format(
+          "problem 'spring_chain': parameter mode={} must be in [1, {}] for n={}, ends={}",
+          config.mode, max_mode, config.n, ends));
+    }
   }
-  config.amplitude = params.real("amplitude", 0.5, "amplitude of the initial mode displacement");
+  config.amplitude =
+      params.real("amplitude", 0.5, "amplitude of the initial mode or node displacement");
   config.velocity = params.real("velocity", 0.0, "uniform initial velocity of every mass");
   return std::make_unique<SpringChain>(config);
 }

@@ -140,6 +140,31 @@ TEST(Cli, FailedRunIsARowWithExitOne) {
   EXPECT_NE(outcome.output.find(",diverged,"), std::string::npos) << outcome.output;
 }
 
+// --initial appends the spec key initial=FILE: the row's problem names the file, and a file of
+// the wrong length is exit 2 naming the problem's n, for run and order alike.
+TEST(Cli, InitialStateFileStartsTheRunAndIsChecked) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string good = (dir / "geomint_cli_initial.csv").string();
+  const std::string bad = (dir / "geomint_cli_initial_bad.csv").string();
+  std::ofstream(good) << "q,v\n0.3,0\n";
+  std::ofstream(bad) << "1,0\n2,0\n";
+  const Outcome ran = geomint(
+      "run --problem harmonic --method stormer_verlet --t-end 1 "
+      "--timing-repeats 0 --initial " +
+      good);
+  EXPECT_EQ(ran.exit_code, 0) << ran.output;
+  EXPECT_NE(ran.output.find("harmonic:initial=" + good + ","), std::string::npos) << ran.output;
+  for (const std::string command : {"run --problem spring_chain:n=4 --method stormer_verlet",
+                                    "order --problem spring_chain:n=4 --method stormer_verlet "
+                                    "--dt 0.1 --t-end 1"}) {
+    const Outcome rejected = geomint(command + " --initial " + bad);
+    EXPECT_EQ(rejected.exit_code, 2) << rejected.output;
+    EXPECT_NE(rejected.output.find("n = 4"), std::string::npos) << rejected.output;
+  }
+  std::filesystem::remove(good);
+  std::filesystem::remove(bad);
+}
+
 TEST(Cli, DivergeFactorZeroLetsADivergingRunFinish) {
   // Explicit Euler at h = 0.1 multiplies the energy by 1.01 per step: 9e12 at t = 300.
   const std::string run =
