@@ -11,6 +11,7 @@
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference.hpp"
+#include "harness/structure_metrics.hpp"
 
 namespace geomint {
 namespace {
@@ -250,6 +251,10 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   record.t_end = config.t_end;
 
   auto observers = make_metric_observers(*problem);
+  check_optional_metrics(config.extra_metrics, "--metric");
+  for (auto& observer : make_optional_observers(*problem, config.extra_metrics)) {
+    observers.push_back(std::move(observer));
+  }
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());
     if (std::filesystem::exists(path)) {
@@ -275,6 +280,12 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
                                           if (series) series->observe(*problem, s, last);
                                         });
   for (const auto& observer : observers) observer->finish(record.metrics);
+  if (std::find(config.extra_metrics.begin(), config.extra_metrics.end(), "symplecticity_defect") !=
+          config.extra_metrics.end() &&
+      symplecticity_defect_applies(*integrator, *problem)) {
+    record.metrics["symplecticity_defect"] =
+        symplecticity_defect(method_spec, *problem, problem->initial_state(), config.dt);
+  }
   result.ok = outcome.status.ok;
   result.final_state = state;
   record.status = outcome.status.ok ? "ok" : outcome.status.reason;

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "harness/record.hpp"
 #include "integrators/integrator.hpp"
@@ -33,6 +34,9 @@ struct RunConfig {
   // <reference_dir>/<problem>.csv when it exists and has a row at t_end (harness/reference.hpp);
   // the row's column `reference` names the file.
   std::string reference_dir = "results/references";
+  // Optional metrics to compute (harness/structure_metrics.hpp: optional_metric_names()), from
+  // `run --metric` or a scene's table_columns.
+  std::vector<std::string> extra_metrics;
 };
 
 // t_reached (failure rows only) is, for every kind of method, the time of the last step point

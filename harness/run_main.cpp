@@ -191,6 +191,10 @@ int run_main(int argc, char** argv) {
   run->add_option("--timing-repeats", timing_repeats,
                   fmt::format("timing pass repeats (0 = none, at most {})", kMaxTimingRepeats));
   run->add_option("--diverge-factor", diverge_factor, diverge_help);
+  std::vector<std::string> extra_metrics;
+  run->add_option("--metric", extra_metrics,
+                  "also compute an optional metric (repeatable): symplecticity_defect, "
+                  "period_measured (with period_err_rel), energy_growth_exponent");
 
   double dt0 = 0;
   long levels = 6;
@@ -321,6 +325,7 @@ int run_main(int argc, char** argv) {
       config.series_state = series_state;
       config.timing_repeats = static_cast<int>(timing_repeats);
       config.diverge_factor = diverge_factor;
+      config.extra_metrics = extra_metrics;
       config.command_line = command_line;
       // Outputs are checked before anything is computed.
       if (!out_path.empty()) check_output_file(out_path, "--out");

@@ -22,6 +22,7 @@
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
 #include "harness/shard.hpp"
+#include "harness/structure_metrics.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
@@ -180,6 +181,14 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
   std::set<std::string> series_paths;
   Plan plan;
   auto& jobs = plan.jobs;
+  // Optional metrics are computed in a scene when its table lists them (structure_metrics.hpp).
+  std::vector<std::string> requested_metrics;
+  for (const auto& name : optional_metric_names()) {
+    if (std::find(scene.table_columns.begin(), scene.table_columns.end(), name) !=
+        scene.table_columns.end()) {
+      requested_metrics.push_back(name);
+    }
+  }
   for (const auto& block : scene.runs) {
     const std::vector<double> dts = block.dts.empty() ? std::vector<double>{0.0} : block.dts;
     for (const auto& problem : block.problems) {
@@ -190,6 +199,7 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
           job.config.t_end = block.t_end;
           job.config.timing_repeats = 0;
           job.config.diverge_factor = block.diverge_factor;
+          job.config.extra_metrics = requested_metrics;
           job.config.command_line = options.command_line;
           if (block.series_every > 0) {
             job.config.series_every = block.series_every;

@@ -108,7 +108,9 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"stormer_verlet", "spring_net"}, Case{"stormer_verlet", "damped_oscillator"},
         Case{"symplectic_euler_a", "damped_oscillator"}, Case{"symplectic_euler_b", "kepler:e=0.6"},
         Case{"rk4", "kepler:e=0.6"}, Case{"rk4", "damped_oscillator"}, Case{"hp", "kepler:e=0.6"},
-        Case{"position_verlet", "kepler:e=0.6"}, Case{"position_verlet", "damped_oscillator"}),
+        Case{"position_verlet", "kepler:e=0.6"}, Case{"position_verlet", "damped_oscillator"},
+        Case{"stormer_verlet:compensated=true", "kepler:e=0.6"},
+        Case{"stormer_verlet:compensated=true", "damped_oscillator"}),
     [](const ::testing::TestParamInfo<Case>& info) {
       std::string name = info.param.method + "_" + info.param.problem;
       for (char& c : name) {

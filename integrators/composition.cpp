@@ -114,7 +114,22 @@ std::unique_ptr<Integrator> make_composition(Params& params) {
   }
   // RATTLE's substeps each end on the constraint manifold with tangent momenta, so the
   // composition stays on it too (checked in tests/constraints_test.cpp).
-  const std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : base;
+  std::string base_spec = base == "hp_midpoint" ? "hp:alpha=0.5" : base;
+  // Compensated summation (GNI §VIII.5) lives in the base: the stages run on one base object
+  // without the state being edited between them, so its carried errors span every stage.
+  const bool compensated = params.flag(
+      "compensated", false,
+      "Kahan's compensated summation of every stage's increments (base=stormer_verlet only)");
+  params.omit_default_from_canonical("compensated");
+  if (compensated) {
+    if (base != "stormer_verlet") {
+      throw InputError(
+          "composition: compensated=true needs base=stormer_verlet (the base that "
+          "implements compensated summation), not base=" +
+          base);
+    }
+    base_spec = "stormer_verlet:compensated=true";
+  }
   return std::make_unique<Composition>(*scheme, base_spec, make_integrator(base_spec));
 }
 

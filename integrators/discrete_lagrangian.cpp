@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
@@ -41,7 +42,9 @@ namespace {
 // M + h² Σ_j w_j a_j(1 − a_j)∇²V(q^j) (+ the impulse's hC), symmetric → sparse LDLT, globalised
 // by backtracking on ½‖R‖² (hp adds the minimisation form), then evaluates p_{k+1} = D₂L_d + F_d⁺.
 // An explicit rule with an impulse in the minus slot still solves (M + hC)v = … by Newton (one
-// iteration for a force linear in v), without the Hessian.
+// iteration for a force linear in v), without the Hessian. Constraints (rule=midpoint only,
+// docs/METHOD.md §3): p_k = −D₁L_d − G(q_k)ᵀΛ with g(q_{k+1}) = 0, by
+// integrators/constrained_step.hpp, then p_{k+1} projected onto the tangent space.
 struct Node {
   double a;  // position along the step, in [0, 1]
   double w;  // weight, Σ w = 1
@@ -61,6 +64,7 @@ class DiscreteLagrangianVI final : public Integrator {
       if (node.a > 0.0 && node.a < 1.0) interior_.push_back(node);
     }
     order_ = std::abs(first_moment - 0.5) <= 1e-14 ? 2 : 1;
+    midpoint_ = nodes_.size() == 1 && nodes_[0].a == 0.5;
     symmetric_ = std::all_of(nodes_.begin(), nodes_.end(), [&](const Node& node) {
       return std::any_of(nodes_.begin(), nodes_.end(), [&](const Node& mirror) {
         return std::abs(mirror.a - (1 - node.a)) <= 1e-14 && std::abs(mirror.w - node.w) <= 1e-14;
@@ -72,6 +76,7 @@ class DiscreteLagrangianVI final : public Integrator {
     unsigned flags = kSymplectic | kVariational;
     flags |= interior_.empty() ? kExplicit : (kImplicit | kNeedsHessian);
     if (symmetric_) flags |= kSymmetric;
+    if (midpoint_) flags |= kConstrained;
     return {"del", order_, flags,
             fmt::format("discrete Euler-Lagrange, quadrature L_d ({}), Marsden-West 2001 §2.3, "
                         "§3.2; Kharevych et al. 2006 §3; docs/METHOD.md §1-2",
@@ -148,11 +153,19 @@ class DiscreteLagrangianVI final : public Integrator {
       // The sizes of the terms the residual balances, at the start iterate.
       const double residual_scale =
           state.p.norm() + (constant_ + state.p).norm() + implicit_term_.norm();
-      const NewtonResult result = newton_.solve(system, v, residual_scale);
-      counters_.newton_iters += result.iterations;
-      counters_.linear_solves += result.linear_solves;
-      counters_.factorizations += result.factorizations;
-      if (!result.converged) return StepStatus::failure(result.reason, describe(result));
+      if (problem.has(kConstraints)) {
+        // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
+        const ConstrainedStepResult constrained =
+            solve_constrained_step(problem, q0_, h, system, newton_.options(), residual_scale, v);
+        count_solve(constrained.newton);
+        if (!constrained.newton.converged) {
+          return StepStatus::failure(constrained.newton.reason, describe(constrained));
+        }
+      } else {
+        const NewtonResult result = newton_.solve(system, v, residual_scale);
+        count_solve(result);
+        if (!result.converged) return StepStatus::failure(result.reason, describe(result));
+      }
       implicit_terms(problem, v);  // no-op unless the last evaluation was elsewhere
     }
 
@@ -172,6 +185,8 @@ class DiscreteLagrangianVI final : public Integrator {
     }
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
+    // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
+    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
     state.q = q1;
     state.p = p1;
     state.t += h;
@@ -180,6 +195,12 @@ class DiscreteLagrangianVI final : public Integrator {
   }
 
  private:
+  void count_solve(const NewtonResult& result) {
+    counters_.newton_iters += result.iterations;
+    counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
+  }
+
   ImpulseStep impulse_step() const { return {q0_, t0_, h_, minus_}; }
 
   void start_gradient(const Problem& problem, const Vec& q) {
@@ -221,6 +242,7 @@ class DiscreteLagrangianVI final : public Integrator {
   double end_weight_ = 0.0;     // Σ w over nodes at q_{k+1}
   int order_ = 1;
   bool symmetric_ = false;
+  bool midpoint_ = false;  // the constrained step is enabled (and tested) for the midpoint rule
   Forcing forcing_;
   NewtonSolver newton_;
 

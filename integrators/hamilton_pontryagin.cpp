@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
@@ -53,6 +54,10 @@ namespace {
 // merit). The default (force_slot=split, force_at=midpoint, as in discrete_lagrangian.cpp) is such
 // a case: on a forced problem minimize is a line-searched Newton on R; force_at=node keeps the
 // exact objective.
+//
+// Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
+// G(q_k)ᵀΛ and g(q_k + hv) = 0, solved by integrators/constrained_step.hpp, then p_{k+1}
+// projected onto the tangent space at q_{k+1}.
 class HamiltonPontryagin final : public Integrator {
  public:
   HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, const NewtonOptions& newton)
@@ -65,7 +70,7 @@ class HamiltonPontryagin final : public Integrator {
   MethodInfo info() const override {
     unsigned flags = kSymplectic | kVariational;
     flags |= (alpha_ == 0.0 || alpha_ == 1.0) ? kExplicit : (kImplicit | kNeedsHessian);
-    if (alpha_ == 0.5) flags |= kSymmetric;
+    if (alpha_ == 0.5) flags |= kSymmetric | kConstrained;
     return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
             "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
             "§4; docs/METHOD.md §4"};
@@ -128,6 +133,8 @@ class HamiltonPontryagin final : public Integrator {
     }
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
+    // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
+    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
     state.q = q1;
     state.p = p1;
     state.t += h;
@@ -219,17 +226,31 @@ class HamiltonPontryagin final : public Integrator {
 
     implicit_terms(problem, v);
     const double residual_scale = state.p.norm() + (b_ - state.p).norm() + implicit_term_.norm();
+    if (problem.has(kConstraints)) {
+      // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
+      const ConstrainedStepResult constrained =
+          solve_constrained_step(problem, q0_, h_, system, newton_.options(), residual_scale, v);
+      count_solve(constrained.newton);
+      if (!constrained.newton.converged) return failure(constrained.newton, describe(constrained));
+      return StepStatus::success();
+    }
     const NewtonResult result = newton_.solve(system, v, residual_scale);
+    count_solve(result);
+    if (!result.converged) return failure(result, describe(result));
+    return StepStatus::success();
+  }
+
+  void count_solve(const NewtonResult& result) {
     counters_.newton_iters += result.iterations;
     // A shifted refactorisation costs what a linear solve costs: count it as one.
     counters_.linear_solves += result.linear_solves + result.shift_factorisations;
     counters_.factorizations += result.factorizations;
-    if (!result.converged) {
-      return StepStatus::failure(result.reason,
-                                 fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),
-                                             minimize_ ? "minimize" : "newton", describe(result)));
-    }
-    return StepStatus::success();
+  }
+
+  StepStatus failure(const NewtonResult& result, const std::string& description) const {
+    return StepStatus::failure(result.reason,
+                               fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),
+                                           minimize_ ? "minimize" : "newton", description));
   }
 
   // F(q_k, v) = F(q_k, 0) − C(q_k)v at a test velocity, and C independent of v: the structure

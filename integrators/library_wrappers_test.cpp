@@ -166,6 +166,8 @@ const AdaptiveCase kAdaptiveCases[] = {
     {"gsl_rk4imp", "rtol=1e-12,atol=1e-14"},                        // 8.5e-10 / 1.3e-10
     {"odeint_dopri5", "rtol=1e-11,atol=1e-13"},                     // 6.7e-10 / 2.0e-10
     {"odeint_rosenbrock4", "rtol=1e-10,atol=1e-12"},                // 1.8e-10 / 1.8e-11
+    // Second order: the global error follows rtol itself (h² ~ rtol per step), millions of steps.
+    {"adaptive_verlet", "rtol=1e-10,atol=1e-13,max_steps=20000000"},  // 2.5e-9 / 1.1e-10
 };
 
 // gtest prints parameters in failure messages; without this an AdaptiveCase is a byte dump.
@@ -274,7 +276,8 @@ TEST_P(AdaptiveWrapper, ProblemExceptionBecomesAFailedStatus) {
                                       : name.rfind("ida", 0) == 0    ? "ida_flag_-"
                                       : name.rfind("arkode", 0) == 0 ? "arkode_flag_-"
                                       : name.rfind("gsl", 0) == 0    ? "gsl_status_"
-                                                                     : "odeint_exception";
+                                      : name.rfind("odeint", 0) == 0 ? "odeint_exception"
+                                                                     : "exception";
   EXPECT_EQ(run.status.reason.rfind(expected_prefix, 0), 0u) << run.status.reason;
   EXPECT_NE(run.status.message.find("cliff reached"), std::string::npos) << run.status.message;
   // It stepped up to the cliff (q = sin t = 0.9 at t ≈ 1.12) and not past it; a stage of the
@@ -593,6 +596,7 @@ TEST(Registry, LibraryWrappersDeclareOrderAndFlags) {
            Expected{"odeint_rosenbrock4", 4, implicit_adaptive | kNeedsHessian},
            Expected{"odeint_velocity_verlet", 2, kExplicit | kSymplectic | kSymmetric},
            Expected{"odeint_mclachlan4", 4, kExplicit | kSymplectic | kSymmetric},
+           Expected{"adaptive_verlet", 2, kExplicit | kAdaptive},
        }) {
     const MethodInfo info = make_integrator(e.spec)->info();
     EXPECT_EQ(info.order, e.order) << e.spec;

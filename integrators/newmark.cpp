@@ -1,10 +1,15 @@
-// Newmark family (Kane, Marsden, Ortiz & West, IJNME 2000; docs/METHOD.md §1 and §7):
-//   q₁ = q₀ + h v₀ + h²[(½−β)a₀ + βa₁],   v₁ = v₀ + h[(1−γ)a₀ + γa₁],   M a = −∇V(q) + F(q, v, t).
-// β = 0, γ = ½ is Störmer–Verlet; β > 0 is symplectic only for a non-canonical form (not declared).
+// Newmark family (Kane, Marsden, Ortiz & West, IJNME 2000; docs/METHOD.md §1 and §7) and its
+// α-generalisations HHT (Hilber, Hughes & Taylor 1977) and generalized-α (Chung & Hulbert 1993):
+//   q₁ = q₀ + h v₀ + h²[(½−β)a₀ + βa₁],   v₁ = v₀ + h[(1−γ)a₀ + γa₁],
+//   M[(1−α_m)a₁ + α_m a₀] = (1−α_f) f(q₁, v₁, t₁) + α_f f(q₀, v₀, t₀),   f = −∇V(q) + F(q, v, t).
+// α_m = α_f = 0 is Newmark (M a = f at every step point); β = 0, γ = ½ is Störmer–Verlet; β > 0 is
+// symplectic only for a non-canonical form (not declared).
 #include <fmt/format.h>
 
 #include <cmath>
 #include <optional>
+#include <string>
+#include <utility>
 
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
@@ -15,8 +20,8 @@ namespace {
 
 // Unknown a₁, residual in momentum units so the relative tolerance means what it means for the
 // variational integrators:
-//   R(a₁) = h[M a₁ + ∇V(q₁(a₁)) − F(q₁, v₁(a₁), t + h)],
-//   ∂R/∂a₁ = h[M + βh²∇²V(q₁) + γh C(q₁, v₁)],   C = −∂F/∂v
+//   R(a₁) = h[(1−α_m)M a₁ + α_m M a₀ − (1−α_f) f(q₁(a₁), v₁(a₁), t + h) − α_f f₀],
+//   ∂R/∂a₁ = h[(1−α_m)M + (1−α_f)(βh²∇²V(q₁) + γh C(q₁, v₁))],   C = −∂F/∂v
 // (the βh² ∂F/∂q part is left out, as in implicit_euler: only the Newton matrix is approximate;
 // without force_jacobian_v the force's a₁-derivative is differenced). Start a₁ = a₀.
 //
@@ -27,30 +32,50 @@ namespace {
 // a₀ is cached between steps (first same as last: a₁ of one step is a₀ of the next). The cache is
 // used only when the incoming (t, q, p) is bitwise the state it was computed for and the problem
 // is the same object, so a caller that edits the state between steps gets a fresh a₀.
+//
+// For HHT and generalized-α (α_m or α_f ≠ 0) a₁ is an algorithmic acceleration, not M⁻¹f(q₁):
+// the method is a one-step map on (q, v, a), and State (t, q, p) does not carry a. The cache
+// carries it between steps, as a multistep method carries its history; a start (reset, or an
+// edited state) takes the consistent acceleration a₀ = M⁻¹f(q₀, v₀, t₀), the start Chung &
+// Hulbert (1993, §2) and Hilber et al. analyse. Recomputing the consistent a₀ at every step
+// instead would be a different two-term method whose high-frequency damping is not the
+// requested ρ∞ (integrators/structural_alpha_test.cpp measures both, README "Methods").
+// At α_m = α_f (γ = ½: HHT α = 0, generalized-α ρ∞ = 1) a consistent start stays consistent,
+// the scheme is Newmark's trapezoidal rule and kSymmetric is declared.
 class Newmark final : public Integrator {
  public:
-  Newmark(double beta, double gamma, const NewtonOptions& newton)
-      : beta_(beta), gamma_(gamma), newton_(newton) {
+  // α-generalisation of Newmark (α_m = α_f = 0); `second_order` is the caller's γ = ½ − α_m + α_f,
+  // decided where γ is computed so that no floating-point comparison decides the declared order.
+  struct Alpha {
+    std::string name = "newmark";
+    double alpha_m = 0.0, alpha_f = 0.0;
+    bool second_order = false;
+    std::string reference = "Newmark, Kane-Marsden-Ortiz-West IJNME 2000; docs/METHOD.md §1, §7";
+  };
+  Newmark(double beta, double gamma, const NewtonOptions& newton, Alpha alpha)
+      : beta_(beta), gamma_(gamma), newton_(newton), alpha_(std::move(alpha)) {
     newton_.options().polish = true;  // invariants to round-off, not to the tolerance
   }
 
   MethodInfo info() const override {
-    const bool second_order = gamma_ == 0.5;
+    const bool second_order = alpha_.second_order;
     unsigned flags = 0;
     if (beta_ == 0.0) {
       flags = kExplicit;
       if (second_order) flags |= kSymplectic | kSymmetric | kVariational;  // Störmer–Verlet
     } else {
       flags = kImplicit | kNeedsHessian;
-      if (second_order) flags |= kSymmetric;
+      if (gamma_ == 0.5 && alpha_.alpha_m == alpha_.alpha_f) flags |= kSymmetric;
     }
-    return {"newmark", second_order ? 2 : 1, flags,
-            "Newmark, Kane-Marsden-Ortiz-West IJNME 2000; docs/METHOD.md §1, §7"};
+    return {alpha_.name, second_order ? 2 : 1, flags, alpha_.reference};
   }
 
   StabilityPrediction predicted_linear_stability() const override {
     // Undamped Newmark on ẍ = −ω²x (Hughes 2000, §9.1.2): unconditionally stable for
     // 2β ≥ γ ≥ ½, otherwise for γ ≥ ½ stable iff hω < 1/√(γ/2 − β); γ < ½ amplifies every mode.
+    // HHT (α ∈ [−⅓, 0]) and generalized-α (ρ∞ ∈ [0, 1]) are unconditionally stable (Hilber et al.
+    // 1977; Chung & Hulbert 1993, §3): every parameter the factories accept is in that range.
+    if (alpha_.alpha_m != 0.0 || alpha_.alpha_f != 0.0) return StabilityPrediction::unconditional();
     if (gamma_ < 0.5) return StabilityPrediction::limit(0.0);
     if (2 * beta_ >= gamma_) return StabilityPrediction::unconditional();
     return StabilityPrediction::limit(1.0 / std::sqrt(gamma_ / 2 - beta_));
@@ -76,12 +101,19 @@ class Newmark final : public Integrator {
     const bool forced = problem.has(kForce);
     const double t1 = state.t + h;
     const Vec v0 = inverse_mass.cwiseProduct(state.p);
+    const double alpha_m = alpha_.alpha_m, alpha_f = alpha_.alpha_f;
+    // The a₁-independent part of the balance: α_m M a₀ − α_f f₀.
+    Vec old_balance = (alpha_m * mass).cwiseProduct(a0_);
+    if (alpha_f != 0.0) {
+      eval_total_force(problem, state.q, v0, state.t, total_);
+      old_balance -= alpha_f * total_;
+    }
     // The a₁-independent parts of q₁ and v₁.
     const Vec q_predict = state.q + h * v0 + (h * h * (0.5 - beta_)) * a0_;
     const Vec v_predict = v0 + (h * (1 - gamma_)) * a0_;
 
     Vec a1 = a0_;
-    if (beta_ == 0.0 && !forced) {
+    if (beta_ == 0.0 && !forced && alpha_m == 0.0 && alpha_f == 0.0) {
       // Explicit: q₁ does not depend on a₁.
       eval_gradient(problem, q_predict, gradient_);
       a1 = -inverse_mass.cwiseProduct(gradient_);
@@ -104,14 +136,15 @@ class Newmark final : public Integrator {
       system.inner_term_scale = [&] { return inner_scale; };
       system.residual = [&](const Vec& a, Vec& residual) {
         total_force(a, total_);
-        residual = h * (mass.cwiseProduct(a) - total_);
+        residual =
+            h * ((1 - alpha_m) * mass.cwiseProduct(a) - (1 - alpha_f) * total_ + old_balance);
       };
       system.jacobian = [&](const Vec& a, SparseMatrix& jacobian) {
-        jacobian = mass_matrix_;
+        jacobian = ((1 - alpha_m) / (1 - alpha_f)) * mass_matrix_;
         const Vec q1 = q_predict + (h * h * beta_) * a;
         if (beta_ != 0.0) {
           eval_hessian(problem, q1, hessian_);
-          inner_scale = std::abs(h) * gradient_term_scale(hessian_, q1);
+          inner_scale = std::abs(h) * (1 - alpha_f) * gradient_term_scale(hessian_, q1);
           jacobian += (beta_ * h * h) * hessian_;
         }
         if (forced) {
@@ -130,7 +163,7 @@ class Newmark final : public Integrator {
             counters_.force_evals += 2 * a.size();
           }
         }
-        jacobian *= h;
+        jacobian *= h * (1 - alpha_f);
       };
       system.symmetric = !forced || (problem.has(kForceJacobian) && *damping_symmetric_);
       // total_ holds the force at q₁(a₀) after the first residual: h‖M a‖ and h‖∇V‖ are the
@@ -173,6 +206,7 @@ class Newmark final : public Integrator {
   double beta_;
   double gamma_;
   NewtonSolver newton_;
+  Alpha alpha_;
   Vec a0_;  // acceleration at the cached state
   const Problem* cached_problem_ = nullptr;
   double cached_t_ = 0.0;
@@ -193,7 +227,43 @@ std::unique_ptr<Integrator> make_newmark(Params& params) {
       "gamma", 0.5, "velocity weight gamma (1/2: second order, no numerical damping)",
       [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
   const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
-  return std::make_unique<Newmark>(beta, gamma, newton);
+  Newmark::Alpha plain;
+  plain.second_order = gamma == 0.5;
+  return std::make_unique<Newmark>(beta, gamma, newton, plain);
+}
+
+// HHT-α in Chung & Hulbert's notation: α_m = 0, α_f = −α, β = (1−α)²/4, γ = ½ − α; the
+// high-frequency spectral radius is ρ∞ = (1+α)/(1−α).
+std::unique_ptr<Integrator> make_hht(Params& params) {
+  const double alpha = params.real(
+      "alpha", -0.05,
+      "HHT alpha in [-1/3, 0] (0: trapezoidal Newmark; rho_inf = (1+alpha)/(1-alpha))",
+      [](double x) { return x >= -1.0 / 3.0 && x <= 0.0; }, "in [-1/3, 0]");
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
+  Newmark::Alpha hht;
+  hht.name = "hht";
+  hht.alpha_f = -alpha;
+  hht.second_order = true;  // γ = ½ − α_m + α_f by construction
+  hht.reference = "Hilber-Hughes-Taylor, EESD 1977; docs/METHOD.md §1, §7";
+  return std::make_unique<Newmark>((1 - alpha) * (1 - alpha) / 4, 0.5 - alpha, newton, hht);
+}
+
+// Generalized-α (Chung & Hulbert, J. Appl. Mech. 1993, eqs. 25 and 17–18): the parameters that
+// put all three roots of the amplification matrix at −ρ∞ for hω → ∞ with second order.
+std::unique_ptr<Integrator> make_generalized_alpha(Params& params) {
+  const double rho = params.real(
+      "rho_inf", 0.8, "spectral radius at h*omega -> infinity, in [0, 1] (1: trapezoidal Newmark)",
+      [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+  const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
+  Newmark::Alpha alpha;
+  alpha.name = "generalized_alpha";
+  alpha.alpha_m = (2 * rho - 1) / (rho + 1);
+  alpha.alpha_f = rho / (rho + 1);
+  alpha.second_order = true;  // γ = ½ − α_m + α_f by construction
+  alpha.reference = "generalized-alpha, Chung-Hulbert J. Appl. Mech. 1993; docs/METHOD.md §1, §7";
+  const double sum = 1 - alpha.alpha_m + alpha.alpha_f;
+  return std::make_unique<Newmark>(sum * sum / 4, 0.5 - alpha.alpha_m + alpha.alpha_f, newton,
+                                   alpha);
 }
 
 }  // namespace geomint

@@ -29,6 +29,13 @@ namespace {
 // sequence is unchanged (the next λ absorbs the normal part of p), but the reported p leaves the
 // tangent space at O(h) — the negative control of the velocity-level constraint metric.
 //
+// Rheonomic constraints g(q, t) = 0 (car_axis; kRheonomic) are the same map in the extended
+// configuration (q, t) with t advanced exactly (Jay 1996; GNI §VII.1.4 with t as a coordinate):
+// G at each end is taken at that end's time, the position constraint is g(q⁺, t + h) = 0 and the
+// velocity one G(q⁺, t + h) M⁻¹p⁺ + ∂g/∂t(q⁺, t + h) = 0. The step stays symmetric, so the
+// compositions over it keep their orders. Time-free problems take the time-free calls, so their
+// results stay bit-identical.
+//
 // The m × m systems are dense: every catalogue problem has a few constraints (rods, pins), and
 // for them a dense LU/LDLᵀ costs less than a sparse analysis per step.
 class Rattle final : public Integrator {
@@ -41,7 +48,8 @@ class Rattle final : public Integrator {
     // and the map leaves the cotangent bundle, so neither symplectic nor symmetric.
     const unsigned geometric = kSymplectic | kSymmetric | kVariational;
     return {"rattle", velocity_projection_ ? 2 : 1,
-            kExplicit | kConstrained | kConstraintsOnly | (velocity_projection_ ? geometric : 0u),
+            kExplicit | kConstrained | kConstraintsOnly | kRheonomic |
+                (velocity_projection_ ? geometric : 0u),
             "RATTLE (Andersen 1983), GNI §VII.1.4; docs/METHOD.md §3"};
   }
 
@@ -57,7 +65,13 @@ class Rattle final : public Integrator {
     eval_total_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
     Vec p_half = state.p + (h / 2) * force_;
     const Vec q_start = state.q;
-    problem.constraint_jacobian(q_start, G_start_);
+    const bool rheonomic = problem.has(kTimeDependentConstraints);
+    const double t_next = state.t + h;
+    if (rheonomic) {
+      problem.constraint_jacobian_at(state.t, q_start, G_start_);
+    } else {
+      problem.constraint_jacobian(q_start, G_start_);
+    }
     // M⁻¹G(q)ᵀ: the direction in which each position multiplier moves q⁺.
     const Eigen::MatrixXd direction =
         inverse_mass.asDiagonal() * Eigen::MatrixXd(G_start_).transpose();
@@ -65,8 +79,13 @@ class Rattle final : public Integrator {
     Vec Lambda = Vec::Zero(G_start_.rows());
     Vec residual;
     for (long iteration = 0;; ++iteration) {
-      problem.constraint(q_next, residual);
-      problem.constraint_jacobian(q_next, G_next_);
+      if (rheonomic) {
+        problem.constraint_at(t_next, q_next, residual);
+        problem.constraint_jacobian_at(t_next, q_next, G_next_);
+      } else {
+        problem.constraint(q_next, residual);
+        problem.constraint_jacobian(q_next, G_next_);
+      }
       if (!residual.allFinite() || !q_next.allFinite()) {
         return StepStatus::failure(
             "nan", fmt::format("rattle: non-finite constraint residual in the step from t={:.17g}",
@@ -101,7 +120,14 @@ class Rattle final : public Integrator {
       // space (ν = (h/2)μ). G M⁻¹ Gᵀ is SPD for independent constraints.
       const Eigen::MatrixXd G = Eigen::MatrixXd(G_next_);
       const Eigen::MatrixXd G_Minv = G * inverse_mass.asDiagonal();
-      const Vec nu = (G_Minv * G.transpose()).ldlt().solve(G_Minv * state.p);
+      Vec rate = G_Minv * state.p;
+      if (rheonomic) {
+        Vec g_t, a_t;
+        problem.constraint_time_terms(state.t, state.q, inverse_mass.cwiseProduct(state.p), g_t,
+                                      a_t);
+        rate += g_t;  // G M⁻¹p⁺ + ∂g/∂t = 0 at t + h
+      }
+      const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);
       state.p -= G.transpose() * nu;
       ++counters_.linear_solves;
       ++counters_.factorizations;

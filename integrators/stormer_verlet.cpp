@@ -52,8 +52,16 @@ void fixed_size_loop(const Gradient& gradient, const Vec& inverse_mass, const St
 // carries the gradient from step to step itself; without a visitor (the harness's timing pass), on
 // problems that offer a fixed gradient, it runs the unforced loop on fixed-size vectors with the
 // gradient inlined.
+//
+// `compensated=true` (GNI §VIII.5, Kahan's compensated summation): the same step written as
+// increments δq = h M⁻¹p½ and δp = (h/2)(f(q) + f(q⁺)), each added to the state with the lost
+// low-order bits carried in error_q_/error_p_ to the next step, so that round-off in the sum
+// q + δq stops growing like √N (Brouwer's law). The carried errors belong to the run: a state
+// edited between steps (the cache check on q and p) starts them again from zero.
 class StormerVerlet final : public Integrator {
  public:
+  explicit StormerVerlet(bool compensated) : compensated_(compensated) {}
+
   MethodInfo info() const override {
     return {"stormer_verlet", 2, kExplicit | kSymplectic | kSymmetric | kVariational,
             "Stormer-Verlet (velocity Verlet), GNI §I.1.4, §VI.3; docs/METHOD.md §1"};
@@ -70,7 +78,9 @@ class StormerVerlet final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     const bool cache_hit = prime_gradient(problem, state);
-    if (problem.has(kForce)) {
+    if (compensated_) {
+      compensated_step(problem, state, h, cache_hit);
+    } else if (problem.has(kForce)) {
       forced_step(problem, state, h, cache_hit);
     } else {
       kick_drift_kick(state.q, state.p, gradient_, problem.inverse_mass(), h, counted(problem));
@@ -84,6 +94,16 @@ class StormerVerlet final : public Integrator {
   AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
                          StepVisitor visit) override {
     AdvanceOutcome outcome;
+    if (compensated_) {
+      bool cache_hit = prime_gradient(problem, state);
+      outcome = run_grid(state, grid, visit, [&](double h) {
+        compensated_step(problem, state, h, cache_hit);
+        cache_hit = true;
+        ++counters_.steps;
+      });
+      remember(problem, state);
+      return outcome;
+    }
     if (problem.has(kForce)) {
       bool cache_hit = prime_gradient(problem, state);
       outcome = run_grid(state, grid, visit, [&](double h) {
@@ -118,11 +138,53 @@ class StormerVerlet final : public Integrator {
     const bool cache_hit =
         cached_problem_ == &problem && cached_q_.size() == state.q.size() && cached_q_ == state.q;
     if (!cache_hit) eval_gradient(problem, state.q, gradient_);
+    if (compensated_ && !(cache_hit && cached_p_ == state.p)) {
+      error_q_ = Vec::Zero(state.q.size());
+      error_p_ = Vec::Zero(state.p.size());
+    }
     return cache_hit;
   }
   void remember(const Problem& problem, const State& state) {
     cached_problem_ = &problem;
     cached_q_ = state.q;
+    if (compensated_) cached_p_ = state.p;
+  }
+
+  // y ← y + δ with Kahan's compensation e (GNI §VIII.5, Algorithm 5.1): a = δ + e, y⁺ = y + a,
+  // e = (y − y⁺) + a. Needs IEEE evaluation order (no -ffast-math, as the build guarantees).
+  static void compensated_add(Vec& y, const Vec& increment, Vec& error) {
+    for (Eigen::Index i = 0; i < y.size(); ++i) {
+      const double a = increment[i] + error[i];
+      const double sum = y[i] + a;
+      error[i] = (y[i] - sum) + a;
+      y[i] = sum;
+    }
+  }
+
+  // One kick–drift–kick as increments (gradient_ = ∇V(q) on entry, ∇V(q⁺) on exit); forces as
+  // in forced_step.
+  void compensated_step(const Problem& problem, State& state, double h, bool cache_hit) {
+    const Vec& inverse_mass = problem.inverse_mass();
+    const bool forced = problem.has(kForce);
+    increment_p_ = -(h / 2) * gradient_;
+    if (forced) {
+      velocity_ = inverse_mass.cwiseProduct(state.p);
+      eval_force(problem, state.q, velocity_, state.t, force_);
+      if (cache_hit) ++counters_.force_evals;
+      increment_p_ += (h / 2) * force_;
+    }
+    half_p_ = state.p + increment_p_;
+    increment_q_ = h * inverse_mass.cwiseProduct(half_p_);
+    compensated_add(state.q, increment_q_, error_q_);
+    state.t += h;
+    eval_gradient(problem, state.q, gradient_);
+    increment_p_ -= (h / 2) * gradient_;
+    if (forced) {
+      velocity_ = inverse_mass.cwiseProduct(half_p_);
+      eval_force(problem, state.q, velocity_, state.t, force_);
+      increment_p_ += (h / 2) * force_;
+    }
+    compensated_add(state.p, increment_p_, error_p_);
   }
   // ∇V through eval_gradient, so that the dynamic loops count their evaluations.
   struct CountedGradient {
@@ -150,15 +212,22 @@ class StormerVerlet final : public Integrator {
     state.p -= (h / 2) * gradient_;
   }
 
+  const bool compensated_;
   const Problem* cached_problem_ = nullptr;
   Vec cached_q_;  // q at which gradient_ = ∇V(q) was evaluated
+  Vec cached_p_;  // p after the last compensated step (its errors belong to that state)
   Vec gradient_, force_, velocity_;
+  Vec error_q_, error_p_, increment_q_, increment_p_, half_p_;  // compensated summation
 };
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_stormer_verlet(Params&) {
-  return std::make_unique<StormerVerlet>();
+std::unique_ptr<Integrator> make_stormer_verlet(Params& params) {
+  const bool compensated = params.flag(
+      "compensated", false,
+      "add the step's increments to q and p with Kahan's compensated summation (GNI §VIII.5)");
+  params.omit_default_from_canonical("compensated");
+  return std::make_unique<StormerVerlet>(compensated);
 }
 
 }  // namespace geomint

@@ -36,13 +36,23 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 enum class Material { kStvk, kNeoHookean };
 enum class Init { kRest, kTwist, kBend, kVelocity };
+// left: the face x = 0 removed from the dofs; none: free; constraint: that face kept as dofs and
+// pinned by q_i − X_i = 0 (PAPER.md §3, docs/METHOD.md §3); pin: only the corner node at the
+// origin pinned that way, so the angular momentum about it stays a conserved quantity.
+enum class Clamp { kLeft, kNone, kFaceConstraint, kPinConstraint };
 
 struct BarConfig {
   int nx = 8, ny = 2, nz = 2;
   double length = 1, width = 0.2, height = 0.2;
   Material material = Material::kNeoHookean;
   double young = 1e5, poisson = 0.3, density = 1000;
-  bool clamp_left = true;
+  Clamp clamp = Clamp::kLeft;
+  bool clamp_left() const { return clamp == Clamp::kLeft; }
+  bool pinned_by_constraint() const {
+    return clamp == Clamp::kFaceConstraint || clamp == Clamp::kPinConstraint;
+  }
+  // Whether the motion is held at the face x = 0 (removed or constrained).
+  bool face_held() const { return clamp == Clamp::kLeft || clamp == Clamp::kFaceConstraint; }
   double gravity = 9.81;
   double damping = 0;  // ν
   Init init = Init::kRest;
@@ -198,7 +208,12 @@ class ElasticBar final : public Problem {
     if (config_.damping > 0) capabilities |= kForce | kForceJacobian;
     // Internal forces are sums over elements of functions of F, invariant under rigid motions;
     // only the clamp and gravity break the symmetry, and the factory forbids gravity unclamped.
-    if (!config_.clamp_left) capabilities |= kLinearMomentum | kAngularMomentum;
+    if (config_.clamp == Clamp::kNone) capabilities |= kLinearMomentum | kAngularMomentum;
+    // A pin at the origin exerts no torque about it: Σ q_i × p_i is conserved without gravity.
+    if (config_.clamp == Clamp::kPinConstraint && config_.gravity == 0) {
+      capabilities |= kAngularMomentum;
+    }
+    if (config_.pinned_by_constraint()) capabilities |= kConstraints;
     set_capabilities(capabilities);
     set_defaults(1e-3, 1.0);
     build_initial_state();
@@ -303,6 +318,43 @@ class ElasticBar final : public Problem {
       total += Vec3(q.segment<3>(i)).cross(Vec3(p.segment<3>(i)));
     }
     return total;
+  }
+
+  // Pins q_i − X_i = 0, three rows per pinned node: G is a selection matrix, so the curvature
+  // and the constraint Hessian vanish; the multipliers are the reaction forces on the pinned
+  // nodes (with a minus sign: M q̈ = −∇V − Gᵀλ).
+  int constraint_count() const override { return 3 * static_cast<int>(pinned_dofs_.size()); }
+  void constraint(const Vec& q, Vec& g) const override {
+    g.resize(constraint_count());
+    for (std::size_t k = 0; k < pinned_dofs_.size(); ++k) {
+      const int d = pinned_dofs_[k];
+      g.segment<3>(3 * static_cast<Eigen::Index>(k)) = q.segment<3>(d) - rest_q_.segment<3>(d);
+    }
+  }
+  void constraint_jacobian(const Vec&, SparseMatrix& G) const override {
+    G.resize(constraint_count(), dof());
+    G.setZero();
+    for (std::size_t k = 0; k < pinned_dofs_.size(); ++k) {
+      for (int axis = 0; axis < 3; ++axis) {
+        G.insert(3 * static_cast<Eigen::Index>(k) + axis, pinned_dofs_[k] + axis) = 1;
+      }
+    }
+    G.makeCompressed();
+  }
+  void constraint_curvature(const Vec&, const Vec&, Vec& c) const override {
+    c = Vec::Zero(constraint_count());
+  }
+  void constraint_hessian(const Vec&, const Vec&, SparseMatrix& K) const override {
+    K.resize(dof(), dof());
+    K.setZero();
+  }
+  std::vector<std::string> multiplier_names() const override {
+    std::vector<std::string> names;
+    for (int node : pinned_nodes_) {
+      for (const char* axis : {"x", "y", "z"})
+        names.push_back(fmt::format("reaction{}_{}", node, axis));
+    }
+    return names;
   }
 
   // Element-by-element bound (Irons–Treharne): with the lumped M = Σ_e M_e, the Rayleigh quotient
@@ -495,11 +547,18 @@ class ElasticBar final : public Problem {
     std::vector<int> node_dof(nodes, -1);
     for (int iz = 0; iz <= nz; ++iz) {
       for (int iy = 0; iy <= ny; ++iy) {
-        for (int ix = config_.clamp_left ? 1 : 0; ix <= nx; ++ix) {
+        for (int ix = config_.clamp_left() ? 1 : 0; ix <= nx; ++ix) {
           const int node = node_index(ix, iy, iz);
           node_dof[node] = 3 * static_cast<int>(free_node_.size());
           free_node_.push_back(node);
           if (ix == nx) tip_dofs_.push_back(node_dof[node]);
+          const bool pinned = config_.clamp == Clamp::kFaceConstraint
+                                  ? ix == 0
+                                  : config_.clamp == Clamp::kPinConstraint && node == 0;
+          if (pinned) {
+            pinned_nodes_.push_back(node);
+            pinned_dofs_.push_back(node_dof[node]);
+          }
         }
       }
     }
@@ -570,7 +629,9 @@ class ElasticBar final : public Problem {
     initial_.p = Vec::Zero(dof());
     // Spin about the bar's centre when free, about the clamped face's centre when clamped; the
     // tilted axis (1, 1, 1)/√3 exercises every angular momentum component.
-    const Vec3 centre = config_.clamp_left ? axis_point : axis_point + Vec3(0.5 * L, 0, 0);
+    const Vec3 centre = config_.face_held()                      ? axis_point
+                        : config_.clamp == Clamp::kPinConstraint ? Vec3::Zero().eval()
+                                                                 : axis_point + Vec3(0.5 * L, 0, 0);
     const Vec3 omega = config_.spin / std::sqrt(3.0) * Vec3::Ones();
     for (int i = 0; i < dof(); i += 3) {
       const Vec3 X = rest_q_.segment<3>(i);
@@ -597,15 +658,19 @@ class ElasticBar final : public Problem {
         }
       }
     }
+    // Consistent start (g = 0, G v = 0): pinned nodes at rest where they are pinned. Every
+    // init leaves the face x = 0 in place; only the spin moves it.
+    for (int d : pinned_dofs_) initial_.p.segment<3>(d).setZero();
   }
 
   BarConfig config_;
   double mu_, lambda_;
   std::vector<Tet> tets_;
-  std::vector<int> free_node_;  // free index → mesh node
-  std::vector<int> tip_dofs_;   // first dof of each node on the face x = length
-  Vec rest_q_;                  // rest positions of the free nodes, laid out like q
-  SparseMatrix pattern_;        // structure of K with zero values
+  std::vector<int> free_node_;                   // free index → mesh node
+  std::vector<int> tip_dofs_;                    // first dof of each node on the face x = length
+  std::vector<int> pinned_nodes_, pinned_dofs_;  // nodes held by constraints, their first dof
+  Vec rest_q_;            // rest positions of the free nodes, laid out like q
+  SparseMatrix pattern_;  // structure of K with zero values
   State initial_;
 };
 
@@ -643,15 +708,21 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
   config.poisson = params.real(
       "poisson", 0.3, "Poisson's ratio", [](double x) { return x >= 0 && x < 0.5; }, "in [0, 0.5)");
   config.density = params.real("density", 1000.0, "mass density rho", positive, "> 0");
-  config.clamp_left = params.choice("clamp", "left", {"left", "none"},
-                                    "left: nodes at x = 0 fixed; none: free") == "left";
+  const std::string clamp = params.choice(
+      "clamp", "left", {"left", "none", "constraint", "pin"},
+      "left: nodes at x = 0 fixed (removed); none: free; constraint: nodes at x = 0 pinned by "
+      "constraints q - X = 0; pin: the corner node at the origin pinned by constraints");
+  config.clamp = clamp == "left"         ? Clamp::kLeft
+                 : clamp == "none"       ? Clamp::kNone
+                 : clamp == "constraint" ? Clamp::kFaceConstraint
+                                         : Clamp::kPinConstraint;
   // Gravity breaks translation invariance, so a free bar gets none (its default is 0) and asking
   // for it is an error rather than a silent loss of the momentum checks.
   config.gravity = params.real(
-      "gravity", config.clamp_left ? 9.81 : 0.0,
-      "gravitational acceleration along -z (default 9.81 clamped, 0 free)",
+      "gravity", config.face_held() ? 9.81 : 0.0,
+      "gravitational acceleration along -z (default 9.81 with a held face, 0 free or pinned)",
       [](double x) { return std::isfinite(x); }, "finite");
-  if (!config.clamp_left && config.gravity != 0) {
+  if (config.clamp == Clamp::kNone && config.gravity != 0) {
     throw InputError(fmt::format(
         "problem 'elastic_bar': parameter gravity={} needs clamp=left (a free bar under gravity "
         "conserves no momentum; use gravity=0 with clamp=none)",
@@ -659,7 +730,7 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
   }
   config.damping =
       params.real("damping", 0.0, "strain-rate damping nu (time units)", non_negative, ">= 0");
-  const std::string init = params.choice("init", config.clamp_left ? "rest" : "velocity",
+  const std::string init = params.choice("init", config.face_held() ? "rest" : "velocity",
                                          {"rest", "twist", "bend", "velocity"},
                                          "initial condition (default rest clamped, velocity free)");
   config.init = init == "rest"    ? Init::kRest

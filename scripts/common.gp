@@ -10,8 +10,8 @@ set grid lw 0.5 lc rgb "#dddddd"
 # the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
 # ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not
 # be prefixes of one another. Line style i is the i-th key; 30 is any method not listed.
-method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3"
-method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3"
+method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake"
+method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection)"
 method_index(name) = sum [i=1:words(method_keys)] (strstrt(name, word(method_keys, i)) == 1 ? i : 0)
 ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 30)
 mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(method_titles, method_found) : name)
@@ -35,6 +35,16 @@ set style line 17 lw 2 lc rgb "#5b2c6f" pt 5  ps 0.8 dt (2,2) # composition_kaha
 set style line 18 lw 2 lc rgb "#637939" pt 4  ps 1.0 dt (8,3) # gauss_s2: dark olive, open square, long dashes
 set style line 19 lw 2 lc rgb "#31a354" pt 6  ps 1.0 dt (8,3) # gauss_s3: mid green, open circle, long dashes
 set style line 20 lw 2 lc rgb "#d6616b" pt 8  ps 1.0 dt (8,3) # lobatto3ab_s3: salmon, open triangle, long dashes
+# Constrained methods (results/constraints): the constrained families share a hue with their
+# unconstrained counterparts' neighbours but not their markers.
+set style line 21 lw 2 lc rgb "#ff7f0e" pt 6  ps 1.3          # rattle: orange (Verlet's), open circle
+set style line 22 lw 2 lc rgb "#a55194" pt 6  ps 0.9 dt (2,2) # composition_rattle_yoshida4: plum, open circle, dotted
+set style line 23 lw 2 lc rgb "#2b8cbe" pt 12 ps 1.1 dt (4,2) # composition_rattle_kahan_li6: steel blue, open diamond, dashed
+set style line 24 lw 2 lc rgb "#5b2c6f" pt 4  ps 0.9 dt (2,2) # composition_rattle_kahan_li8: dark plum, open square, dotted
+set style line 25 lw 2 lc rgb "#7f7f7f" pt 1  ps 1.5          # ida_index_2: grey, plus
+set style line 26 lw 2 lc rgb "#1f77b4" pt 2  ps 1.3 dt (5,3) # ida_index_3: blue, cross, dashed
+set style line 27 lw 2 lc rgb "#d62728" pt 9  ps 1.2          # penalty: red, filled triangle
+set style line 28 lw 2 lc rgb "#2ca02c" pt 11 ps 1.2 dt (5,3) # shake (rattle without velocity projection): green, dashed
 set style line 30 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
 # Curves that are not methods (a parameter family, step sizes, energies of one method, bodies):
 # an ordered dark-to-light palette, styles 41-48, so they cannot be mistaken for a method.

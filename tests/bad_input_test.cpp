@@ -169,6 +169,9 @@ const std::vector<Case>& cases() {
       {"DivergeFactorNan",
        "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --diverge-factor nan", 2,
        "--diverge-factor"},
+      // --- optional metrics ---
+      {"MetricUnknown", "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --metric foo", 2,
+       "unknown metric 'foo'"},
       // --- outputs: collisions and unwritable targets, reported before any computing (the runs
       // below would take far longer than the timeout if they were computed first) ---
       {"SeriesIsOut",

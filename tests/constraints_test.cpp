@@ -128,6 +128,9 @@ TEST_P(ConstrainedPair, KeepsTheConstraintToRoundOff) {
 TEST_P(ConstrainedPair, SymplecticMeansNoEnergyDrift) {
   const auto& [method, problem] = GetParam();
   if (!(make_integrator(method)->info().flags & kSymplectic)) GTEST_SKIP() << "not symplectic";
+  // A driven problem (car_axis: a moving constraint and a time-dependent spring) exchanges
+  // energy with its driver, so there is no conserved energy to keep.
+  if (make_problem(problem)->has(kForce)) GTEST_SKIP() << "driven: energy not conserved";
   // 100 steps per unit (the default step) over 300 units: on the chaotic chains the energy error
   // is then an oscillation of ~1e-3 with no trend; the conical motion's is at round-off, where
   // only a random walk remains, so the drift is compared with at least 1e-11.
