@@ -7,7 +7,7 @@ SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
         format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables \
-        test-cluster
+        test-cluster test-external
 
 all: build
 
@@ -22,10 +22,15 @@ build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 # Fast suites (< 10 minutes on 2 cores; long runs carry the CTest label "slow"), then what a
-# user's CI does: the CI-sized scenes, gated.
+# user's CI does: the CI-sized scenes, gated; then geomint installed into a temporary prefix and
+# examples/external_method built and tested against it (README "Verify your own integrator").
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
+	@$(MAKE) --no-print-directory test-external
+
+test-external: build
+	@JOBS=$(JOBS) bash scripts/test-external.sh $(BUILD_DIR)
 
 # Sweeps on a real Slurm (README "Running on a cluster"): as root, installs slurmctld, slurmd and
 # munge, starts them on this machine, runs a scene through `geomint slurm --submit` in 8 shards,

@@ -13,14 +13,36 @@ namespace geomint {
 #include "integrators/registry.def"
 #undef GEOMINT_METHOD
 
-const std::vector<IntegratorEntry>& integrator_registry() {
-  static const std::vector<IntegratorEntry> entries = {
+namespace {
+// A function-local static, so register_method() called from another translation unit's static
+// initialiser (MethodRegistrar) finds the built-in entries already in place.
+std::vector<IntegratorEntry>& mutable_integrator_registry() {
+  static std::vector<IntegratorEntry> entries = {
 #define GEOMINT_METHOD(name, factory, variants, summary) \
   {#name, summary, &factory, split_variants(variants)},
 #include "integrators/registry.def"
 #undef GEOMINT_METHOD
   };
   return entries;
+}
+}  // namespace
+
+const std::vector<IntegratorEntry>& integrator_registry() { return mutable_integrator_registry(); }
+
+void register_method(IntegratorEntry entry) {
+  auto& entries = mutable_integrator_registry();
+  check_registration_name(entry.name, "method");
+  if (entry.factory == nullptr) {
+    throw InputError(fmt::format("register_method: method '{}' has no factory", entry.name));
+  }
+  for (const auto& existing : entries) {
+    if (existing.name == entry.name) {
+      throw InputError(fmt::format("register_method: a method named '{}' is already registered{}",
+                                   entry.name, existing.builtin ? " (built-in)" : ""));
+    }
+  }
+  entry.builtin = false;
+  entries.push_back(std::move(entry));
 }
 
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {

@@ -198,8 +198,21 @@ struct IntegratorEntry {
   std::string summary;
   std::unique_ptr<Integrator> (*factory)(Params&);
   std::vector<std::string> variants;  // extra parameter sets the test suite must also cover
+  // false for register_method() entries, which the README's table leaves out
+  bool builtin = true;
 };
+// The built-in entries (registry.def) followed by the register_method() ones, in call order.
 const std::vector<IntegratorEntry>& integrator_registry();
+
+// A method defined outside the tree (README "Verify your own integrator", docs/ARCHITECTURE.md):
+// appended to the registry that make_integrator, `geomint list`, the sweeps, applicable() and
+// the registry-driven tests read. Call it before run_main (or through a static MethodRegistrar);
+// not thread-safe. Throws InputError for a name that is not a plain spec name or is already
+// registered (a built-in's name included). `builtin` is set to false.
+void register_method(IntegratorEntry entry);
+struct MethodRegistrar {
+  explicit MethodRegistrar(IntegratorEntry entry) { register_method(std::move(entry)); }
+};
 
 // Default specs to exercise in registry-driven tests and `geomint list`: one per entry, plus
 // extra configurations an entry declares worth testing (e.g. hp with both solvers).

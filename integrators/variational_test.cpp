@@ -12,6 +12,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "tests/test_util.hpp"
+#include "verify/verify.hpp"
 
 namespace geomint {
 namespace {
@@ -220,36 +221,9 @@ TEST(NegativeControl, SymplecticityDefectIsLargeForNonSymplecticMethods) {
 // ---------------------------------------------------------------------------------------------
 // Discrete Noether on a free spring network (docs/METHOD.md claim 1).
 
-struct MomentumErrors {
-  bool ok = false;
-  double linear = INFINITY;   // max |ΔL| / |L₀|
-  double angular = INFINITY;  // max |ΔJ| / |J₀|
-  Vec angular_final;          // J_N − J₀
-};
-
-MomentumErrors momentum_errors(const std::string& method, const std::string& problem_spec, double h,
-                               int steps) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
-  State state = problem->initial_state();
-  const Vec linear0 = problem->linear_momentum(state.q, state.p);
-  const Vec angular0 = problem->angular_momentum(state.q, state.p);
-  MomentumErrors errors;
-  errors.linear = errors.angular = 0;
-  integrator->reset(*problem, state, h);
-  for (int k = 0; k < steps; ++k) {
-    if (!integrator->step(*problem, state, h).ok) return {};
-    errors.linear =
-        std::max(errors.linear, (problem->linear_momentum(state.q, state.p) - linear0).norm());
-    errors.angular =
-        std::max(errors.angular, (problem->angular_momentum(state.q, state.p) - angular0).norm());
-  }
-  errors.linear /= linear0.norm();
-  errors.angular /= angular0.norm();
-  errors.angular_final = problem->angular_momentum(state.q, state.p) - angular0;
-  errors.ok = true;
-  return errors;
-}
+// verify::momentum_errors (verify/verify.hpp): max |ΔL|/|L₀|, |ΔJ|/|J₀| and J_N − J₀ of a run.
+using verify::momentum_errors;
+using verify::MomentumErrors;
 
 std::vector<std::string> variational_methods() {
   std::vector<std::string> out;
@@ -263,11 +237,10 @@ std::vector<std::string> variational_methods() {
 class VariationalMethod : public testing::TestWithParam<std::string> {};
 
 TEST_P(VariationalMethod, KeepsSpringNetMomentaOver10000Steps) {
-  const MomentumErrors errors = momentum_errors(GetParam(), "spring_net:nx=4,ny=4", 0.01, 10000);
-  ASSERT_TRUE(errors.ok);
-  // Round-off (and polished solves) over 1e4 steps; a tolerance-level solve would show ~1e-10.
-  EXPECT_LE(errors.linear, 1e-12);
-  EXPECT_LE(errors.angular, 1e-12);
+  // verify::momentum_maps_kept's defaults: spring_net:nx=4,ny=4, 1e4 steps of 0.01, both relative
+  // errors <= 1e-12: round-off and polished solves; a tolerance-level solve would show ~1e-10.
+  const verify::CheckResult result = verify::momentum_maps_kept(GetParam());
+  EXPECT_TRUE(result.passed) << verify::describe(result);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, VariationalMethod, testing::ValuesIn(variational_methods()),

@@ -11,14 +11,35 @@ namespace geomint {
 #include "problems/registry.def"
 #undef GEOMINT_PROBLEM
 
-const std::vector<ProblemEntry>& problem_registry() {
-  static const std::vector<ProblemEntry> entries = {
+namespace {
+// Function-local static: safe to extend from another translation unit's static initialiser.
+std::vector<ProblemEntry>& mutable_problem_registry() {
+  static std::vector<ProblemEntry> entries = {
 #define GEOMINT_PROBLEM(name, factory, variants, summary) \
   {#name, summary, &factory, split_variants(variants)},
 #include "problems/registry.def"
 #undef GEOMINT_PROBLEM
   };
   return entries;
+}
+}  // namespace
+
+const std::vector<ProblemEntry>& problem_registry() { return mutable_problem_registry(); }
+
+void register_problem(ProblemEntry entry) {
+  auto& entries = mutable_problem_registry();
+  check_registration_name(entry.name, "problem");
+  if (entry.factory == nullptr) {
+    throw InputError(fmt::format("register_problem: problem '{}' has no factory", entry.name));
+  }
+  for (const auto& existing : entries) {
+    if (existing.name == entry.name) {
+      throw InputError(fmt::format("register_problem: a problem named '{}' is already registered{}",
+                                   entry.name, existing.builtin ? " (built-in)" : ""));
+    }
+  }
+  entry.builtin = false;
+  entries.push_back(std::move(entry));
 }
 
 std::vector<std::string> problem_test_specs() {

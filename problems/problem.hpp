@@ -182,8 +182,19 @@ struct ProblemEntry {
   std::string summary;
   std::unique_ptr<Problem> (*factory)(Params&);
   std::vector<std::string> variants;  // extra parameter sets for the registry-driven tests
+  // false for register_problem() entries, which the README's table leaves out
+  bool builtin = true;
 };
+// The built-in entries (registry.def) followed by the register_problem() ones, in call order.
 const std::vector<ProblemEntry>& problem_registry();
+
+// A problem defined outside the tree, as register_method() for methods (integrators/
+// integrator.hpp): seen by make_problem, `geomint list`, the sweeps and the registry-driven tests.
+// Throws InputError for a name that is not a plain spec name or is already registered.
+void register_problem(ProblemEntry entry);
+struct ProblemRegistrar {
+  explicit ProblemRegistrar(ProblemEntry entry) { register_problem(std::move(entry)); }
+};
 
 // The specs the registry-driven tests exercise (problems/problems_test.cpp): each entry's
 // defaults, then its variants from problems/registry.def.

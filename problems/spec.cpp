@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -63,6 +64,18 @@ std::string format_number(double value) {
   char buffer[64];
   auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return std::string(buffer, result.ptr);
+}
+
+void check_registration_name(const std::string& name, const std::string& kind) {
+  bool plain = !name.empty();
+  for (char c : name) {
+    plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  }
+  if (!plain) {
+    throw InputError(fmt::format(
+        "register_{}: name '{}' must be non-empty letters, digits and '_' (it is a spec name)",
+        kind, name));
+  }
 }
 
 std::vector<std::string> split_variants(const std::string& text) {

@@ -31,6 +31,10 @@ struct Spec {
 // (integrators/registry.def, problems/registry.def): "a=1;a=2,b=3" -> {"a=1", "a=2,b=3"}.
 std::vector<std::string> split_variants(const std::string& text);
 
+// Throws InputError unless `name` can be a registry name (letters, digits, '_'): what
+// register_method() and register_problem() accept; `kind` is "method" or "problem".
+void check_registration_name(const std::string& name, const std::string& kind);
+
 // Documentation of one parameter, collected while a factory reads its parameters.
 struct ParamDoc {
   std::string key;

@@ -83,6 +83,15 @@ fs::path scratch(const std::string& name) {
 // Bad input (exit 2, a message naming it, no file) is covered case by case in
 // tests/bad_input_test.cpp.
 
+// The installed package's version file and `geomint --version` say the same (CMake's
+// PROJECT_VERSION, README "Verify your own integrator"); exit 0 without a command.
+TEST(Cli, VersionPrintsTheProjectVersion) {
+  const Outcome outcome = geomint("--version");
+  EXPECT_EQ(outcome.exit_code, 0) << outcome.output;
+  EXPECT_EQ(outcome.output.rfind(std::string("geomint ") + GEOMINT_VERSION + " (", 0), 0u)
+      << outcome.output;
+}
+
 TEST(Cli, RunWritesOneRowWithProvenance) {
   const fs::path out = scratch("run.csv");
   const Outcome outcome = geomint(

@@ -14,7 +14,7 @@
 #include "harness/run.hpp"
 #include "harness/sweep.hpp"
 #include "harness/table.hpp"
-#include "tests/method_checks.hpp"
+#include "verify/verify.hpp"
 
 namespace geomint {
 namespace {
@@ -149,7 +149,7 @@ TEST_P(ConstrainedPair, SymmetricMeansReversible) {
   const auto& [method, problem] = GetParam();
   if (!(make_integrator(method)->info().flags & kSymmetric)) GTEST_SKIP() << "not symmetric";
   const double h = time_unit(problem) / 20;
-  EXPECT_LT(test::reversibility_defect(method, problem, h), 1e-12);
+  EXPECT_LT(verify::reversibility_defect(method, problem, h), 1e-12);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, ConstrainedPair, testing::ValuesIn(pairs()), pair_name);
@@ -175,7 +175,7 @@ TEST(NegativeControl, ShakeVelocitiesLeaveTheVelocityConstraintAtFirstOrder) {
   // The positions still satisfy g = 0: only the velocity level fails.
   EXPECT_LE(coarse.record.metrics.at("constraint_err_max"), 1e-13 * scales_of(problem).length);
   const double h = make_problem(problem)->default_dt() * 5;
-  EXPECT_GT(test::reversibility_defect(shake, problem, h), 1e-6);
+  EXPECT_GT(verify::reversibility_defect(shake, problem, h), 1e-6);
 }
 
 // Order on a nonlinear constrained problem with an exact solution (the conical spherical

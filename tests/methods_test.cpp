@@ -1,13 +1,14 @@
 // Registry-driven method checks (docs/DESIGN.md §7): every registered method's declared order and
 // every declared flag is verified, not only declared, so a new method is checked the day it is
-// added. Negative controls make sure the checks can fail.
+// added; the order, drift and reversibility checks are the geomint::verify kit's (verify/).
+// Negative controls make sure the checks can fail.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
-#include "tests/method_checks.hpp"
+#include "verify/verify.hpp"
 
 namespace geomint {
 namespace {
@@ -36,40 +37,27 @@ class EveryMethod : public testing::TestWithParam<std::string> {
 };
 
 // Ladders chosen so every method has >= 4 points in its asymptotic range and none reaches the
-// round-off plateau before the fit; the fit drops pre-asymptotic points itself.
-struct Ladder {
-  const char* problem;
-  double dt0;
-  int levels;
-  double t_end;
-};
-constexpr Ladder kPendulumLadder{"pendulum:theta0=1.5", 0.1, 7, 5.0};
-constexpr Ladder kKeplerLadder{"kepler:e=0.6", 0.02, 7, 5.0};
-
-void expect_declared_order(const std::string& method, const Ladder& ladder) {
-  const int declared = make_integrator(method)->info().order;
-  // High orders reach the plateau sooner: start them at a larger dt (×4 from order 4, ×16 from
-  // order 8) and end orders >= 6 two levels earlier. On Kepler the round-off plateau sits near
-  // 1e-13, above the fit's plateau floor, so a finest point there would bend the slope.
-  const double dt0 = ladder.dt0 * (declared >= 8 ? 16 : declared >= 4 ? 4 : 1);
-  const int levels = declared >= 6 ? ladder.levels - 2 : ladder.levels;
-  const OrderStudy study = order_study(ladder.problem, method, dt0, levels, ladder.t_end);
-  ASSERT_TRUE(std::isfinite(study.fit.order))
-      << method << " on " << ladder.problem << ": " << study.fit.note;
-  // ±0.3: the tolerance of docs/DESIGN.md §7 for a least-squares slope over >= 3 asymptotic points.
-  EXPECT_NEAR(study.fit.order, declared, 0.3) << method << " on " << ladder.problem << " (points "
-                                              << to_row(study.record).at("points_used") << ")";
+// round-off plateau before the fit (verify::pendulum_ladder, kepler_ladder); the fit drops
+// pre-asymptotic points itself, and verify::declared_order starts high orders at larger steps.
+void expect_declared_order(const std::string& method, const verify::Ladder& ladder) {
+  const verify::CheckResult result = verify::declared_order(method, ladder);
+  ASSERT_TRUE(std::isfinite(result.measured)) << verify::describe(result);
+  EXPECT_TRUE(result.passed) << verify::describe(result);
 }
 
-TEST_P(EveryMethod, DeclaredOrderOnPendulum) { expect_declared_order(GetParam(), kPendulumLadder); }
-TEST_P(EveryMethod, DeclaredOrderOnKepler) { expect_declared_order(GetParam(), kKeplerLadder); }
+TEST_P(EveryMethod, DeclaredOrderOnPendulum) {
+  expect_declared_order(GetParam(), verify::pendulum_ladder());
+}
+TEST_P(EveryMethod, DeclaredOrderOnKepler) {
+  expect_declared_order(GetParam(), verify::kepler_ladder());
+}
 
 // Non-unit masses: a method that forgets M⁻¹ somewhere (Newmark's initial acceleration, say) is
 // exact for m = 1 and loses its order for any other mass, so every order test above would pass.
 // Linear problems with exact solutions, heavy and light: harmonic with m = 4, and a fixed-end
 // chain of four 2.5-kg masses.
-constexpr Ladder kHeavyHarmonicLadder{"harmonic:mass=4,omega=2", 0.1, 7, 5.0};
-constexpr Ladder kHeavyChainLadder{"spring_chain:n=4,mass=2.5,stiffness=3", 0.1, 7, 5.0};
+const verify::Ladder kHeavyHarmonicLadder{"harmonic:mass=4,omega=2", 0.1, 7, 5.0};
+const verify::Ladder kHeavyChainLadder{"spring_chain:n=4,mass=2.5,stiffness=3", 0.1, 7, 5.0};
 TEST_P(EveryMethod, DeclaredOrderWithNonUnitMass) {
   expect_declared_order(GetParam(), kHeavyHarmonicLadder);
   expect_declared_order(GetParam(), kHeavyChainLadder);
@@ -113,51 +101,34 @@ TEST_P(EveryMethod, LinearProblemsAreSolvedScaleFree) {
   }
 }
 
-// Bounded energy error with no drift: over 1e5 steps the least-squares trend of the per-window
-// maxima, times the horizon, must stay below 10% of the maximum error itself. A drifting method
-// (explicit Euler, RK4) has trend × T ≈ err_max.
-bool energy_bounded_without_drift(const std::string& method, double* ratio) {
-  RunConfig config;
-  // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
-  // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
-  config.dt = make_integrator(method)->info().order >= 6 ? 0.2 : 0.05;
-  config.t_end = 1e5 * config.dt;
-  config.timing_repeats = 0;
-  const RunResult result = run_one("pendulum:theta0=1.5", method, config);
-  if (!result.ok) {
-    *ratio = INFINITY;
-    return false;
-  }
-  const double drift = result.record.metrics.at("energy_drift");
-  const double err_max = result.record.metrics.at("energy_err_max");
-  *ratio = std::abs(drift) * config.t_end / err_max;
-  return *ratio < 0.1 && err_max < 0.1;
-}
-
+// Bounded energy error with no drift (verify::energy_without_drift): over 1e5 steps the
+// least-squares trend of the per-window maxima, times the horizon, must stay below 10% of the
+// maximum error itself. A drifting method (explicit Euler, RK4) has trend × T ≈ err_max.
 TEST_P(EveryMethod, SymplecticMeansBoundedEnergy) {
   if (!(info().flags & kSymplectic)) GTEST_SKIP() << "not declared symplectic";
-  double ratio = 0;
-  EXPECT_TRUE(energy_bounded_without_drift(GetParam(), &ratio))
-      << GetParam() << ": drift*T/err_max = " << ratio;
+  const verify::CheckResult result = verify::energy_without_drift(GetParam());
+  EXPECT_TRUE(result.passed) << verify::describe(result);
 }
 
 TEST(NegativeControl, DriftCheckFailsForRk4AndExplicitEuler) {
-  double ratio = 0;
-  EXPECT_FALSE(energy_bounded_without_drift("rk4", &ratio)) << "rk4 ratio " << ratio;
-  EXPECT_FALSE(energy_bounded_without_drift("explicit_euler", &ratio))
-      << "explicit_euler ratio " << ratio;
+  for (const char* method : {"rk4", "explicit_euler"}) {
+    const verify::CheckResult result = verify::energy_without_drift(method);
+    EXPECT_FALSE(result.passed) << verify::describe(result);
+  }
 }
 
 TEST_P(EveryMethod, SymmetricMeansReversible) {
   if (!(info().flags & kSymmetric)) GTEST_SKIP() << "not declared symmetric";
   // 40 steps of round-off at ~1e-16 each, with implicit solves at 1e-12 relative tolerance.
-  EXPECT_LT(test::reversibility_defect(GetParam(), "pendulum:theta0=1.5", 0.1), 1e-11);
-  EXPECT_LT(test::reversibility_defect(GetParam(), "kepler:e=0.6", 0.01), 1e-11);
+  for (const char* check : {"reversible_pendulum", "reversible_kepler"}) {
+    const verify::CheckResult result = verify::run_check(GetParam(), check);
+    EXPECT_TRUE(result.passed) << verify::describe(result);
+  }
 }
 
 TEST(NegativeControl, ReversibilityCheckFailsForNonSymmetricMethods) {
-  EXPECT_GT(test::reversibility_defect("symplectic_euler_a", "pendulum:theta0=1.5", 0.1), 1e-6);
-  EXPECT_GT(test::reversibility_defect("rk4", "pendulum:theta0=1.5", 0.1), 1e-9);
+  EXPECT_GT(verify::reversibility_defect("symplectic_euler_a", "pendulum:theta0=1.5", 0.1), 1e-6);
+  EXPECT_GT(verify::reversibility_defect("rk4", "pendulum:theta0=1.5", 0.1), 1e-9);
 }
 
 // Central force: a variational/symplectic method with a rotation-invariant discrete Lagrangian

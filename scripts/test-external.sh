@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs geomint from an existing build into a temporary prefix, then configures, builds and
+# tests examples/external_method against it with its own CMake configure, as a user would
+# (README "Verify your own integrator"; run by `make test`). Usage: test-external.sh [BUILD_DIR]
+# Exit code: 0 when the install, the example's build and every one of its tests succeed.
+set -euo pipefail
+build_dir=${1:-build}
+source_dir=$(cd "$(dirname "$0")/.." && pwd)
+jobs=${JOBS:-2}
+work=$(mktemp -d "${TMPDIR:-/tmp}/geomint-external.XXXXXX")
+# Kept for inspection when something failed.
+trap 'status=$?; if [[ $status == 0 ]]; then rm -rf "$work"; else echo "test-external: see $work" >&2; fi' EXIT
+
+cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log" ||
+  { cat "$work/install.log"; echo "test-external: cmake --install failed" >&2; exit 1; }
+launcher=()
+if [[ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ]]; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER="$CMAKE_CXX_COMPILER_LAUNCHER")
+fi
+cmake -S "$source_dir/examples/external_method" -B "$work/build" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$work/prefix" "${launcher[@]}" > "$work/configure.log" ||
+  { cat "$work/configure.log"; echo "test-external: configure against the prefix failed" >&2; exit 1; }
+cmake --build "$work/build" -j "$jobs" > "$work/build.log" ||
+  { cat "$work/build.log"; echo "test-external: the example did not build" >&2; exit 1; }
+"$work/prefix/bin/geomint" --version
+(cd "$work/build" && ctest --output-on-failure -j "$jobs") ||
+  { echo "test-external: the example's tests failed" >&2; exit 1; }
+echo "test-external: examples/external_method built and passed against $work/prefix"

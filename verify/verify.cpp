@@ -1,0 +1,241 @@
+// The property checks of verify.hpp (docs/DESIGN.md §7): one copy, used by the in-tree suites
+// and by users' tests through the installed package.
+#include "verify/verify.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "harness/order.hpp"
+#include "harness/run.hpp"
+
+namespace geomint::verify {
+namespace {
+
+CheckResult start(const char* check, const std::string& method, const std::string& problem) {
+  CheckResult result;
+  result.check = check;
+  result.method = method;
+  result.problem = problem;
+  return result;
+}
+
+CheckResult not_declared(const char* check, const std::string& method, const char* property) {
+  CheckResult result = start(check, method, "");
+  result.applies = false;
+  result.passed = true;
+  result.detail = fmt::format("not declared {}", property);
+  return result;
+}
+
+RunResult run_untimed(const std::string& problem, const std::string& method, double dt,
+                      double t_end) {
+  RunConfig config;
+  config.dt = dt;
+  config.t_end = t_end;
+  config.timing_repeats = 0;
+  return run_one(problem, method, config);
+}
+
+}  // namespace
+
+std::string describe(const CheckResult& result) {
+  const char* verdict = !result.applies ? "SKIP" : result.passed ? "PASS" : "FAIL";
+  std::string text = fmt::format("{} {} {}", verdict, result.check, result.method);
+  if (!result.problem.empty()) text += " on " + result.problem;
+  if (result.applies) {
+    text += fmt::format(": measured {:.4g} (bound {:.4g})", result.measured, result.bound);
+  }
+  if (!result.detail.empty()) text += "; " + result.detail;
+  return text;
+}
+
+Ladder pendulum_ladder() { return {"pendulum:theta0=1.5", 0.1, 7, 5.0}; }
+Ladder kepler_ladder() { return {"kepler:e=0.6", 0.02, 7, 5.0}; }
+
+CheckResult declared_order(const std::string& method, const Ladder& ladder, double tolerance) {
+  CheckResult result = start("declared_order", method, ladder.problem);
+  const int declared = make_integrator(method)->info().order;
+  result.bound = declared;
+  // On Kepler the round-off plateau sits near 1e-13, above the fit's plateau floor, so a finest
+  // point there would bend the slope: hence fewer levels for the high orders.
+  const double dt0 = ladder.dt0 * (declared >= 8 ? 16 : declared >= 4 ? 4 : 1);
+  const int levels = declared >= 6 ? ladder.levels - 2 : ladder.levels;
+  const OrderStudy study = order_study(ladder.problem, method, dt0, levels, ladder.t_end);
+  result.measured = study.fit.order;
+  if (!std::isfinite(study.fit.order)) {
+    result.detail = "no order could be fitted: " + study.fit.note;
+    return result;
+  }
+  result.passed = std::abs(study.fit.order - declared) <= tolerance;
+  result.detail = fmt::format("declared {} ± {}, ladder points used {}", declared, tolerance,
+                              to_row(study.record).at("points_used"));
+  return result;
+}
+
+CheckResult energy_without_drift(const std::string& method, const std::string& problem) {
+  CheckResult result = start("energy_without_drift", method, problem);
+  result.bound = 0.1;
+  // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
+  // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
+  const double dt = make_integrator(method)->info().order >= 6 ? 0.2 : 0.05;
+  const double t_end = 1e5 * dt;
+  const RunResult run = run_untimed(problem, method, dt, t_end);
+  if (!run.ok) {
+    result.measured = INFINITY;
+    result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
+    return result;
+  }
+  const double drift = run.record.metrics.at("energy_drift");
+  const double err_max = run.record.metrics.at("energy_err_max");
+  result.measured = std::abs(drift) * t_end / err_max;
+  result.passed = result.measured < result.bound && err_max < 0.1;
+  result.detail = fmt::format("drift·T/err_max over 1e5 steps of {}; energy_err_max {:.3g} (< 0.1)",
+                              dt, err_max);
+  return result;
+}
+
+double reversibility_defect(const std::string& method, const std::string& problem_spec, double h,
+                            int steps) {
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method);
+  const State initial = problem->initial_state();
+  State state = initial;
+  integrator->reset(*problem, state, h);
+  for (int k = 0; k < steps; ++k) {
+    if (!integrator->step(*problem, state, h).ok) return INFINITY;
+  }
+  integrator->reset(*problem, state, -h);
+  for (int k = 0; k < steps; ++k) {
+    if (!integrator->step(*problem, state, -h).ok) return INFINITY;
+  }
+  const double scale = std::sqrt(initial.q.squaredNorm() + initial.p.squaredNorm());
+  return std::sqrt((state.q - initial.q).squaredNorm() + (state.p - initial.p).squaredNorm()) /
+         scale;
+}
+
+CheckResult reversible(const std::string& method, const std::string& problem, double h,
+                       double bound) {
+  CheckResult result = start("reversible", method, problem);
+  result.bound = bound;
+  result.measured = reversibility_defect(method, problem, h);
+  result.passed = result.measured < bound;
+  result.detail =
+      fmt::format("20 steps of h = {:g} then 20 of −h, distance to the start / |y₀|", h);
+  return result;
+}
+
+MomentumErrors momentum_errors(const std::string& method, const std::string& problem_spec, double h,
+                               int steps) {
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method);
+  State state = problem->initial_state();
+  const Vec linear0 = problem->linear_momentum(state.q, state.p);
+  const Vec angular0 = problem->angular_momentum(state.q, state.p);
+  MomentumErrors errors;
+  errors.linear = errors.angular = 0;
+  integrator->reset(*problem, state, h);
+  for (int k = 0; k < steps; ++k) {
+    if (!integrator->step(*problem, state, h).ok) return {};
+    errors.linear =
+        std::max(errors.linear, (problem->linear_momentum(state.q, state.p) - linear0).norm());
+    errors.angular =
+        std::max(errors.angular, (problem->angular_momentum(state.q, state.p) - angular0).norm());
+  }
+  errors.linear /= linear0.norm();
+  errors.angular /= angular0.norm();
+  errors.angular_final = problem->angular_momentum(state.q, state.p) - angular0;
+  errors.ok = true;
+  return errors;
+}
+
+CheckResult momentum_maps_kept(const std::string& method, const std::string& problem, double h,
+                               int steps, double bound) {
+  CheckResult result = start("momentum_maps_kept", method, problem);
+  result.bound = bound;
+  const MomentumErrors errors = momentum_errors(method, problem, h, steps);
+  result.measured = std::max(errors.linear, errors.angular);
+  result.passed = errors.ok && result.measured <= bound;
+  result.detail = errors.ok
+                      ? fmt::format("{} steps of {:g}: max |ΔL|/|L₀| {:.3g}, |ΔJ|/|J₀| {:.3g}",
+                                    steps, h, errors.linear, errors.angular)
+                      : "a step failed";
+  return result;
+}
+
+CheckResult constraint_kept(const std::string& method, const std::string& problem_spec,
+                            double steps_per_unit, double units, double bound) {
+  CheckResult result = start("constraint_kept", method, problem_spec);
+  result.bound = bound;
+  const auto problem = make_problem(problem_spec);
+  const State initial = problem->initial_state();
+  // g is a length error and G M⁻¹p a rate of one: measured against the configuration's size and
+  // the speed (set by gravity, length per 100 default steps, when released from rest).
+  const double length = initial.q.lpNorm<Eigen::Infinity>();
+  const double speed =
+      std::max(problem->inverse_mass().cwiseProduct(initial.p).lpNorm<Eigen::Infinity>(),
+               length / (problem->default_dt() * 100));
+  const double unit = length / speed;
+  const RunResult run = run_untimed(problem_spec, method, unit / steps_per_unit, unit * units);
+  if (!run.ok) {
+    result.measured = INFINITY;
+    result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
+    return result;
+  }
+  const double position = run.record.metrics.at("constraint_err_max") / length;
+  const double velocity = run.record.metrics.at("constraint_vel_err_max") / speed;
+  result.measured = std::max(position, velocity);
+  result.passed = result.measured <= bound;
+  result.detail =
+      fmt::format("relative residuals: position {:.3g}, velocity {:.3g}", position, velocity);
+  return result;
+}
+
+std::vector<std::string> check_names() {
+  return {"declared_order_pendulum", "declared_order_kepler", "energy_without_drift",
+          "reversible_pendulum",     "reversible_kepler",     "momentum_maps_kept",
+          "constraint_kept"};
+}
+
+CheckResult run_check(const std::string& method, const std::string& name,
+                      const std::string& constrained_problem) {
+  const unsigned flags = make_integrator(method)->info().flags;
+  const bool constraints_only = flags & kConstraintsOnly;
+  if (name == "constraint_kept") {
+    return constraints_only ? constraint_kept(method, constrained_problem)
+                            : not_declared("constraint_kept", method, "constraints-only");
+  }
+  if (constraints_only) return not_declared(name.c_str(), method, "unconstrained");
+  if (name == "declared_order_pendulum" || name == "declared_order_kepler") {
+    if (flags & kAdaptive) return not_declared(name.c_str(), method, "fixed-step");
+    return declared_order(method,
+                          name == "declared_order_pendulum" ? pendulum_ladder() : kepler_ladder());
+  }
+  if (name == "energy_without_drift") {
+    return (flags & kSymplectic) ? energy_without_drift(method)
+                                 : not_declared(name.c_str(), method, "symplectic");
+  }
+  if (name == "reversible_pendulum" || name == "reversible_kepler") {
+    if (!(flags & kSymmetric)) return not_declared(name.c_str(), method, "symmetric");
+    // 40 steps of round-off at ~1e-16 each, with implicit solves at 1e-12 relative tolerance.
+    return name == "reversible_pendulum" ? reversible(method, "pendulum:theta0=1.5", 0.1, 1e-11)
+                                         : reversible(method, "kepler:e=0.6", 0.01, 1e-11);
+  }
+  if (name == "momentum_maps_kept") {
+    return (flags & kVariational) ? momentum_maps_kept(method)
+                                  : not_declared(name.c_str(), method, "variational");
+  }
+  throw InputError(
+      fmt::format("verify: unknown check '{}' (valid: {})", name, fmt::join(check_names(), ", ")));
+}
+
+std::vector<CheckResult> verify_method(const std::string& method,
+                                       const std::string& constrained_problem) {
+  std::vector<CheckResult> results;
+  for (const auto& name : check_names()) {
+    results.push_back(run_check(method, name, constrained_problem));
+  }
+  return results;
+}
+
+}  // namespace geomint::verify
