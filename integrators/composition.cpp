@@ -43,10 +43,32 @@ class Composition final : public Integrator {
     steps_ = 0;
   }
 
+  // DΦ = DΦ_s ⋯ DΦ_1: the base's tangents at the intermediate states.
+  bool has_step_tangent(const Problem& problem) const override {
+    return base_->has_step_tangent(problem);
+  }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    Eigen::MatrixXd stage;
+    tangent = Eigen::MatrixXd::Identity(2 * problem.dof(), 2 * problem.dof());
+    return substeps(state, h, [&](double substep) {
+      const StepStatus status = base_->step_tangent(problem, state, substep, stage);
+      tangent = stage * tangent;
+      return status;
+    });
+  }
+
   StepStatus step(const Problem& problem, State& state, double h) override {
+    return substeps(state, h, [&](double substep) { return base_->step(problem, state, substep); });
+  }
+
+ private:
+  // Runs `base_step(γ_i h)` for every stage, then sets t and the counters.
+  template <class BaseStep>
+  StepStatus substeps(State& state, double h, BaseStep&& base_step) {
     const double t0 = state.t;
     for (size_t i = 0; i < gamma_.size(); ++i) {
-      const StepStatus status = base_->step(problem, state, gamma_[i] * h);
+      const StepStatus status = base_step(gamma_[i] * h);
       if (!status.ok) {
         counters_ = base_->counters();
         counters_.steps = steps_;
@@ -61,7 +83,6 @@ class Composition final : public Integrator {
     return StepStatus::success();
   }
 
- private:
   const coefficients::CompositionScheme& scheme_;
   std::string base_name_;
   std::unique_ptr<Integrator> base_;

@@ -16,6 +16,7 @@
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -192,6 +193,19 @@ class DiscreteLagrangianVI final : public Integrator {
     state.t += h;
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // The quadrature DEL map's tangent (integrators/tangent.hpp) at v = (q₁ − q₀)/h.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const Vec q0 = state.q;
+    const StepStatus status = step(problem, state, h);
+    if (!status.ok) return status;
+    std::vector<QuadratureNode> nodes;
+    for (const Node& node : nodes_) nodes.push_back({node.a, node.w});
+    tangent = quadrature_del_tangent(problem, q0, state.q, (state.q - q0) / h, h, nodes);
+    return status;
   }
 
  private:

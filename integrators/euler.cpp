@@ -11,6 +11,7 @@
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -24,6 +25,18 @@ class ExplicitEuler final : public Integrator {
 
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(0.0);  // |1 + ihω| > 1 for every h > 0
+  }
+
+  // δq⁺ = δq + h M⁻¹δp, δp⁺ = δp − h∇²V(q)δq: both from the incoming tangent.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    TangentBlock block(problem.dof());
+    const Eigen::MatrixXd start_q = block.q;
+    block.drift(problem.inverse_mass(), h);
+    block.p -= h * (dense_hessian(problem, state.q) * start_q);
+    tangent = block.stacked();
+    return step(problem, state, h);
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
@@ -68,6 +81,26 @@ class ImplicitEuler final : public Integrator {
     newton_.forget_pattern();
     end_force_norm_ = std::numeric_limits<double>::quiet_NaN();
     damping_symmetric_.reset();
+  }
+
+  // At the converged v = M⁻¹p⁺, R = M v − p + h∇V(q + h v) gives (H = ∇²V(q⁺))
+  //   (M + h²H) δv = δp − hH δq,   δq⁺ = δq + h δv,   δp⁺ = M δv.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const StepStatus status = step(problem, state, h);
+    if (!status.ok) return status;
+    const int n = problem.dof();
+    const Eigen::MatrixXd hessian = dense_hessian(problem, state.q);
+    const Eigen::MatrixXd matrix = Eigen::MatrixXd(problem.mass().asDiagonal()) + h * h * hessian;
+    Eigen::MatrixXd rhs(n, 2 * n);
+    rhs << -h * hessian, Eigen::MatrixXd::Identity(n, n);
+    const Eigen::MatrixXd dv = matrix.partialPivLu().solve(rhs);
+    TangentBlock block(n);
+    block.q += h * dv;
+    block.p = problem.mass().asDiagonal() * dv;
+    tangent = block.stacked();
+    return status;
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {

@@ -12,6 +12,7 @@
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -141,6 +142,17 @@ class HamiltonPontryagin final : public Integrator {
     velocity_ = v;
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // The α-rule DEL map (integrators/tangent.hpp) at the converged v, either solver.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const Vec q0 = state.q;
+    const StepStatus status = step(problem, state, h);
+    if (status.ok)
+      tangent = quadrature_del_tangent(problem, q0, state.q, velocity_, h, {{alpha_, 1.0}});
+    return status;
   }
 
  private:

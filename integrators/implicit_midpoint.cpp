@@ -9,6 +9,7 @@
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -111,6 +112,19 @@ class ImplicitMidpoint final : public Integrator {
     state.t += h;
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // Unforced, p₁ = 2M v̄ − p₀ = M v̄ − (h/2)∇V(q̄): the DEL map of the midpoint node (½, 1)
+  // (integrators/tangent.hpp) at v̄ = (q₁ − q₀)/h.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const Vec q0 = state.q;
+    const StepStatus status = step(problem, state, h);
+    if (status.ok) {
+      tangent = quadrature_del_tangent(problem, q0, state.q, (state.q - q0) / h, h, {{0.5, 1.0}});
+    }
+    return status;
   }
 
  private:

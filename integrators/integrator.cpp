@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace geomint {
 
@@ -181,6 +182,12 @@ StabilityPrediction Integrator::predicted_linear_stability() const {
         "adaptive: error control chooses the step, so there is no fixed-step limit");
   }
   return StabilityPrediction::none("");
+}
+
+bool Integrator::has_step_tangent(const Problem&) const { return false; }
+
+StepStatus Integrator::step_tangent(const Problem&, State&, double, Eigen::MatrixXd&) {
+  throw std::logic_error(info().name + ": step_tangent is not implemented (has_step_tangent)");
 }
 
 StepStatus Integrator::adaptive_step(const Problem&, State&, double) {

@@ -145,6 +145,19 @@ class Integrator {
   // fixed-step method without an override fails the registry test in harness/stability_test.cpp.
   virtual StabilityPrediction predicted_linear_stability() const;
 
+  // The linearised step (README "Metrics"; integrators/tangent.hpp): whether step_tangent()
+  // gives the exact DΦ of this method on `problem`. The default says no; methods that implement
+  // it say yes on unforced, unconstrained problems with a Hessian (tangent_applies()).
+  virtual bool has_step_tangent(const Problem& problem) const;
+  // One step exactly as step() from a reset at `state` (a method carrying a variable of its own,
+  // HHT's acceleration, starts it consistently as reset() does), and `tangent` = DΦ =
+  // ∂(q⁺, p⁺)/∂(q, p) at the incoming state, 2n×2n with (q, p) ordered as (q₁…qₙ, p₁…pₙ), from
+  // the Hessian: explicit methods propagate tangent vectors through their stages, implicit ones
+  // apply the implicit function theorem to their converged step equations. Only where
+  // has_step_tangent(problem); the default throws std::logic_error.
+  virtual StepStatus step_tangent(const Problem& problem, State& state, double h,
+                                  Eigen::MatrixXd& tangent);
+
   const Counters& counters() const { return counters_; }
 
  protected:

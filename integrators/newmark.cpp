@@ -14,6 +14,7 @@
 #include "integrators/forcing.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -187,6 +188,40 @@ class Newmark final : public Integrator {
     remember(problem, state);
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // From the consistent start a₀ = −M⁻¹∇V(q₀) (as reset() takes it), with H₀, H₁ = ∇²V(q₀),
+  // ∇²V(q₁):
+  //   δa₀ = −M⁻¹H₀δq₀,  δq̃ = δq₀ + h δv₀ + h²(½−β)δa₀,  δṽ = δv₀ + h(1−γ)δa₀,
+  //   [(1−α_m)M + (1−α_f)βh²H₁] δa₁ = −(1−α_f)H₁δq̃ − α_f H₀δq₀ − α_m M δa₀,
+  //   δq₁ = δq̃ + βh²δa₁,  δp₁ = M(δṽ + γh δa₁).
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const int n = problem.dof();
+    const auto mass = problem.mass().asDiagonal();
+    const auto inverse_mass = problem.inverse_mass().asDiagonal();
+    const Eigen::MatrixXd start_hessian = dense_hessian(problem, state.q);
+    cached_problem_ = nullptr;  // the consistent a₀, not a carried one
+    const StepStatus status = step(problem, state, h);
+    if (!status.ok) return status;
+    const Eigen::MatrixXd end_hessian = dense_hessian(problem, state.q);
+    const double alpha_m = alpha_.alpha_m, alpha_f = alpha_.alpha_f;
+    const TangentBlock start(n);
+    const Eigen::MatrixXd dv0 = inverse_mass * start.p;
+    const Eigen::MatrixXd da0 = -(inverse_mass * (start_hessian * start.q));
+    const Eigen::MatrixXd dq_predict = start.q + h * dv0 + (h * h * (0.5 - beta_)) * da0;
+    const Eigen::MatrixXd dv_predict = dv0 + (h * (1 - gamma_)) * da0;
+    const Eigen::MatrixXd matrix =
+        (1 - alpha_m) * Eigen::MatrixXd(mass) + ((1 - alpha_f) * beta_ * h * h) * end_hessian;
+    const Eigen::MatrixXd da1 =
+        matrix.partialPivLu().solve(-(1 - alpha_f) * (end_hessian * dq_predict) -
+                                    alpha_f * (start_hessian * start.q) - alpha_m * (mass * da0));
+    TangentBlock block(n);
+    block.q = dq_predict + (beta_ * h * h) * da1;
+    block.p = mass * (dv_predict + (gamma_ * h) * da1);
+    tangent = block.stacked();
+    return status;
   }
 
  private:

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "integrators/newton.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -188,6 +189,48 @@ class ImplicitPartitionedRk final : public Integrator {
     previous_p_ = state.p;
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // Unforced, at the converged stage velocities V with H_j = ∇²V(Q_j), the implicit function
+  // theorem on R_i = M V_i − p₀ + hΣ_j â_ij ∇V(Q_j) = 0 gives
+  //   Σ_k (M δ_ik + h²Σ_j â_ij a_jk H_j) δV_k = δp₀ − hΣ_j â_ij H_j δq₀,
+  //   δQ_j = δq₀ + hΣ_k a_jk δV_k,  δq₁ = δq₀ + hΣ_j b_j δV_j,  δp₁ = δp₀ − hΣ_j b_j H_j δQ_j.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const int n = problem.dof();
+    const Vec q0 = state.q;
+    const StepStatus status = step(problem, state, h);
+    if (!status.ok) return status;
+    std::vector<Eigen::MatrixXd> hessians;
+    for (int j = 0; j < stages_; ++j) {
+      Vec qj = q0;
+      for (int k = 0; k < stages_; ++k) qj += (h * a_(j, k)) * previous_v_.segment(k * n, n);
+      hessians.push_back(dense_hessian(problem, qj));
+    }
+    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(stages_ * n, stages_ * n);
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(stages_ * n, 2 * n);
+    for (int i = 0; i < stages_; ++i) {
+      matrix.block(i * n, i * n, n, n) += Eigen::MatrixXd(problem.mass().asDiagonal());
+      rhs.block(i * n, n, n, n).setIdentity();
+      for (int j = 0; j < stages_; ++j) {
+        rhs.block(i * n, 0, n, n) -= (h * a_hat_(i, j)) * hessians[j];
+        for (int k = 0; k < stages_; ++k) {
+          matrix.block(i * n, k * n, n, n) += (h * h * a_hat_(i, j) * a_(j, k)) * hessians[j];
+        }
+      }
+    }
+    const Eigen::MatrixXd dv = matrix.partialPivLu().solve(rhs);
+    TangentBlock block(n);
+    const TangentBlock start(n);
+    for (int j = 0; j < stages_; ++j) {
+      Eigen::MatrixXd dq_stage = start.q;
+      for (int k = 0; k < stages_; ++k) dq_stage += (h * a_(j, k)) * dv.middleRows(k * n, n);
+      block.q += (h * b_[j]) * dv.middleRows(j * n, n);
+      block.p -= (h * b_[j]) * (hessians[j] * dq_stage);
+    }
+    tangent = block.stacked();
+    return status;
   }
 
  private:

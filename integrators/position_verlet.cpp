@@ -3,6 +3,7 @@
 // the adjoint-ordered sibling of stormer_verlet (docs/METHOD.md §1).
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -27,6 +28,19 @@ class PositionVerlet final : public ExplicitStepper<PositionVerlet> {
   // On q̈ = −ω²q the step matrix has trace 2 − (hω)², as for kick–drift–kick (GNI §I.5).
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(2.0);
+  }
+
+  // Drift, kick with ∇²V(q½), drift.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    TangentBlock block(problem.dof());
+    block.drift(problem.inverse_mass(), h / 2);
+    const Vec half_q = state.q + (h / 2) * problem.inverse_mass().cwiseProduct(state.p);
+    block.kick(dense_hessian(problem, half_q), h);
+    block.drift(problem.inverse_mass(), h / 2);
+    tangent = block.stacked();
+    return step(problem, state, h);
   }
 
   void advance_by(const Problem& problem, State& state, double h) {

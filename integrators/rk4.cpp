@@ -3,6 +3,7 @@
 // Not symplectic: the negative control of docs/METHOD.md §7.
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -15,6 +16,34 @@ class Rk4 final : public ExplicitStepper<Rk4> {
 
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(2.0 * std::sqrt(2.0));  // |R(iy)| ≤ 1 iff y ≤ 2√2 (GNI §VI.4)
+  }
+
+  // The same stages on the tangent: δK_i = (M⁻¹δP_i, −∇²V(Q_i)δQ_i) at the stage points Y_i.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    const Vec& inverse_mass = problem.inverse_mass();
+    const TangentBlock start(problem.dof());
+    TangentBlock stage = start, sum = start;
+    Vec stage_q = state.q, stage_p = state.p, gradient;
+    const double offsets[] = {h / 2, h / 2, h};  // Y_{i+1} = y + offsets[i]·K_i
+    const double weights[] = {h / 6, h / 3, h / 3, h / 6};
+    for (int i = 0; i < 4; ++i) {
+      // K_i and δK_i at the stage point (stage_q, stage_p) with tangent `stage`.
+      const Vec dq = inverse_mass.cwiseProduct(stage_p);
+      problem.gradient(stage_q, gradient);
+      const Eigen::MatrixXd dq_tangent = inverse_mass.asDiagonal() * stage.p;
+      const Eigen::MatrixXd dp_tangent = -(dense_hessian(problem, stage_q) * stage.q);
+      sum.q += weights[i] * dq_tangent;
+      sum.p += weights[i] * dp_tangent;
+      if (i == 3) break;
+      stage_q = state.q + offsets[i] * dq;
+      stage_p = state.p - offsets[i] * gradient;
+      stage.q = start.q + offsets[i] * dq_tangent;
+      stage.p = start.p + offsets[i] * dp_tangent;
+    }
+    tangent = sum.stacked();
+    return step(problem, state, h);
   }
 
   // One step (ExplicitStepper runs it for step() and advance()).

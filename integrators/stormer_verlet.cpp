@@ -2,6 +2,7 @@
 // L(q_{k+1}, v)] (docs/METHOD.md §1; Hairer, Lubich & Wanner, GNI §I.1.4 and §VI.3, eq. (3.4)).
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -89,6 +90,19 @@ class StormerVerlet final : public Integrator {
     remember(problem, state);
     ++counters_.steps;
     return StepStatus::success();
+  }
+
+  // Kick with ∇²V(q), drift, kick with ∇²V(q⁺); compensated summation changes only rounding.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    TangentBlock block(problem.dof());
+    block.kick(dense_hessian(problem, state.q), h / 2);
+    block.drift(problem.inverse_mass(), h);
+    const StepStatus status = step(problem, state, h);
+    block.kick(dense_hessian(problem, state.q), h / 2);
+    tangent = block.stacked();
+    return status;
   }
 
   AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,

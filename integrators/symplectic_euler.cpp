@@ -3,6 +3,7 @@
 // enter as discrete Lagrange–d'Alembert impulses h·F (docs/METHOD.md §2).
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/tangent.hpp"
 
 namespace geomint {
 namespace {
@@ -19,6 +20,17 @@ class SymplecticEulerA final : public ExplicitStepper<SymplecticEulerA> {
 
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
+  }
+
+  // Kick with ∇²V(q), drift.
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    TangentBlock block(problem.dof());
+    block.kick(dense_hessian(problem, state.q), h);
+    block.drift(problem.inverse_mass(), h);
+    tangent = block.stacked();
+    return step(problem, state, h);
   }
 
   // Kick then drift (ExplicitStepper runs it for step() and advance()).
@@ -47,6 +59,18 @@ class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
 
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(2.0);  // trace of the step matrix 2 − (hω)² (GNI §I.5)
+  }
+
+  // Drift, kick with ∇²V(q⁺).
+  bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
+  StepStatus step_tangent(const Problem& problem, State& state, double h,
+                          Eigen::MatrixXd& tangent) override {
+    TangentBlock block(problem.dof());
+    block.drift(problem.inverse_mass(), h);
+    const StepStatus status = step(problem, state, h);
+    block.kick(dense_hessian(problem, state.q), h);
+    tangent = block.stacked();
+    return status;
   }
 
   // Drift then kick (ExplicitStepper runs it for step() and advance()).
