@@ -107,18 +107,6 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-// One step of a fresh integrator from `start`, as a vector (q, p); NaN entries when it fails.
-Vec one_step(const std::string& method_spec, const Problem& problem, const State& start, double h) {
-  const auto method = make_integrator(method_spec);
-  State state = start;
-  method->reset(problem, state, h);
-  const long n = state.q.size();
-  Vec out(2 * n);
-  if (!method->step(problem, state, h).ok) return Vec::Constant(2 * n, kNaN);
-  out << state.q, state.p;
-  return out;
-}
-
 }  // namespace
 
 const std::vector<std::string>& optional_metric_names() {
@@ -136,40 +124,40 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
   }
 }
 
+std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem) {
+  if (method.info().flags & kAdaptive) return "adaptive method: no fixed one-step map";
+  if (problem.has(kForce)) return "forced problem: the step is not a Hamiltonian map";
+  if (problem.has(kConstraints))
+    return "constrained problem: the step acts on the constraint manifold";
+  if (!problem.has(kHessian)) return "the problem offers no Hessian to linearise the step with";
+  if (!method.has_step_tangent(problem)) return "the method has no linearised step (step_tangent)";
+  return "";
+}
+
 bool symplecticity_defect_applies(const Integrator& method, const Problem& problem) {
-  return !(method.info().flags & kAdaptive) && !problem.has(kForce) && !problem.has(kConstraints);
+  return symplecticity_defect_not_applicable(method, problem).empty();
+}
+
+double symplecticity_defect(const Eigen::MatrixXd& tangent) {
+  if (!tangent.allFinite()) return kNaN;
+  const long n = tangent.rows() / 2;
+  Eigen::MatrixXd form = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  form.topRightCorner(n, n) = Eigen::MatrixXd::Identity(n, n);
+  form.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
+  const double size = tangent.cwiseAbs().maxCoeff();
+  return (tangent.transpose() * form * tangent - form).cwiseAbs().maxCoeff() /
+         std::max(1.0, size * size);
 }
 
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,
                             const State& state, double h) {
-  const long n = state.q.size();
-  // ε^{1/3}: balances the O(δ²) truncation and O(ε/δ) rounding of a central difference.
-  const double root = std::cbrt(std::numeric_limits<double>::epsilon());
-  const double q_scale =
-      state.q.lpNorm<Eigen::Infinity>() > 0 ? state.q.lpNorm<Eigen::Infinity>() : 1.0;
-  const double p_scale =
-      state.p.lpNorm<Eigen::Infinity>() > 0 ? state.p.lpNorm<Eigen::Infinity>() : 1.0;
-  Eigen::MatrixXd jacobian(2 * n, 2 * n);
-  for (long j = 0; j < 2 * n; ++j) {
-    const double delta = root * (j < n ? q_scale : p_scale);
-    State plus = state, minus = state;
-    if (j < n) {
-      plus.q[j] += delta, minus.q[j] -= delta;
-    } else {
-      plus.p[j - n] += delta, minus.p[j - n] -= delta;
-    }
-    // The actual perturbation after rounding, so the quotient divides by what was added.
-    const double step = j < n ? plus.q[j] - minus.q[j] : plus.p[j - n] - minus.p[j - n];
-    jacobian.col(j) =
-        (one_step(method_spec, problem, plus, h) - one_step(method_spec, problem, minus, h)) / step;
-  }
-  if (!jacobian.allFinite()) return kNaN;
-  Eigen::MatrixXd form = Eigen::MatrixXd::Zero(2 * n, 2 * n);
-  form.topRightCorner(n, n) = Eigen::MatrixXd::Identity(n, n);
-  form.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  const double size = jacobian.cwiseAbs().maxCoeff();
-  return (jacobian.transpose() * form * jacobian - form).cwiseAbs().maxCoeff() /
-         std::max(1.0, size * size);
+  const auto method = make_integrator(method_spec);
+  if (!symplecticity_defect_applies(*method, problem)) return kNaN;
+  State start = state;
+  method->reset(problem, start, h);
+  Eigen::MatrixXd tangent;
+  if (!method->step_tangent(problem, start, h, tangent).ok) return kNaN;
+  return symplecticity_defect(tangent);
 }
 
 std::vector<std::unique_ptr<Observer>> make_optional_observers(

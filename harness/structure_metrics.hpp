@@ -20,14 +20,19 @@ const std::vector<std::string>& optional_metric_names();
 void check_optional_metrics(const std::vector<std::string>& names, const std::string& option);
 
 // ‖DΦᵀ J DΦ − J‖_max / max(1, ‖DΦ‖²_max) of the one-step map Φ: (q, p) ↦ (q, p) with step h at
-// `state` (max norm: the largest entry), J the canonical 2n×2n form. DΦ is a central difference
-// with steps ε^{1/3}·max(‖(q, p)‖∞, 1) of maps each run by a fresh integrator from a reset at the
-// perturbed state; NaN when a step fails. Its noise floor (~1e-10, README "Metrics") is measured
-// by harness/structure_metrics_test.cpp.
+// `state` (max norm: the largest entry), J the canonical 2n×2n form. DΦ is the method's
+// linearised step (Integrator::step_tangent, integrators/tangent.hpp) taken by a fresh integrator
+// from a reset at `state`, never a difference quotient; NaN when the step fails. Its floor (round
+// off, README "Metrics") is measured by tests/structure_metrics_test.cpp.
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,
                             const State& state, double h);
+// The same defect of a given 2n×2n DΦ.
+double symplecticity_defect(const Eigen::MatrixXd& tangent);
 
-// Whether the defect applies: fixed-step method, unforced and unconstrained problem.
+// Why the defect does not apply to `method` on `problem`, or "" when it does: it needs a
+// fixed-step method that implements the linearised step there (unforced, unconstrained problems
+// with a Hessian; not the library and adaptive solvers).
+std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem);
 bool symplecticity_defect_applies(const Integrator& method, const Problem& problem);
 
 // Observers for the requested optional trajectory metrics that apply to `problem`.
