@@ -286,6 +286,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
     record.metrics["symplecticity_defect"] =
         symplecticity_defect(method_spec, *problem, problem->initial_state(), config.dt);
   }
+  add_normal_mode_metrics(method_spec, *problem, config.dt, config.extra_metrics, record.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
   record.status = outcome.status.ok ? "ok" : outcome.status.reason;

@@ -3,8 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <limits>
 
 #include "problems/problem.hpp"
@@ -111,7 +113,8 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 
 const std::vector<std::string>& optional_metric_names() {
   static const std::vector<std::string> names = {"symplecticity_defect", "period_measured",
-                                                 "energy_growth_exponent"};
+                                                 "energy_growth_exponent", "mode_freq_err_max",
+                                                 "mode_damping_max"};
   return names;
 }
 
@@ -158,6 +161,72 @@ double symplecticity_defect(const std::string& method_spec, const Problem& probl
   Eigen::MatrixXd tangent;
   if (!method->step_tangent(problem, start, h, tangent).ok) return kNaN;
   return symplecticity_defect(tangent);
+}
+
+std::string normal_modes_not_applicable(const Integrator& method, const Problem& problem) {
+  if (!problem.is_linear()) return "not a linear problem (Problem::is_linear)";
+  return symplecticity_defect_not_applicable(method, problem);
+}
+
+std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
+                                                const Problem& problem, double h) {
+  const auto method = make_integrator(method_spec);
+  if (!normal_modes_not_applicable(*method, problem).empty()) return {};
+  State state = problem.initial_state();
+  method->reset(problem, state, h);
+  Eigen::MatrixXd tangent;
+  if (!method->step_tangent(problem, state, h, tangent).ok || !tangent.allFinite()) return {};
+  const long n = problem.dof();
+  SparseMatrix hessian;
+  problem.hessian(problem.initial_state().q, hessian);
+  const Eigen::MatrixXd stiffness(hessian);
+  const Eigen::MatrixXd mass = problem.mass().asDiagonal();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, mass);
+  const Eigen::MatrixXd& shapes = solver.eigenvectors();  // VᵀMV = I
+  // Modal coordinates: (x, y) = (VᵀM q, Vᵀp), inverse (q, p) = (V x, M V y).
+  const Eigen::MatrixXd modal_q = shapes.transpose() * mass;
+  const Eigen::MatrixXd mass_shapes = mass * shapes;
+  std::vector<DiscreteMode> modes;
+  for (long j = 0; j < n; ++j) {
+    const double x_x = modal_q.row(j) * tangent.topLeftCorner(n, n) * shapes.col(j);
+    const double x_y = modal_q.row(j) * tangent.topRightCorner(n, n) * mass_shapes.col(j);
+    const double y_x = shapes.col(j).transpose() * tangent.bottomLeftCorner(n, n) * shapes.col(j);
+    const double y_y =
+        shapes.col(j).transpose() * tangent.bottomRightCorner(n, n) * mass_shapes.col(j);
+    // λ = tr/2 ± √(tr²/4 − det) of the block [[x_x, x_y], [y_x, y_y]].
+    const double half_trace = (x_x + y_y) / 2;
+    const std::complex<double> root =
+        std::sqrt(std::complex<double>(half_trace * half_trace - (x_x * y_y - x_y * y_x)));
+    const std::complex<double> plus = half_trace + root, minus = half_trace - root;
+    DiscreteMode mode;
+    mode.omega = std::sqrt(std::max(0.0, solver.eigenvalues()[j]));
+    mode.omega_discrete = std::max(std::abs(std::arg(plus)), std::abs(std::arg(minus))) / h;
+    mode.amplitude = std::max(std::abs(plus), std::abs(minus));
+    modes.push_back(mode);
+  }
+  return modes;
+}
+
+void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
+                             const std::vector<std::string>& names,
+                             std::map<std::string, double>& metrics) {
+  const bool frequency = requested(names, "mode_freq_err_max");
+  const bool damping = requested(names, "mode_damping_max");
+  if (!frequency && !damping) return;
+  const std::vector<DiscreteMode> modes = discrete_normal_modes(method_spec, problem, h);
+  if (modes.empty()) return;
+  // Rigid modes (ω = 0 to rounding, a free chain's translation) have no relative error.
+  const double rigid = 1e-8 * modes.back().omega;
+  double frequency_error = 0, damping_error = 0;
+  for (const DiscreteMode& mode : modes) {
+    if (mode.omega > rigid) {
+      frequency_error =
+          std::max(frequency_error, std::abs(mode.omega_discrete - mode.omega) / mode.omega);
+    }
+    damping_error = std::max(damping_error, std::abs(mode.amplitude - 1));
+  }
+  if (frequency) metrics["mode_freq_err_max"] = frequency_error;
+  if (damping) metrics["mode_damping_max"] = damping_error;
 }
 
 std::vector<std::unique_ptr<Observer>> make_optional_observers(

@@ -35,6 +35,31 @@ double symplecticity_defect(const Eigen::MatrixXd& tangent);
 std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem);
 bool symplecticity_defect_applies(const Integrator& method, const Problem& problem);
 
+// One normal mode of a linear problem (Problem::is_linear) and of a method's one-step map on it:
+// ω from the generalised eigenproblem K v = ω²M v (K = ∇²V), and the pair of eigenvalues
+// λ = ρe^{±iθ} of DΦ on that mode's (q, p) plane, as the discrete frequency ω̃ = θ/h and the
+// amplitude factor per step ρ = max |λ| (1 for a stable symplectic method).
+struct DiscreteMode {
+  double omega = 0;           // continuous frequency
+  double omega_discrete = 0;  // θ/h, θ ∈ [0, π]
+  double amplitude = 0;       // ρ
+};
+// Why the normal-mode metrics do not apply, or "": they need a linear problem and the
+// linearised step (symplecticity_defect_not_applicable).
+std::string normal_modes_not_applicable(const Integrator& method, const Problem& problem);
+// The modes in increasing ω, each with its discrete counterpart: DΦ from step_tangent at the
+// problem's initial state (the map is linear, so any state gives the same), transformed to the
+// M-orthonormal modal coordinates (q = V x, p = M V y), where every method here (a function of
+// hM⁻¹K) is block diagonal with one 2×2 block per mode; the eigenvalues of DΦ are those of the
+// blocks. Empty when not applicable or the step fails.
+std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
+                                                const Problem& problem, double h);
+// mode_freq_err_max = max over modes with ω > 0 of |ω̃ − ω|/ω, mode_damping_max = max |ρ − 1|;
+// added to `metrics` when asked for in `names` and applicable.
+void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
+                             const std::vector<std::string>& names,
+                             std::map<std::string, double>& metrics);
+
 // Observers for the requested optional trajectory metrics that apply to `problem`.
 std::vector<std::unique_ptr<Observer>> make_optional_observers(
     const Problem& problem, const std::vector<std::string>& names);

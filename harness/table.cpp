@@ -103,6 +103,8 @@ const std::vector<std::string>& standard_columns() {
                                                    "constraint_err_max",
                                                    "constraint_vel_err_max",
                                                    "symplecticity_defect",
+                                                   "mode_freq_err_max",
+                                                   "mode_damping_max",
                                                    "error_final",
                                                    "error_max",
                                                    "phase_err",

@@ -20,6 +20,7 @@ class OscillatorBase : public Problem {
   double potential(const Vec& q) const override { return 0.5 * stiffness() * q[0] * q[0]; }
   void gradient(const Vec& q, Vec& g) const override { HarmonicGradient{stiffness()}(q, g); }
   FixedGradient fixed_gradient() const override { return HarmonicGradient{stiffness()}; }
+  bool is_linear() const override { return true; }
   void hessian(const Vec&, SparseMatrix& H) const override {
     H.resize(1, 1);
     H.setZero();

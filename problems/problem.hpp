@@ -85,6 +85,10 @@ class Problem {
   virtual double period() const;
   // Highest linearised frequency at q (for stability reports). Only when has(kOmegaMax).
   virtual double omega_max(const Vec& q) const;
+  // Whether V is quadratic (∇²V = K constant, needs kHessian): the normal modes K v = ω²M v are
+  // then the motion's, and a method's one-step map is linear, so its linearised step is the map
+  // itself (the normal-mode metrics, harness/structure_metrics.hpp).
+  virtual bool is_linear() const { return false; }
 
   // Holonomic constraints g(q) = 0 (PAPER.md §3, docs/METHOD.md "Constraints"). Only when
   // has(kConstraints). The motion is M q̈ = −∇V(q) + F − G(q)ᵀλ, G = ∂g/∂q, with m =

@@ -76,6 +76,7 @@ class SpringChain final : public Problem {
     }
   }
 
+  bool is_linear() const override { return config_.alpha == 0 && config_.beta == 0; }
   void hessian(const Vec& q, SparseMatrix& H) const override {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(4 * springs());

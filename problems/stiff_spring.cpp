@@ -49,6 +49,7 @@ class StiffSpring final : public Problem {
     g.resize(2);
     g << soft_ * q[0] - tension, tension;
   }
+  bool is_linear() const override { return true; }
   void hessian(const Vec&, SparseMatrix& H) const override {
     H.resize(2, 2);
     H.setZero();

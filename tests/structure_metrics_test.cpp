@@ -118,6 +118,83 @@ TEST(SymplecticityDefect, UnknownMetricNameIsAnInputError) {
   EXPECT_NO_THROW(check_optional_metrics(optional_metric_names(), "--metric"));
 }
 
+// Normal modes of the discrete map against the closed forms on a linear chain of 0.7 masses with
+// fixed ends (GNI §I.5, §XIII.2): Störmer–Verlet's step matrix has trace 2 − (hω)², so
+// cos hω̃ = 1 − (hω)²/2, ω̃ = (2/h) arcsin(hω/2); the implicit midpoint rule's eigenvalues are
+// (1 + ihω/2)/(1 − ihω/2), ω̃ = (2/h) arctan(hω/2); both with ρ = 1. Explicit Euler's are
+// 1 ± ihω: ρ = √(1 + h²ω²), ω̃ = arctan(hω)/h.
+TEST(NormalModes, DiscreteFrequenciesFollowTheClosedForms) {
+  const auto chain = make_problem("spring_chain:n=5,mass=0.7,stiffness=1.3,ends=free");
+  const double h = 0.5;
+  struct Case {
+    std::string spec;
+    double (*frequency)(double h, double omega);
+    double (*amplitude)(double h, double omega);
+  };
+  const std::vector<Case> cases = {
+      {"stormer_verlet", [](double h, double w) { return 2 / h * std::asin(h * w / 2); },
+       [](double, double) { return 1.0; }},
+      {"implicit_midpoint", [](double h, double w) { return 2 / h * std::atan(h * w / 2); },
+       [](double, double) { return 1.0; }},
+      {"explicit_euler", [](double h, double w) { return std::atan(h * w) / h; },
+       [](double h, double w) { return std::sqrt(1 + h * h * w * w); }}};
+  for (const Case& c : cases) {
+    const std::vector<DiscreteMode> modes = discrete_normal_modes(c.spec, *chain, h);
+    ASSERT_EQ(modes.size(), 5u) << c.spec;
+    EXPECT_LE(modes.front().omega, 1e-7) << "the free chain's translation";
+    for (const DiscreteMode& mode : modes) {
+      std::printf("%-18s omega %.6f discrete %.12f rho %.15f\n", c.spec.c_str(), mode.omega,
+                  mode.omega_discrete, mode.amplitude);
+      EXPECT_NEAR(mode.omega_discrete, c.frequency(h, mode.omega), 1e-13) << c.spec;
+      EXPECT_NEAR(mode.amplitude, c.amplitude(h, mode.omega), 1e-13) << c.spec;
+    }
+  }
+}
+
+// The columns: Störmer–Verlet's largest relative frequency error on the harmonic oscillator is
+// (2/(hω)) arcsin(hω/2) − 1 ≈ (hω)²/24, reported only for linear problems and when asked for.
+TEST(NormalModes, MetricsAreReportedForLinearProblemsOnly) {
+  const RunRecord harmonic = run_with("harmonic:omega=3", "stormer_verlet", 0.1, 1,
+                                      {"mode_freq_err_max", "mode_damping_max"});
+  ASSERT_TRUE(harmonic.metrics.count("mode_freq_err_max"));
+  EXPECT_NEAR(harmonic.metrics.at("mode_freq_err_max"), 2 / 0.3 * std::asin(0.15) - 1, 1e-13);
+  EXPECT_LE(harmonic.metrics.at("mode_damping_max"), 1e-14);
+  EXPECT_NO_THROW(to_row(harmonic));
+  EXPECT_FALSE(run_with("pendulum", "stormer_verlet", 0.1, 1, {"mode_freq_err_max"})
+                   .metrics.count("mode_freq_err_max"));
+  EXPECT_FALSE(run_with("harmonic:omega=3", "stormer_verlet", 0.1, 1, {})
+                   .metrics.count("mode_freq_err_max"));
+  EXPECT_NE(normal_modes_not_applicable(*make_integrator("stormer_verlet"),
+                                        *make_problem("spring_chain:model=fpu_beta")),
+            "");
+}
+
+// A problem that declares itself linear has a constant Hessian K and ∇V(q) = K q.
+TEST(NormalModes, LinearProblemsHaveAConstantHessian) {
+  int linear = 0;
+  for (const auto& spec : problem_test_specs()) {
+    const auto problem = make_problem(spec);
+    if (!problem->is_linear()) continue;
+    ++linear;
+    ASSERT_TRUE(problem->has(kHessian)) << spec;
+    const State state = problem->initial_state();
+    const Vec shifted = state.q + Vec::LinSpaced(state.q.size(), 0.3, -0.7);
+    SparseMatrix at_state, at_shifted;
+    problem->hessian(state.q, at_state);
+    problem->hessian(shifted, at_shifted);
+    const Eigen::MatrixXd stiffness(at_state);
+    EXPECT_LE((stiffness - Eigen::MatrixXd(at_shifted)).cwiseAbs().maxCoeff(),
+              1e-12 * stiffness.cwiseAbs().maxCoeff())
+        << spec;
+    Vec gradient;
+    problem->gradient(shifted, gradient);
+    EXPECT_LE((gradient - stiffness * shifted).cwiseAbs().maxCoeff(),
+              1e-12 * stiffness.cwiseAbs().maxCoeff() * shifted.cwiseAbs().maxCoeff())
+        << spec;
+  }
+  EXPECT_GE(linear, 4);
+}
+
 // Störmer–Verlet's period error is O(h²): halving dt divides it by ~4.
 TEST(PeriodMeasured, PendulumPeriodConvergesAtSecondOrder) {
   const RunRecord coarse =
