@@ -20,6 +20,7 @@
 #include "harness/reference_generator.hpp"
 #include "harness/run.hpp"
 #include "harness/shard.hpp"
+#include "harness/structure_metrics.hpp"
 #include "harness/sweep.hpp"
 
 namespace geomint {
@@ -34,8 +35,8 @@ constexpr int kExitFailed = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 3;
 
-const std::vector<std::string> kCommands = {"list",  "run",   "order",     "sweep",
-                                            "merge", "slurm", "reference", "gate"};
+const std::vector<std::string> kCommands = {"list",  "run",       "order", "sweep", "merge",
+                                            "slurm", "reference", "gate",  "modes"};
 
 // CLI11 says "A subcommand is required" for a missing or unknown verb; say which verbs exist.
 // Returns false (message printed) when argv[1] is not an option and not a command.
@@ -284,6 +285,13 @@ int run_main(int argc, char** argv) {
                         "spacing of the written rows (> 0; default: t-end/100; must divide t-end)");
   reference->add_option("--out", out_path, "output file (default: results/references/...)");
 
+  auto* modes = app.add_subcommand(
+      "modes",
+      "Print the normal modes of a method's one-step map on a linear problem (README \"Metrics\")");
+  modes->add_option("--problem", problem_spec, "linear problem spec")->required();
+  modes->add_option("--method", method_spec, "method spec")->required();
+  modes->add_option("--dt", dt, "step (> 0)")->required();
+
   std::string gates_path;
   std::vector<std::string> gate_results;
   auto* gate = app.add_subcommand(
@@ -387,6 +395,34 @@ int run_main(int argc, char** argv) {
       fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
                  study.record.declared_order, to_row(study.record).at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
+      return 0;
+    }
+    if (*modes) {
+      if (!(dt > 0)) throw InputError(fmt::format("--dt must be > 0 (got {})", dt));
+      const auto problem = make_problem(problem_spec);
+      const auto method = make_integrator(method_spec);
+      const Applicability can_run = applicable(*method, *problem);
+      if (!can_run.ok) throw InputError(can_run.reason);
+      const std::string why_not = normal_modes_not_applicable(*method, *problem);
+      if (!why_not.empty()) {
+        throw InputError(
+            fmt::format("modes: {} on {}: {}", method->spec(), problem->spec(), why_not));
+      }
+      const std::vector<DiscreteMode> table = discrete_normal_modes(method_spec, *problem, dt);
+      if (table.empty()) {
+        fmt::print(stderr, "geomint: modes: the step failed\n");
+        return kExitFailed;
+      }
+      // ω, the discrete ω̃ = θ/h, (ω̃ − ω)/ω (empty for a rigid mode) and ρ, one row per mode.
+      fmt::print("mode,omega,omega_discrete,freq_err_rel,rho\n");
+      for (size_t j = 0; j < table.size(); ++j) {
+        const DiscreteMode& mode = table[j];
+        const bool rigid = mode.omega <= 1e-8 * table.back().omega;
+        fmt::print(
+            "{},{:.17g},{:.17g},{},{:.17g}\n", j + 1, mode.omega, mode.omega_discrete,
+            rigid ? "" : fmt::format("{:.17g}", (mode.omega_discrete - mode.omega) / mode.omega),
+            mode.amplitude);
+      }
       return 0;
     }
     if (*reference) {

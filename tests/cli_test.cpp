@@ -149,6 +149,21 @@ TEST(Cli, FailedRunIsARowWithExitOne) {
   EXPECT_NE(outcome.output.find(",diverged,"), std::string::npos) << outcome.output;
 }
 
+// `modes` prints one row per normal mode (ω, ω̃, relative error, ρ); a nonlinear problem or a
+// method without a linearised step is bad input naming the reason. Störmer–Verlet on the harmonic
+// oscillator at hω = 0.5: ω̃ = (2/h) arcsin(hω/2) = 1.0107…
+TEST(Cli, ModesPrintsOneRowPerModeAndRejectsNonlinearProblems) {
+  const Outcome outcome = geomint("modes --problem harmonic --method stormer_verlet --dt 0.5");
+  EXPECT_EQ(outcome.exit_code, 0) << outcome.output;
+  EXPECT_NE(outcome.output.find("mode,omega,omega_discrete,freq_err_rel,rho\n1,1,1.0107"),
+            std::string::npos)
+      << outcome.output;
+  const Outcome nonlinear = geomint("modes --problem pendulum --method stormer_verlet --dt 0.1");
+  EXPECT_EQ(nonlinear.exit_code, 2) << nonlinear.output;
+  EXPECT_NE(nonlinear.output.find("not a linear problem"), std::string::npos) << nonlinear.output;
+  EXPECT_EQ(geomint("modes --problem harmonic --method cvode_bdf --dt 0.1").exit_code, 2);
+}
+
 // --initial appends the spec key initial=FILE: the row's problem names the file, and a file of
 // the wrong length is exit 2 naming the problem's n, for run and order alike.
 TEST(Cli, InitialStateFileStartsTheRunAndIsChecked) {
