@@ -288,6 +288,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   }
   result.ok = outcome.status.ok;
   result.final_state = state;
+  result.final_impulses = integrator->last_constraint_impulses();
   record.status = outcome.status.ok ? "ok" : outcome.status.reason;
   if (!outcome.status.ok) {
     record.message = outcome.status.message;

@@ -257,13 +257,14 @@ std::string describe(const ConstrainedStepResult& result) {
       newton.converged ? "" : fmt::format(" ({})", newton.reason));
 }
 
-void project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p) {
+Vec project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p) {
   SparseMatrix jacobian;
   problem.constraint_jacobian(q, jacobian);
   const Eigen::MatrixXd G = Eigen::MatrixXd(jacobian);
   const Eigen::MatrixXd G_Minv = G * problem.inverse_mass().asDiagonal();
   const Vec nu = (G_Minv * G.transpose()).ldlt().solve(G_Minv * p);
   p -= G.transpose() * nu;
+  return nu;
 }
 
 }  // namespace geomint

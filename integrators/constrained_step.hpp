@@ -42,7 +42,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
 std::string describe(const ConstrainedStepResult& result);
 
 // p ← p − G(q)ᵀν with (G M⁻¹ Gᵀ)ν = G M⁻¹ p: the M⁻¹-orthogonal projection onto the tangent
-// space at q (the second multiplier of RATTLE), so that G(q) M⁻¹ p = 0.
-void project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p);
+// space at q (the second multiplier of RATTLE), so that G(q) M⁻¹ p = 0. Returns the impulse ν.
+Vec project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p);
 
 }  // namespace geomint

@@ -97,6 +97,7 @@ class DiscreteLagrangianVI final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    constraint_impulses_.reset();
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -161,6 +162,7 @@ class DiscreteLagrangianVI final : public Integrator {
         if (!constrained.newton.converged) {
           return StepStatus::failure(constrained.newton.reason, describe(constrained));
         }
+        constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h};
       } else {
         const NewtonResult result = newton_.solve(system, v, residual_scale);
         count_solve(result);
@@ -186,7 +188,10 @@ class DiscreteLagrangianVI final : public Integrator {
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
-    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
+    if (problem.has(kConstraints)) {
+      Vec nu = project_momentum_to_tangent_space(problem, q1, p1);
+      if (constraint_impulses_) constraint_impulses_->end = std::move(nu);
+    }
     state.q = q1;
     state.p = p1;
     state.t += h;

@@ -93,6 +93,7 @@ class HamiltonPontryagin final : public Integrator {
   const Vec& velocity() const { return velocity_; }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    constraint_impulses_.reset();
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -134,7 +135,10 @@ class HamiltonPontryagin final : public Integrator {
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
-    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
+    if (problem.has(kConstraints)) {
+      Vec nu = project_momentum_to_tangent_space(problem, q1, p1);
+      if (constraint_impulses_) constraint_impulses_->end = std::move(nu);
+    }
     state.q = q1;
     state.p = p1;
     state.t += h;
@@ -232,6 +236,7 @@ class HamiltonPontryagin final : public Integrator {
           solve_constrained_step(problem, q0_, h_, system, newton_.options(), residual_scale, v);
       count_solve(constrained.newton);
       if (!constrained.newton.converged) return failure(constrained.newton, describe(constrained));
+      constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h_};
       return StepStatus::success();
     }
     const NewtonResult result = newton_.solve(system, v, residual_scale);

@@ -113,7 +113,10 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
                           method, t, rtol, atol, ratio));
 }
 
-void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }
+void Integrator::reset(const Problem&, const State&, double) {
+  counters_ = Counters{};
+  constraint_impulses_.reset();
+}
 
 AdvanceOutcome Integrator::advance(const Problem& problem, State& state, const StepGrid& grid,
                                    StepVisitor visit) {
