@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "harness/observers.hpp"
+#include "harness/reference.hpp"
 
 namespace geomint {
 namespace {
@@ -146,12 +147,25 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
   std::vector<double> errors_q, errors_p, errors_multiplier;
   study.multiplier_applies = problem->has(kConstraints) &&
                              problem->exact_multipliers(problem->initial_state().t).has_value();
+  // What error_final was measured against: the exact solution, or the reference file the run
+  // found (car_axis: the Test Set's values); without either, the finest level
+  // (Richardson-style self-convergence).
+  std::shared_ptr<const ReferenceSolution> reference_file;
+  if (exact && !problem->has(kExact)) {
+    reference_file =
+        load_reference(reference_path(RunConfig{}.reference_dir, problem->spec()), *problem);
+  }
+  const auto reference_at = [&](double t) -> State {
+    if (!exact) return study.runs.back().final_state;
+    if (!reference_file) return problem->exact(t);
+    const int row = reference_file->row_at(t);  // error_final exists, so the row does
+    if (row < 0) return {t, Vec::Constant(problem->dof(), nan), Vec::Constant(problem->dof(), nan)};
+    return {t, reference_file->q[row], reference_file->p[row]};
+  };
   for (const auto& run : study.runs) {
     double error = nan, error_q = nan, error_p = nan, error_multiplier = nan;
     if (run.ok) {
-      // No exact solution: compare with the finest level (Richardson-style self-convergence).
-      const State reference =
-          exact ? problem->exact(run.final_state.t) : study.runs.back().final_state;
+      const State reference = reference_at(run.final_state.t);
       const double q_squared = (run.final_state.q - reference.q).squaredNorm();
       const double p_squared = (run.final_state.p - reference.p).squaredNorm();
       error_q = std::sqrt(q_squared);
