@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "harness/observers.hpp"
+#include "harness/reference.hpp"
 
 namespace geomint {
 namespace {
@@ -21,6 +22,22 @@ double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// |λ̄ − λ(t_N − h/2)|∞ for the method's discrete multiplier λ̄ = (start + end)/h, the mean
+// constraint force of its last step, which is second order about the step's midpoint and only
+// first order at either end (measured, docs/METHOD.md §3); methods without impulses fall back to
+// the state's multiplier λ(q_N, p_N) against λ(t_N).
+double multiplier_error(const Problem& problem, const RunResult& run, OrderStudy& study) {
+  const State& end = run.final_state;
+  if (run.final_impulses) {
+    const ConstraintImpulses& impulses = *run.final_impulses;
+    const Vec exact = *problem.exact_multipliers(end.t - impulses.h / 2);
+    return (impulses.mean_multiplier() - exact).lpNorm<Eigen::Infinity>();
+  }
+  study.multiplier_from_state = true;
+  const Vec exact = *problem.exact_multipliers(end.t);
+  return (problem.multipliers(end.t, end.q, end.p) - exact).lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace
@@ -125,24 +142,49 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     result.record.order_level = k;
     study.runs.push_back(std::move(result));
   }
+  const auto problem = make_problem(problem_spec);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> errors_q, errors_p, errors_multiplier;
+  study.multiplier_applies = problem->has(kConstraints) &&
+                             problem->exact_multipliers(problem->initial_state().t).has_value();
+  // What error_final was measured against: the exact solution, or the reference file the run
+  // found (car_axis: the Test Set's values); without either, the finest level
+  // (Richardson-style self-convergence).
+  std::shared_ptr<const ReferenceSolution> reference_file;
+  if (exact && !problem->has(kExact)) {
+    reference_file =
+        load_reference(reference_path(RunConfig{}.reference_dir, problem->spec()), *problem);
+  }
+  const auto reference_at = [&](double t) -> State {
+    if (!exact) return study.runs.back().final_state;
+    if (!reference_file) return problem->exact(t);
+    const int row = reference_file->row_at(t);  // error_final exists, so the row does
+    if (row < 0) return {t, Vec::Constant(problem->dof(), nan), Vec::Constant(problem->dof(), nan)};
+    return {t, reference_file->q[row], reference_file->p[row]};
+  };
   for (const auto& run : study.runs) {
-    double error = std::numeric_limits<double>::quiet_NaN();
+    double error = nan, error_q = nan, error_p = nan, error_multiplier = nan;
     if (run.ok) {
-      if (exact) {
-        error = run.record.metrics.at("error_final");
-      } else {
-        // No exact solution: compare with the finest level (Richardson-style self-convergence).
-        const State& finest = study.runs.back().final_state;
-        error = std::sqrt((run.final_state.q - finest.q).squaredNorm() +
-                          (run.final_state.p - finest.p).squaredNorm());
-      }
+      const State reference = reference_at(run.final_state.t);
+      const double q_squared = (run.final_state.q - reference.q).squaredNorm();
+      const double p_squared = (run.final_state.p - reference.p).squaredNorm();
+      error_q = std::sqrt(q_squared);
+      error_p = std::sqrt(p_squared);
+      error = exact ? run.record.metrics.at("error_final") : std::sqrt(q_squared + p_squared);
+      if (study.multiplier_applies) error_multiplier = multiplier_error(*problem, run, study);
     }
     errors.push_back(error);
+    errors_q.push_back(error_q);
+    errors_p.push_back(error_p);
+    errors_multiplier.push_back(error_multiplier);
   }
   if (!exact) {
     // The finest level is the reference, so it has no error of its own.
-    errors.back() = std::numeric_limits<double>::quiet_NaN();
+    errors.back() = errors_q.back() = errors_p.back() = nan;
   }
+  study.fit_q = fit_order(dts, errors_q);
+  study.fit_p = fit_order(dts, errors_p);
+  if (study.multiplier_applies) study.fit_multiplier = fit_order(dts, errors_multiplier);
   study.fit = fit_order(dts, errors);
   const auto method = make_integrator(method_spec);
   OrderRecord& record = study.record;
@@ -151,11 +193,26 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
   record.ran = true;
   record.t_end = t_end;
   if (std::isfinite(study.fit.order)) record.order = study.fit.order;
+  if (std::isfinite(study.fit_q.order)) record.order_q = study.fit_q.order;
+  if (std::isfinite(study.fit_p.order)) record.order_p = study.fit_p.order;
+  record.multiplier_applies = study.multiplier_applies;
+  if (std::isfinite(study.fit_multiplier.order)) {
+    record.order_multiplier = study.fit_multiplier.order;
+  }
   record.declared_order = method->info().order;
   for (int i : study.fit.used) record.points_used.push_back(dts[i]);
   record.status = std::isfinite(study.fit.order) ? "ok" : "no_fit";
   std::string note = study.fit.note;
   if (!exact) note += std::string(note.empty() ? "" : "; ") + "error vs finest level";
+  const auto add_note = [&note](const std::string& text) {
+    note += (note.empty() ? "" : "; ") + text;
+  };
+  if (study.multiplier_applies && study.multiplier_from_state) {
+    add_note("multiplier from (q, p): the method exposes none");
+  }
+  if (study.multiplier_applies && !std::isfinite(study.fit_multiplier.order)) {
+    add_note("no multiplier fit: " + study.fit_multiplier.note);
+  }
   if (!note.empty()) record.message = note;
   return study;
 }

@@ -22,9 +22,17 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
                    double plateau_floor = 1e-13);
 
 struct OrderStudy {
-  OrderFit fit;
-  std::vector<RunResult> runs;  // one per ladder level
-  OrderRecord record;           // the order.csv row
+  OrderFit fit;  // of ‖(q, p) − exact‖ (error_final)
+  // The same fit on the final ‖q − q_exact‖ and ‖p − p_exact‖ alone (or against the finest level).
+  OrderFit fit_q, fit_p;
+  // |λ̄ − λ(t_N − h/2)|∞ with λ̄ the method's discrete multiplier (docs/METHOD.md §3, "Discrete
+  // multiplier"), or |λ(q_N, p_N) − λ(t_N)|∞ from the state for methods that expose none; only
+  // when the problem has exact_multipliers() (multiplier_applies).
+  OrderFit fit_multiplier;
+  bool multiplier_applies = false;
+  bool multiplier_from_state = false;  // the fallback above was used
+  std::vector<RunResult> runs;         // one per ladder level
+  OrderRecord record;                  // the order.csv row
 };
 
 // Ladder length: at least 3 points for a fit, at most kMaxOrderLevels (dt0·2⁻²⁹ is already far
@@ -38,7 +46,8 @@ void validate_order_study(const std::string& problem_spec, const std::string& me
                           double dt0, long levels, double t_end);
 
 // Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing, and fits error_final (or, for
-// problems without an exact solution, the difference to the finest level — noted in the row).
+// problems without an exact solution, the difference to the finest level — noted in the row),
+// the q and p parts of it, and the multiplier error where the problem knows its exact value.
 // Validates everything first (validate_order_study), so bad input throws before any run.
 OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
                        int levels, double t_end, double diverge_factor = kDefaultDivergeFactor);

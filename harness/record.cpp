@@ -119,16 +119,28 @@ std::vector<std::string> record_columns(const std::vector<RunRecord>& records) {
   return columns_of(record_schema(), records);
 }
 
+namespace {
+// A fitted order to 3 decimals, empty when there was no fit, no cell when the ladder did not run.
+std::optional<std::string> fitted_order_cell(const OrderRecord& r,
+                                             const std::optional<double>& order) {
+  if (!r.ran) return std::nullopt;
+  return order ? fmt::format("{:.3f}", *order) : "";
+}
+}  // namespace
+
 const std::vector<Column<OrderRecord>>& order_schema() {
   using Cell = std::optional<std::string>;
   static const std::vector<Column<OrderRecord>> schema = {
       {"label", [](const OrderRecord& r) { return r.label; }},
       {"problem", [](const OrderRecord& r) { return Cell(r.problem); }},
       {"method", [](const OrderRecord& r) { return Cell(r.method); }},
-      {"order",
+      {"order", [](const OrderRecord& r) { return fitted_order_cell(r, r.order); }},
+      {"order_q", [](const OrderRecord& r) { return fitted_order_cell(r, r.order_q); }},
+      {"order_p", [](const OrderRecord& r) { return fitted_order_cell(r, r.order_p); }},
+      {"order_multiplier",
        [](const OrderRecord& r) -> Cell {
-         if (!r.ran) return std::nullopt;
-         return r.order ? fmt::format("{:.3f}", *r.order) : "";
+         if (r.ran && !r.multiplier_applies) return "n/a";
+         return fitted_order_cell(r, r.order_multiplier);
        }},
       {"declared_order",
        [](const OrderRecord& r) -> Cell {

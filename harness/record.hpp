@@ -37,8 +37,12 @@ struct RunRecord {
 struct OrderRecord {
   std::optional<std::string> label;  // [[orders]] block label (sweeps)
   std::string problem, method;
-  bool ran = false;                    // the ladder ran: the fit columns are written
-  std::optional<double> order;         // the fitted order; nullopt: no fit
+  bool ran = false;             // the ladder ran: the fit columns are written
+  std::optional<double> order;  // the fitted order; nullopt: no fit
+  // The same fit on ‖q − q_exact‖, ‖p − p_exact‖ and |λ − λ_exact| alone (harness/order.hpp);
+  // multiplier_applies is false when the problem has no exact multipliers (column "n/a").
+  std::optional<double> order_q, order_p, order_multiplier;
+  bool multiplier_applies = false;
   int declared_order = 0;              // MethodInfo::order
   std::vector<double> points_used;     // dt of the ladder points in the fit
   std::string status;                  // ok, no_fit, error

@@ -140,8 +140,18 @@ TEST(OrderRecord, FitColumnsOnlyForStudiesThatRan) {
   EXPECT_EQ(columns_of(order_schema(), std::vector<OrderRecord>{failed}),
             (std::vector<std::string>{"problem", "method", "status", "message"}));
   EXPECT_EQ(columns_of(order_schema(), std::vector<OrderRecord>{failed, no_fit}),
-            (std::vector<std::string>{"problem", "method", "order", "declared_order", "points_used",
-                                      "status", "message", "t_end"}));
+            (std::vector<std::string>{"problem", "method", "order", "order_q", "order_p",
+                                      "order_multiplier", "declared_order", "points_used", "status",
+                                      "message", "t_end"}));
+  // The multiplier's order is n/a where the problem knows no exact multiplier, empty without a fit.
+  EXPECT_EQ(row.at("order_multiplier"), "n/a");
+  OrderRecord constrained = fitted;
+  constrained.multiplier_applies = true;
+  EXPECT_EQ(to_row(constrained).at("order_multiplier"), "");
+  constrained.order_multiplier = 1.9912;
+  constrained.order_q = 2.0004;
+  EXPECT_EQ(to_row(constrained).at("order_multiplier"), "1.991");
+  EXPECT_EQ(to_row(constrained).at("order_q"), "2.000");
 }
 
 }  // namespace

@@ -289,6 +289,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   add_normal_mode_metrics(method_spec, *problem, config.dt, config.extra_metrics, record.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
+  result.final_impulses = integrator->last_constraint_impulses();
   record.status = outcome.status.ok ? "ok" : outcome.status.reason;
   if (!outcome.status.ok) {
     record.message = outcome.status.message;

@@ -47,6 +47,8 @@ struct RunResult {
   RunRecord record;  // identifiers, status, metrics, counters, wall_s
   bool ok = true;
   State final_state;
+  // The method's multiplier impulses in its last step (Integrator::last_constraint_impulses).
+  std::optional<ConstraintImpulses> final_impulses;
 };
 
 // Validates specs and config (InputError on bad input), then runs. Numerical failures are

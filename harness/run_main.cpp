@@ -395,6 +395,12 @@ int run_main(int argc, char** argv) {
       fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
                  study.record.declared_order, to_row(study.record).at("points_used"),
                  study.fit.note.empty() ? "" : "; " + study.fit.note);
+      const Row orders = to_row(study.record);
+      const auto shown = [](const std::string& cell) { return cell.empty() ? "no fit" : cell; };
+      fmt::print(stderr, "order_q {}, order_p {}, order_multiplier {}{}\n",
+                 shown(orders.at("order_q")), shown(orders.at("order_p")),
+                 shown(orders.at("order_multiplier")),
+                 study.multiplier_from_state ? " (multiplier from (q, p))" : "");
       return 0;
     }
     if (*modes) {

@@ -26,6 +26,22 @@ struct KktPoint {
   bool finite = false;
 };
 
+// g and G at one time: g(q, t) and G(q, t) for rheonomic constraints, the time-free calls
+// otherwise (so that time-free results stay bit-identical).
+struct ConstraintsAt {
+  ConstraintsAt(const Problem& problem_in, double t_in)
+      : problem(problem_in), t(t_in), rheonomic(problem_in.has(kTimeDependentConstraints)) {}
+  void value(const Vec& q, Vec& g) const {
+    rheonomic ? problem.constraint_at(t, q, g) : problem.constraint(q, g);
+  }
+  void jacobian(const Vec& q, SparseMatrix& G) const {
+    rheonomic ? problem.constraint_jacobian_at(t, q, G) : problem.constraint_jacobian(q, G);
+  }
+  const Problem& problem;
+  double t;
+  bool rheonomic;
+};
+
 // ‖G‖∞, the largest absolute row sum.
 double row_sum_norm(const Eigen::MatrixXd& G) {
   return G.rows() > 0 ? G.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
@@ -58,14 +74,15 @@ class StepMatrixSolver {
 
 }  // namespace
 
-ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& q_start, double h,
-                                             const NewtonSystem& system,
+ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& q_start,
+                                             double t_start, double h, const NewtonSystem& system,
                                              const NewtonOptions& options, double residual_scale,
                                              Vec& v) {
   ConstrainedStepResult out;
   NewtonResult& result = out.newton;
+  const ConstraintsAt start(problem, t_start), next(problem, t_start + h);
   SparseMatrix jacobian_start;
-  problem.constraint_jacobian(q_start, jacobian_start);
+  start.jacobian(q_start, jacobian_start);
   // G(q_k): the multiplier force sits at the known node (docs/METHOD.md §3), so F₁ is linear in Λ
   // and H needs no constraint-curvature term.
   const Eigen::MatrixXd G0 = Eigen::MatrixXd(jacobian_start);
@@ -81,7 +98,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
     point.v = x;
     point.impulse = impulse;
     point.q_next = q_start + h * x;
-    problem.constraint(point.q_next, point.g);
+    next.value(point.q_next, point.g);
     system.residual(x, point.F1);
     ++result.residual_evals;
     const Vec multiplier_force = G0_transpose * impulse;
@@ -105,7 +122,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
       break;
     }
     SparseMatrix jacobian_next;
-    problem.constraint_jacobian(current.q_next, jacobian_next);
+    next.jacobian(current.q_next, jacobian_next);
     const Eigen::MatrixXd G1 = Eigen::MatrixXd(jacobian_next);
     const double g_threshold =
         kConstraintTolerance * row_sum_norm(G1) * current.q_next.lpNorm<Eigen::Infinity>();
@@ -257,13 +274,21 @@ std::string describe(const ConstrainedStepResult& result) {
       newton.converged ? "" : fmt::format(" ({})", newton.reason));
 }
 
-void project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p) {
+Vec project_momentum_to_tangent_space(const Problem& problem, double t, const Vec& q, Vec& p) {
+  const ConstraintsAt at(problem, t);
   SparseMatrix jacobian;
-  problem.constraint_jacobian(q, jacobian);
+  at.jacobian(q, jacobian);
   const Eigen::MatrixXd G = Eigen::MatrixXd(jacobian);
   const Eigen::MatrixXd G_Minv = G * problem.inverse_mass().asDiagonal();
-  const Vec nu = (G_Minv * G.transpose()).ldlt().solve(G_Minv * p);
+  Vec rate = G_Minv * p;
+  if (at.rheonomic) {
+    Vec g_t, a_t;
+    problem.constraint_time_terms(t, q, problem.inverse_mass().cwiseProduct(p), g_t, a_t);
+    rate += g_t;  // G M⁻¹p + ∂g/∂t = 0 at t
+  }
+  const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);
   p -= G.transpose() * nu;
+  return nu;
 }
 
 }  // namespace geomint

@@ -19,6 +19,8 @@ struct ConstrainedStepResult {
 
 // Solves, for v (in: the start iterate, out: the last accepted one) and Λ,
 //   F₁ = R(v) + G(q_k)ᵀΛ = 0,   F₂ = g(q_k + hv)/h = 0,
+// with, for rheonomic constraints (kTimeDependentConstraints), G(q_k, t_k) in F₁ and
+// g(q_k + hv, t_k + h) in F₂ — RATTLE's extended-configuration form (integrators/rattle.cpp);
 // where R = system.residual is the unconstrained step's residual (∇E_k when system.objective is
 // E_k) and system.jacobian its symmetric Jacobian H. Converged when ‖F₁‖ ≤ tol·residual_scale
 // (options.tolerance, as the unconstrained solve) and max|g| ≤ 1e-14·‖G‖∞‖q_{k+1}‖∞ (rattle's
@@ -33,8 +35,8 @@ struct ConstrainedStepResult {
 // solve's default), then the m × m system G(q_{k+1})H⁻¹G(q_k)ᵀ (dense LU: not symmetric, since
 // the two Jacobians sit at different nodes, and m is a few rods). Never throws on numerical
 // trouble.
-ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& q_start, double h,
-                                             const NewtonSystem& system,
+ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& q_start,
+                                             double t_start, double h, const NewtonSystem& system,
                                              const NewtonOptions& options, double residual_scale,
                                              Vec& v);
 
@@ -42,7 +44,9 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
 std::string describe(const ConstrainedStepResult& result);
 
 // p ← p − G(q)ᵀν with (G M⁻¹ Gᵀ)ν = G M⁻¹ p: the M⁻¹-orthogonal projection onto the tangent
-// space at q (the second multiplier of RATTLE), so that G(q) M⁻¹ p = 0.
-void project_momentum_to_tangent_space(const Problem& problem, const Vec& q, Vec& p);
+// space at q (the second multiplier of RATTLE), so that G(q) M⁻¹ p = 0. Returns the impulse ν.
+// Rheonomic constraints: G(q, t) M⁻¹ p + ∂g/∂t(q, t) = 0 instead, the velocity constraint of the
+// moving manifold at time t (the time-free calls otherwise, so time-free runs are unchanged).
+Vec project_momentum_to_tangent_space(const Problem& problem, double t, const Vec& q, Vec& p);
 
 }  // namespace geomint

@@ -77,7 +77,7 @@ class DiscreteLagrangianVI final : public Integrator {
     unsigned flags = kSymplectic | kVariational;
     flags |= interior_.empty() ? kExplicit : (kImplicit | kNeedsHessian);
     if (symmetric_) flags |= kSymmetric;
-    if (midpoint_) flags |= kConstrained;
+    if (midpoint_) flags |= kConstrained | kRheonomic;
     return {"del", order_, flags,
             fmt::format("discrete Euler-Lagrange, quadrature L_d ({}), Marsden-West 2001 §2.3, "
                         "§3.2; Kharevych et al. 2006 §3; docs/METHOD.md §1-2",
@@ -98,6 +98,7 @@ class DiscreteLagrangianVI final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    constraint_impulses_.reset();
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -156,12 +157,13 @@ class DiscreteLagrangianVI final : public Integrator {
           state.p.norm() + (constant_ + state.p).norm() + implicit_term_.norm();
       if (problem.has(kConstraints)) {
         // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
-        const ConstrainedStepResult constrained =
-            solve_constrained_step(problem, q0_, h, system, newton_.options(), residual_scale, v);
+        const ConstrainedStepResult constrained = solve_constrained_step(
+            problem, q0_, t0_, h, system, newton_.options(), residual_scale, v);
         count_solve(constrained.newton);
         if (!constrained.newton.converged) {
           return StepStatus::failure(constrained.newton.reason, describe(constrained));
         }
+        constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h};
       } else {
         const NewtonResult result = newton_.solve(system, v, residual_scale);
         count_solve(result);
@@ -187,7 +189,10 @@ class DiscreteLagrangianVI final : public Integrator {
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
-    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
+    if (problem.has(kConstraints)) {
+      Vec nu = project_momentum_to_tangent_space(problem, state.t + h, q1, p1);
+      if (constraint_impulses_) constraint_impulses_->end = std::move(nu);
+    }
     state.q = q1;
     state.p = p1;
     state.t += h;

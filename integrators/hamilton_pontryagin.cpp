@@ -71,7 +71,7 @@ class HamiltonPontryagin final : public Integrator {
   MethodInfo info() const override {
     unsigned flags = kSymplectic | kVariational;
     flags |= (alpha_ == 0.0 || alpha_ == 1.0) ? kExplicit : (kImplicit | kNeedsHessian);
-    if (alpha_ == 0.5) flags |= kSymmetric | kConstrained;
+    if (alpha_ == 0.5) flags |= kSymmetric | kConstrained | kRheonomic;
     return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
             "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
             "§4; docs/METHOD.md §4"};
@@ -94,6 +94,7 @@ class HamiltonPontryagin final : public Integrator {
   const Vec& velocity() const { return velocity_; }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    constraint_impulses_.reset();
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -135,7 +136,10 @@ class HamiltonPontryagin final : public Integrator {
     if (plus > 0.0)
       add_plus_impulse(problem, forcing_, state, q1, h, v, plus, p1, force_, counters_);
     // The second multiplier: p_{k+1} on the tangent space at q_{k+1} (docs/METHOD.md §3).
-    if (problem.has(kConstraints)) project_momentum_to_tangent_space(problem, q1, p1);
+    if (problem.has(kConstraints)) {
+      Vec nu = project_momentum_to_tangent_space(problem, state.t + h, q1, p1);
+      if (constraint_impulses_) constraint_impulses_->end = std::move(nu);
+    }
     state.q = q1;
     state.p = p1;
     state.t += h;
@@ -240,10 +244,11 @@ class HamiltonPontryagin final : public Integrator {
     const double residual_scale = state.p.norm() + (b_ - state.p).norm() + implicit_term_.norm();
     if (problem.has(kConstraints)) {
       // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
-      const ConstrainedStepResult constrained =
-          solve_constrained_step(problem, q0_, h_, system, newton_.options(), residual_scale, v);
+      const ConstrainedStepResult constrained = solve_constrained_step(
+          problem, q0_, t0_, h_, system, newton_.options(), residual_scale, v);
       count_solve(constrained.newton);
       if (!constrained.newton.converged) return failure(constrained.newton, describe(constrained));
+      constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h_};
       return StepStatus::success();
     }
     const NewtonResult result = newton_.solve(system, v, residual_scale);

@@ -114,7 +114,10 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
                           method, t, rtol, atol, ratio));
 }
 
-void Integrator::reset(const Problem&, const State&, double) { counters_ = Counters{}; }
+void Integrator::reset(const Problem&, const State&, double) {
+  counters_ = Counters{};
+  constraint_impulses_.reset();
+}
 
 AdvanceOutcome Integrator::advance(const Problem& problem, State& state, const StepGrid& grid,
                                    StepVisitor visit) {
@@ -151,7 +154,8 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   }
   if (problem.has(kTimeDependentConstraints) && !(info.flags & kRheonomic)) {
     return {false, fmt::format("method '{}' handles only time-free constraints; problem '{}' has "
-                               "time-dependent ones (rattle, ida:index=2 or ida:index=3 solve it)",
+                               "time-dependent ones (rattle, hp, del:rule=midpoint, compositions "
+                               "over rattle or hp_midpoint, ida:index=2 or ida:index=3 solve it)",
                                method.spec(), problem.name())};
   }
   if ((info.flags & kConstraintsOnly) && !problem.has(kConstraints)) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,17 @@ struct AdvanceOutcome {
   long steps = 0;
 };
 
+// The multiplier impulses of a constrained step of length h (docs/METHOD.md §3): `start` acts
+// along G(q_k)ᵀ (RATTLE's (h/2)λ, the KKT step's Λ) and `end` along G(q_{k+1})ᵀ (the velocity
+// projection's ν), so p_{k+1} = p_k + (unconstrained impulses) − G(q_k)ᵀstart − G(q_{k+1})ᵀend.
+struct ConstraintImpulses {
+  Vec start, end;
+  double h = 0.0;
+  // (start + end)/h, the step's mean constraint force: the discrete multiplier the order study
+  // fits against λ(t_k + h/2) (docs/METHOD.md §3, "Discrete multiplier").
+  Vec mean_multiplier() const { return (start + end) / h; }
+};
+
 struct Counters {
   long steps = 0;
   long force_evals = 0;   // gradient (and force) evaluations
@@ -160,6 +172,13 @@ class Integrator {
 
   const Counters& counters() const { return counters_; }
 
+  // The multiplier impulses of the last step, for methods that solve for them (rattle, the
+  // constrained hp/del step); empty otherwise (no step since reset(), unconstrained problem,
+  // compositions, adaptive solvers).
+  const std::optional<ConstraintImpulses>& last_constraint_impulses() const {
+    return constraint_impulses_;
+  }
+
  protected:
   // Evaluation helpers that keep the counters honest.
   void eval_gradient(const Problem& problem, const Vec& q, Vec& g);
@@ -170,6 +189,7 @@ class Integrator {
   void eval_total_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
 
   Counters counters_;
+  std::optional<ConstraintImpulses> constraint_impulses_;  // cleared by reset()
 
  private:
   Vec extra_force_;  // eval_total_force's F(q, v, t), kept to avoid an allocation per call

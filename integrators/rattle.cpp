@@ -61,6 +61,7 @@ class Rattle final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    constraint_impulses_.reset();
     const Vec& inverse_mass = problem.inverse_mass();
     eval_total_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
     Vec p_half = state.p + (h / 2) * force_;
@@ -111,6 +112,7 @@ class Rattle final : public Integrator {
     // p½ = M(q⁺ − q)/h with the multipliers' impulse; written from Λ so that no difference of
     // nearby positions is divided by h.
     p_half -= (1 / h) * (Eigen::MatrixXd(G_start_).transpose() * Lambda);
+    ConstraintImpulses impulses{Lambda / h, Vec::Zero(Lambda.size()), h};  // start = (h/2)λ
     state.q = q_next;
     state.t += h;
     eval_total_force(problem, state.q, inverse_mass.cwiseProduct(p_half), state.t, force_);
@@ -129,9 +131,11 @@ class Rattle final : public Integrator {
       }
       const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);
       state.p -= G.transpose() * nu;
+      impulses.end = nu;
       ++counters_.linear_solves;
       ++counters_.factorizations;
     }
+    constraint_impulses_ = std::move(impulses);
     ++counters_.steps;
     return StepStatus::success();
   }

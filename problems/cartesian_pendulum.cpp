@@ -73,6 +73,15 @@ class CartesianPendulum final : public Problem {
     const PendulumMotion::Angle angle = motion_.at(t);
     return state_at(t, angle.theta, angle.theta_dot);
   }
+  // The rod tension from the angle motion: the radial part of M q̈ = −∇V − Gᵀλ with G = q̂ᵀ
+  // gives −mLθ̇² = mg cos θ − λ, so λ = m(Lθ̇² + g cos θ) — a closed form independent of
+  // multipliers()' index reduction.
+  std::optional<Vec> exact_multipliers(double t) const override {
+    if (!has(kExact)) return std::nullopt;
+    const PendulumMotion::Angle angle = motion_.at(t);
+    return Vec::Constant(1, mass_ * (length_ * angle.theta_dot * angle.theta_dot +
+                                     gravity_ * std::cos(angle.theta)));
+  }
   double period() const override {
     if (!has(kPeriod)) return Problem::period();
     return motion_.period();

@@ -142,6 +142,8 @@ void Problem::constraint_hessian(const Vec&, const Vec&, SparseMatrix&) const {
   missing(*this, "constraint Hessian");
 }
 
+std::optional<Vec> Problem::exact_multipliers(double) const { return std::nullopt; }
+
 void Problem::constraint_at(double, const Vec& q, Vec& g) const { constraint(q, g); }
 void Problem::constraint_jacobian_at(double, const Vec& q, SparseMatrix& G) const {
   constraint_jacobian(q, G);

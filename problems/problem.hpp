@@ -76,6 +76,10 @@ class Problem {
   virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
   // Exact solution. Only when has(kExact).
   virtual State exact(double t) const;
+  // The exact motion's multipliers λ(t) (same sign and units as multipliers()), from the problem's
+  // own closed form; nullopt when it has none (the default). The order study fits the methods'
+  // discrete multipliers against it (harness/order.cpp, docs/METHOD.md §3).
+  virtual std::optional<Vec> exact_multipliers(double t) const;
   // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
   virtual Vec linear_momentum(const Vec& q, const Vec& p) const;
   // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when
