@@ -105,6 +105,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "symplecticity_defect",
                                                    "error_final",
                                                    "error_max",
+                                                   "scd",
                                                    "phase_err",
                                                    "period_err",
                                                    "period_measured",
