@@ -55,7 +55,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
     first_order(problem, t + h / 2, stage_q_, dq_[2]);
     stage_q_ = y + h * dq_[2];
     first_order(problem, t + h, stage_q_, dq_[3]);
-    state.q += (h / 6) * (dq_[0] + 2 * dq_[1] + 2 * dq_[2] + dq_[3]);
+    state.q += (h / 6) * (dq_[0] + 2 * (dq_[1] + dq_[2]) + dq_[3]);
     state.t = t + h;
     ++counters_.steps;
   }
