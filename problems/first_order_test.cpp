@@ -96,6 +96,11 @@ TEST(FirstOrderProblems, TestSetInitialValuesAndReferences) {
   vdpol->first_order_rhs(0.0, vdpol->initial_state().q, f);
   EXPECT_EQ(f[1], -2.0 / 1.0e-6);
   EXPECT_FALSE(make_problem("van_der_pol:mu=10")->has(kEndReference));
+  // μ = 10⁶: ε = 1e-12, with a computed reference at t = 2.
+  const auto stiffest = make_problem("van_der_pol:mu=1e6");
+  EXPECT_TRUE(stiffest->has(kEndReference));
+  stiffest->first_order_rhs(0.0, stiffest->initial_state().q, f);
+  EXPECT_EQ(f[1], -2.0 / 1.0e-12);
 
   const auto rober = make_problem("robertson");
   EXPECT_EQ(rober->initial_state().q, (Vec(3) << 1.0, 0.0, 0.0).finished());
