@@ -137,7 +137,8 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 }
 
 bool symplecticity_defect_applies(const Integrator& method, const Problem& problem) {
-  return !(method.info().flags & kAdaptive) && !problem.has(kForce) && !problem.has(kConstraints);
+  return !(method.info().flags & kAdaptive) && !problem.has(kForce) && !problem.has(kConstraints) &&
+         !problem.has(kFirstOrderOnly);
 }
 
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,

@@ -89,5 +89,24 @@ TEST(FirstOrderRuns, TightCvodeRunsReproduceTheTestSetReferences) {
   EXPECT_EQ(short_run.record.metrics.count("scd"), 0u);
 }
 
+// The commands and options written for (q, p) refuse a first-order problem with an input error
+// or leave their metric out, instead of crashing (both crashed before).
+TEST(FirstOrderRuns, LagrangianOnlyOptionsRefuseOrSkip) {
+  try {
+    make_problem("robertson:initial=/nonexistent.csv");
+    FAIL() << "initial= accepted on a first-order problem";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("first-order"), std::string::npos) << error.what();
+  }
+  RunConfig config;
+  config.dt = 1e-3;
+  config.t_end = 0.05;
+  config.timing_repeats = 0;
+  config.extra_metrics = {"symplecticity_defect", "period_measured", "energy_growth_exponent"};
+  const RunResult result = run_one("van_der_pol:mu=10", "rk4", config);
+  EXPECT_TRUE(result.ok);
+  EXPECT_EQ(result.record.metrics.count("symplecticity_defect"), 0u);
+}
+
 }  // namespace
 }  // namespace geomint
