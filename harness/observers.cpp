@@ -284,9 +284,53 @@ class PericentreObserver : public Observer {
   std::vector<double> passages_;
 };
 
+// At a step point on Problem::end_reference_time() (within 1e-9 relative; the run's t_end must
+// be that time): error_final = ‖(q, p) − (q_ref, p_ref)‖₂ and scd = significant correct digits,
+// the IVP Test Set's definition −log₁₀ maxᵢ |xᵢ − xᵢ_ref| / |xᵢ_ref| over every component of
+// (q, p) (relative error, max norm; components with x_ref = 0 are left out). On Pleiades p = m v
+// with exact masses, so p's relative errors are v's, as the Test Set states them.
+class EndReferenceObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State&, double) override {
+    time_ = problem.end_reference_time();
+    reference_ = problem.end_reference();
+  }
+  void observe(const Problem&, const State& state) override {
+    if (std::abs(state.t - time_) > 1e-9 * std::max(1.0, std::abs(time_))) return;
+    reached_ = true;
+    error_ =
+        std::sqrt((state.q - reference_.q).squaredNorm() + (state.p - reference_.p).squaredNorm());
+    worst_relative_ =
+        std::max(worst_relative(state.q, reference_.q), worst_relative(state.p, reference_.p));
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    if (!reached_) return;
+    metrics["error_final"] = error_;
+    metrics["scd"] = -std::log10(worst_relative_);
+  }
+
+ private:
+  static double worst_relative(const Vec& x, const Vec& reference) {
+    double worst = 0;
+    for (Eigen::Index i = 0; i < reference.size(); ++i) {
+      if (reference[i] == 0) continue;
+      // A non-finite component counts as no correct digit at all.
+      const double relative = std::abs(x[i] - reference[i]) / std::abs(reference[i]);
+      worst = std::isnan(relative) ? std::numeric_limits<double>::infinity()
+                                   : std::max(worst, relative);
+    }
+    return worst;
+  }
+
+  double time_ = 0, error_ = 0, worst_relative_ = 0;
+  State reference_;
+  bool reached_ = false;
+};
+
 }  // namespace
 
 bool has_energy_reference(const Problem& problem) {
+  if (problem.has(kFirstOrderOnly)) return false;  // no energy at all
   return !problem.has(kForce) || problem.has(kExact);
 }
 
@@ -302,6 +346,7 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
         std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
   }
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
+  if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
   if (problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce)) {
     observers.push_back(std::make_unique<PhaseObserver>());

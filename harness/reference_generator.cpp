@@ -144,6 +144,15 @@ std::string number17(double value) { return fmt::format("{:.17g}", value); }
 
 ReferenceSummary generate_reference(const ReferenceOptions& options) {
   const auto problem = make_problem(options.problem_spec);
+  if (problem->has(kFirstOrderOnly)) {
+    // The generator integrates (q, p) with ∇V; a first-order problem carries its reference instead.
+    throw InputError(fmt::format(
+        "reference: problem '{}' is a first-order ODE y' = f(t, y) without a potential; the "
+        "generator integrates Lagrangian systems only{}",
+        problem->name(),
+        problem->has(kEndReference) ? " (this one carries its own reference at its end time)"
+                                    : ""));
+  }
   if (!(options.t_end > 0 && std::isfinite(options.t_end))) {
     throw InputError(fmt::format("--t-end must be a finite number > 0 (got {})", options.t_end));
   }

@@ -181,6 +181,10 @@ TEST(Reference, BadOptionsAreInputErrors) {
   options.output_every = 1.0;
   options.t_end = -1.0;
   expect_input_error([&] { generate_reference(options); }, {"--t-end"});
+  // A first-order-only problem has no (q, p, ∇V) to integrate (it segfaulted before).
+  options.problem_spec = "robertson";
+  options.t_end = 10.0;
+  expect_input_error([&] { generate_reference(options); }, {"'robertson'", "first-order"});
   options.problem_spec = "no_such_problem";
   EXPECT_THROW(generate_reference(options), InputError);
 }

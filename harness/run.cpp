@@ -32,7 +32,9 @@ class SeriesWriter {
   SeriesWriter(const Problem& problem, const RunConfig& config, const std::string& method_spec)
       : config_(config), file_(config.series_path), out_(file_.stream()) {
     with_state_ = problem.dof() <= 64 || config.series_state;
-    std::vector<std::string> columns = {"t", "energy"};
+    first_order_ = problem.has(kFirstOrderOnly);
+    std::vector<std::string> columns = {"t"};
+    if (!first_order_) columns.push_back("energy");
     if (problem.has(kLinearMomentum)) {
       const Vec momentum =
           problem.linear_momentum(problem.initial_state().q, problem.initial_state().p);
@@ -53,8 +55,13 @@ class SeriesWriter {
       for (const auto& name : problem.multiplier_names()) columns.push_back(name);
     }
     if (with_state_) {
-      for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("q_{}", i));
-      for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("p_{}", i));
+      // A first-order-only problem's state is y alone (State::q).
+      for (int i = 0; i < problem.dof(); ++i) {
+        columns.push_back(fmt::format("{}_{}", first_order_ ? "y" : "q", i));
+      }
+      if (!first_order_) {
+        for (int i = 0; i < problem.dof(); ++i) columns.push_back(fmt::format("p_{}", i));
+      }
     }
     for (const auto& [key, value] : provenance(config.command_line)) {
       out_ << fmt::format("# {}: {}\n", key, value);
@@ -66,7 +73,8 @@ class SeriesWriter {
 
   void observe(const Problem& problem, const State& state, bool last) {
     if (count_++ % config_.series_every != 0 && !last) return;
-    line_ = format_number(state.t) + "," + format_number(problem.energy(state.q, state.p));
+    line_ = format_number(state.t);
+    if (!first_order_) line_ += "," + format_number(problem.energy(state.q, state.p));
     auto append = [this](const Vec& values) {
       for (double v : values) line_ += "," + format_number(v);
     };
@@ -94,6 +102,7 @@ class SeriesWriter {
   AtomicFileWriter file_;
   std::ostream& out_;
   bool with_state_ = true;
+  bool first_order_ = false;
   long count_ = 0;
   std::string line_;
   std::vector<double> extras_;
@@ -117,7 +126,8 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   const double t0 = state.t;
   const double energy0 = problem.energy(state.q, state.p);
   const double energy_scale = std::max(std::abs(energy0), 1e-300);
-  const bool conservative = !problem.has(kForce);
+  // First-order-only problems have no energy: the state-norm rule, as for forced ones.
+  const bool conservative = !problem.has(kForce) && !problem.has(kFirstOrderOnly);
   const bool divergence = divergence_rule_on(config.diverge_factor);
   outcome.t_reached = t0;
   // Sets outcome.status and returns false when the state fails the checks; a passing step

@@ -129,6 +129,7 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 
 std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem) {
   if (method.info().flags & kAdaptive) return "adaptive method: no fixed one-step map";
+  if (problem.has(kFirstOrderOnly)) return "first-order problem: no canonical (q, p) pair";
   if (problem.has(kForce)) return "forced problem: the step is not a Hamiltonian map";
   if (problem.has(kConstraints))
     return "constrained problem: the step acts on the constraint manifold";

@@ -107,6 +107,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "mode_damping_max",
                                                    "error_final",
                                                    "error_max",
+                                                   "scd",
                                                    "phase_err",
                                                    "period_err",
                                                    "period_measured",

@@ -68,7 +68,7 @@ class ImplicitEuler final : public Integrator {
   explicit ImplicitEuler(const NewtonOptions& newton) : newton_(newton) {}
 
   MethodInfo info() const override {
-    return {"implicit_euler", 1, kImplicit | kNeedsHessian,
+    return {"implicit_euler", 1, kImplicit | kNeedsHessian | kFirstOrderCapable,
             "backward Euler, Hairer-Wanner Solving ODEs II §IV.3; docs/METHOD.md §7"};
   }
 
@@ -104,6 +104,7 @@ class ImplicitEuler final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    if (problem.has(kFirstOrderOnly)) return step_first_order(problem, state, h);
     const Vec& mass = problem.mass();
     const double t_next = state.t + h;
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -160,6 +161,42 @@ class ImplicitEuler final : public Integrator {
   }
 
  private:
+  // Backward Euler on y' = f(t, y) (a first-order-only problem, y = state.q): Newton on
+  // R(y⁺) = y⁺ − y − h f(t + h, y⁺) with ∂R/∂y⁺ = I − h ∂f/∂y (sparse LU), from y⁺ = y, the
+  // residual relative to ‖y‖ + h‖f(t, y)‖.
+  StepStatus step_first_order(const Problem& problem, State& state, double h) {
+    const double t_next = state.t + h;
+    const Vec& y = state.q;
+    ++counters_.force_evals;
+    problem.first_order_rhs(state.t, y, force_);
+    const double residual_scale = y.norm() + std::abs(h) * force_.norm();
+    NewtonSystem system;
+    system.residual = [&](const Vec& x, Vec& residual) {
+      ++counters_.force_evals;
+      problem.first_order_rhs(t_next, x, force_);
+      residual = x - y - h * force_;
+    };
+    system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
+      ++counters_.hessian_evals;
+      problem.first_order_jacobian(t_next, x, hessian_);
+      jacobian.resize(x.size(), x.size());
+      jacobian.setIdentity();
+      jacobian -= h * hessian_;
+      jacobian.makeCompressed();
+    };
+    system.symmetric = false;
+    Vec y_next = y;
+    const NewtonResult result = newton_.solve(system, y_next, residual_scale);
+    counters_.newton_iters += result.iterations;
+    counters_.linear_solves += result.linear_solves;
+    counters_.factorizations += result.factorizations;
+    if (!result.converged) return StepStatus::failure(result.reason, describe(result));
+    state.q = y_next;
+    state.t = t_next;
+    ++counters_.steps;
+    return StepStatus::success();
+  }
+
   void add_force_jacobian(const Problem& problem, const Vec& q_start, const Vec& v, double t_next,
                           double h, SparseMatrix& jacobian) {
     if (problem.has(kForceJacobian)) {

@@ -44,14 +44,14 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
   MethodInfo info() const override {
     switch (method_) {
       case GslMethod::kRk8pd:
-        return {"gsl_rk8pd", 8, kExplicit | kAdaptive,
+        return {"gsl_rk8pd", 8, kExplicit | kAdaptive | kFirstOrderCapable,
                 "GSL odeiv2 rk8pd: embedded Runge-Kutta Prince-Dormand (8, 9)"};
       case GslMethod::kMsbdf:
         // Variable order 1..5: the declared order is the maximum.
-        return {"gsl_msbdf", 5, kImplicit | kAdaptive | kNeedsHessian,
+        return {"gsl_msbdf", 5, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
                 "GSL odeiv2 msbdf: variable-order BDF in Nordsieck form (Byrne & Hindmarsh)"};
       case GslMethod::kRk4imp:
-        return {"gsl_rk4imp", 4, kImplicit | kAdaptive | kNeedsHessian,
+        return {"gsl_rk4imp", 4, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
                 "GSL odeiv2 rk4imp: 2-stage Gauss-Legendre implicit Runge-Kutta, step doubling"};
     }
     return {};
@@ -60,13 +60,11 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
   void reset(const Problem& problem, const State& state, double h) override {
     driver_.reset();
     begin_adaptive_reset(problem, state, h);
-    const int dof = problem.dof();
-    y_.resize(2 * dof);
-    ydot_start_.resize(2 * dof);
-    Eigen::Map<Vec>(y_.data(), dof) = state.q;
-    Eigen::Map<Vec>(y_.data() + dof, dof) = state.p;
+    y_.resize(problem.first_order_size());
+    ydot_start_.resize(y_.size());
+    problem.pack_first_order(state, y_.data());
     const bool needs_jacobian = method_ != GslMethod::kRk8pd;
-    if (needs_jacobian && !problem.has(kHessian)) {
+    if (needs_jacobian && !problem.has_first_order_jacobian()) {
       setup_status_ = StepStatus::failure(
           "needs_hessian",
           fmt::format("{} needs the Jacobian, i.e. a problem Hessian", info().name));
@@ -130,9 +128,7 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
     // GSL leaves h untouched after the step that reaches t1; otherwise h is the next suggestion.
     if (t != t_stop) h_ = h;
     t_ = t;
-    const int dof = problem.dof();
-    state.q = Eigen::Map<const Vec>(y_.data(), dof);
-    state.p = Eigen::Map<const Vec>(y_.data() + dof, dof);
+    problem.unpack_first_order(y_.data(), state);
     state.t = t_;
     return StepStatus::success();
   }

@@ -85,6 +85,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kNeedsHessian, "needs_hessian"},
       {kConstraintsOnly, "constraints_only"},
       {kRheonomic, "rheonomic"},
+      {kFirstOrderCapable, "first_order"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -142,6 +143,14 @@ void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatr
 
 Applicability applicable(const Integrator& method, const Problem& problem) {
   const MethodInfo info = method.info();
+  if (problem.has(kFirstOrderOnly)) {
+    if (info.flags & kFirstOrderCapable) return {};
+    return {false,
+            fmt::format("method '{}' integrates Lagrangian systems (q, p, M, grad V); "
+                        "problem '{}' is a first-order ODE y' = f(t, y) only; methods "
+                        "that apply: {}",
+                        method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
+  }
   if ((info.flags & kNeedsHessian) && !problem.has(kHessian)) {
     return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
                                info.name, problem.name())};
@@ -172,6 +181,15 @@ std::vector<std::string> constrained_methods() {
     if (make_integrator(spec)->info().flags & kConstrained) specs.push_back(spec);
   }
   if (specs.empty()) specs.push_back("(none registered yet)");
+  return specs;
+}
+
+std::vector<std::string> first_order_methods() {
+  std::vector<std::string> specs;
+  for (const auto& spec : integrator_test_specs()) {
+    const unsigned flags = make_integrator(spec)->info().flags;
+    if ((flags & kFirstOrderCapable) && !(flags & kConstraintsOnly)) specs.push_back(spec);
+  }
   return specs;
 }
 

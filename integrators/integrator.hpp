@@ -25,6 +25,9 @@ enum MethodFlag : unsigned {
   kNeedsHessian = 1u << 7,     // needs Problem::hessian
   kConstraintsOnly = 1u << 8,  // only for problems with constraints (rattle, penalty, ida:index)
   kRheonomic = 1u << 9,        // also time-dependent constraints (kTimeDependentConstraints)
+  // Runs a generic first-order system y' = f(t, y) (Problem::first_order_rhs/_jacobian), so
+  // also the kFirstOrderOnly problems (van der Pol, Robertson); the others need (q, p, M, ∇V).
+  kFirstOrderCapable = 1u << 10,
 };
 std::vector<std::string> flag_names(unsigned flags);
 
@@ -211,6 +214,8 @@ struct Applicability {
 Applicability applicable(const Integrator& method, const Problem& problem);
 // The registry test specs whose methods handle holonomic constraints (for messages and tests).
 std::vector<std::string> constrained_methods();
+// The registry test specs whose methods run first-order-only problems (kFirstOrderCapable).
+std::vector<std::string> first_order_methods();
 
 // CVODE's "too much accuracy" test (tolsf, CVODE user guide §2.1): unit roundoff times the
 // weighted RMS norm of y with weights 1/(rtol|y_i| + atol). Above 1 the tolerances ask for less

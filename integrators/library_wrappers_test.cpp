@@ -580,19 +580,21 @@ TEST(Registry, LibraryWrappersDeclareOrderAndFlags) {
     int order;
     unsigned flags;
   };
-  const unsigned implicit_adaptive = kImplicit | kAdaptive;
+  // The ODE solvers also run first-order-only problems (kFirstOrderCapable).
+  const unsigned implicit_adaptive = kImplicit | kAdaptive | kFirstOrderCapable;
+  const unsigned explicit_adaptive = kExplicit | kAdaptive | kFirstOrderCapable;
   for (const Expected& e : {
            Expected{"cvode_bdf", 5, implicit_adaptive},
            Expected{"cvode_bdf:max_order=3", 3, implicit_adaptive},
            Expected{"cvode_adams", 12, implicit_adaptive},
            Expected{"ida", 5, implicit_adaptive},
-           Expected{"arkode_erk", 5, kExplicit | kAdaptive},
-           Expected{"arkode_erk:table=verner_8_5_6", 6, kExplicit | kAdaptive},
-           Expected{"arkode_erk:table=fehlberg_13_7_8", 8, kExplicit | kAdaptive},
-           Expected{"gsl_rk8pd", 8, kExplicit | kAdaptive},
+           Expected{"arkode_erk", 5, explicit_adaptive},
+           Expected{"arkode_erk:table=verner_8_5_6", 6, explicit_adaptive},
+           Expected{"arkode_erk:table=fehlberg_13_7_8", 8, explicit_adaptive},
+           Expected{"gsl_rk8pd", 8, explicit_adaptive},
            Expected{"gsl_msbdf", 5, implicit_adaptive | kNeedsHessian},
            Expected{"gsl_rk4imp", 4, implicit_adaptive | kNeedsHessian},
-           Expected{"odeint_dopri5", 5, kExplicit | kAdaptive},
+           Expected{"odeint_dopri5", 5, explicit_adaptive},
            Expected{"odeint_rosenbrock4", 4, implicit_adaptive | kNeedsHessian},
            Expected{"odeint_velocity_verlet", 2, kExplicit | kSymplectic | kSymmetric},
            Expected{"odeint_mclachlan4", 4, kExplicit | kSymplectic | kSymmetric},

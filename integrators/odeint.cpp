@@ -51,8 +51,8 @@ class OdeintAdaptive : public AdaptiveIntegrator {
     if (!ready_to_step(problem, state, t_stop, status)) return status;
     // Tolerances below round-off: the controller would accept ever smaller steps near t = 0
     // until the step budget runs out; say so at once, as CVODE does.
-    y_buffer_.resize(2 * state.q.size());
-    y_buffer_ << state.q, state.p;
+    y_buffer_.resize(problem.first_order_size());
+    problem.pack_first_order(state, y_buffer_.data());
     status = check_tolerances_above_roundoff(y_buffer_.data(), y_buffer_.size(),
                                              "too_much_accuracy", info().name);
     if (!status.ok) return status;
@@ -104,8 +104,8 @@ class OdeintAdaptive : public AdaptiveIntegrator {
   // Base reset plus the starting step; derived resets load their state first.
   void begin(const Problem& problem, const State& state, double h) {
     begin_adaptive_reset(problem, state, h);
-    y_buffer_.resize(2 * problem.dof());
-    y_buffer_ << state.q, state.p;
+    y_buffer_.resize(problem.first_order_size());
+    problem.pack_first_order(state, y_buffer_.data());
     try {
       problem.first_order_rhs(t_, y_buffer_, ydot_buffer_);
       ++counters_.force_evals;
@@ -139,14 +139,14 @@ class OdeintDopri5 final : public OdeintAdaptive {
   explicit OdeintDopri5(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
-    return {"odeint_dopri5", 5, kExplicit | kAdaptive,
+    return {"odeint_dopri5", 5, kExplicit | kAdaptive | kFirstOrderCapable,
             "Boost.Odeint runge_kutta_dopri5, controlled (Dormand & Prince 1980)"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
     begin(problem, state, h);
-    y_.resize(2 * problem.dof());
-    view(y_) << state.q, state.p;
+    y_.resize(problem.first_order_size());
+    problem.pack_first_order(state, view(y_).data());
     stepper_.emplace(odeint::make_controlled(settings_.atol, settings_.rtol, Stepper()));
   }
 
@@ -161,9 +161,7 @@ class OdeintDopri5 final : public OdeintAdaptive {
   }
 
   void publish(State& state) const override {
-    const int dof = static_cast<int>(y_.size() / 2);
-    state.q = view(y_).head(dof);
-    state.p = view(y_).tail(dof);
+    problem_->unpack_first_order(view(y_).data(), state);
   }
 
   StdVector y_;
@@ -183,18 +181,18 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
   explicit OdeintRosenbrock4(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
-    return {"odeint_rosenbrock4", 4, kImplicit | kAdaptive | kNeedsHessian,
+    return {"odeint_rosenbrock4", 4, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
             "Boost.Odeint rosenbrock4, controlled (Shampine 1982; Hairer & Wanner II, §IV.7)"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
     begin(problem, state, h);
-    if (setup_status_.ok && !problem.has(kHessian)) {
+    if (setup_status_.ok && !problem.has_first_order_jacobian()) {
       setup_status_ = StepStatus::failure(
           "needs_hessian", "odeint_rosenbrock4 needs the Jacobian, i.e. a problem Hessian");
     }
-    y_.resize(2 * problem.dof());
-    view(y_) << state.q, state.p;
+    y_.resize(problem.first_order_size());
+    problem.pack_first_order(state, view(y_).data());
     controller_.emplace(settings_.atol, settings_.rtol);
   }
 
@@ -232,9 +230,7 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
   }
 
   void publish(State& state) const override {
-    const int dof = static_cast<int>(y_.size() / 2);
-    state.q = view(y_).head(dof);
-    state.p = view(y_).tail(dof);
+    problem_->unpack_first_order(view(y_).data(), state);
   }
 
   UblasVector y_;

@@ -1,6 +1,7 @@
 // Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
 // F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
-// Not symplectic: the negative control of docs/METHOD.md §7.
+// Not symplectic: the negative control of docs/METHOD.md §7. On a first-order-only problem it is
+// the same tableau on y' = f(t, y).
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
@@ -11,7 +12,8 @@ namespace {
 class Rk4 final : public ExplicitStepper<Rk4> {
  public:
   MethodInfo info() const override {
-    return {"rk4", 4, kExplicit, "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
+    return {"rk4", 4, kExplicit | kFirstOrderCapable,
+            "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
   }
 
   StabilityPrediction predicted_linear_stability() const override {
@@ -48,6 +50,10 @@ class Rk4 final : public ExplicitStepper<Rk4> {
 
   // One step (ExplicitStepper runs it for step() and advance()).
   void advance_by(const Problem& problem, State& state, double h) {
+    if (problem.has(kFirstOrderOnly)) {
+      advance_first_order(problem, state, h);
+      return;
+    }
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
@@ -67,6 +73,27 @@ class Rk4 final : public ExplicitStepper<Rk4> {
   }
 
  private:
+  // y = state.q (State::p is empty on these problems).
+  void advance_first_order(const Problem& problem, State& state, double h) {
+    const double t = state.t;
+    const Vec& y = state.q;
+    first_order(problem, t, y, dq_[0]);
+    stage_q_ = y + (h / 2) * dq_[0];
+    first_order(problem, t + h / 2, stage_q_, dq_[1]);
+    stage_q_ = y + (h / 2) * dq_[1];
+    first_order(problem, t + h / 2, stage_q_, dq_[2]);
+    stage_q_ = y + h * dq_[2];
+    first_order(problem, t + h, stage_q_, dq_[3]);
+    state.q += (h / 6) * (dq_[0] + 2 * (dq_[1] + dq_[2]) + dq_[3]);
+    state.t = t + h;
+    ++counters_.steps;
+  }
+
+  void first_order(const Problem& problem, double t, const Vec& y, Vec& ydot) {
+    ++counters_.force_evals;
+    problem.first_order_rhs(t, y, ydot);
+  }
+
   void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
     dq = problem.inverse_mass().cwiseProduct(p);
     eval_total_force(problem, q, dq, t, dp);

@@ -102,14 +102,16 @@ class SundialsIntegrator : public AdaptiveIntegrator {
   SundialsIntegrator(const AdaptiveSettings& settings, std::string library)
       : AdaptiveIntegrator(settings, "SUNDIALS wrappers"), library_(std::move(library)) {}
 
-  // Base reset, a fresh context and y0 = (q, p, 0 …): `extra` zero components after (q, p) for
-  // DAE unknowns (multipliers). Returns false (setup_status_ set) on failure.
+  // Base reset, a fresh context and y0 = (q, p, 0 …) (y0 = q on a first-order-only problem):
+  // `extra` zero components after (q, p) for DAE unknowns (multipliers). Returns false
+  // (setup_status_ set) on failure.
   bool begin_reset(const Problem& problem, const State& state, int extra = 0) {
     begin_adaptive_reset(problem, state, 0.0);
     library_message_.clear();
     extra_rhs_evals_ = extra_jacobian_evals_ = 0;
     dof_ = problem.dof();
-    n_ = 2 * dof_ + extra;
+    ode_size_ = problem.first_order_size();
+    n_ = ode_size_ + extra;
     y_.reset();  // before the context it was created in
     context_.reset();
     SUNContext context = nullptr;
@@ -121,8 +123,7 @@ class SundialsIntegrator : public AdaptiveIntegrator {
     if (!y_) return setup_failed(-1, "N_VNew_Serial failed");
     auto y = view_mutable(y_.get());
     y.setZero();
-    y.head(dof_) = state.q;
-    y.segment(dof_, dof_) = state.p;
+    problem.pack_first_order(state, y.data());
     return true;
   }
 
@@ -160,9 +161,7 @@ class SundialsIntegrator : public AdaptiveIntegrator {
   // Copies the solver's y (the state of record) into State. A return at the stop time is
   // stamped with t_stop exactly, so the caller's loop ends on it without a sliver step.
   void publish(N_Vector y, double t_returned, double t_stop, bool at_stop, State& state) {
-    const auto values = view(y);
-    state.q = values.head(dof_);
-    state.p = values.segment(dof_, dof_);
+    problem_->unpack_first_order(N_VGetArrayPointer(y), state);
     t_ = at_stop ? t_stop : t_returned;
     state.t = t_;
   }
@@ -204,6 +203,7 @@ class SundialsIntegrator : public AdaptiveIntegrator {
 
   std::string library_;  // flag prefix: "cvode", "ida", "arkode"
   int dof_ = 0;
+  int ode_size_ = 0;  // length of the ODE part of y: 2·dof, or dof (first-order-only problems)
   int n_ = 0;
   std::string library_message_;
   long extra_rhs_evals_ = 0;       // evaluations made outside the library (IDA's y'(0))
@@ -245,7 +245,8 @@ class Cvode final : public SundialsIntegrator {
         nonlin_conv_coef_(nonlin_conv_coef) {}
 
   MethodInfo info() const override {
-    return {bdf_ ? "cvode_bdf" : "cvode_adams", max_order_, kImplicit | kAdaptive,
+    return {bdf_ ? "cvode_bdf" : "cvode_adams", max_order_,
+            kImplicit | kAdaptive | kFirstOrderCapable,
             bdf_ ? "SUNDIALS CVODE, variable-order BDF (CVODE user guide v6.4.1, §2.1)"
                  : "SUNDIALS CVODE, variable-order Adams-Moulton (CVODE user guide v6.4.1, §2.1)"};
   }
@@ -271,12 +272,13 @@ class Cvode final : public SundialsIntegrator {
         !check_setup(CVodeSetNonlinConvCoef(cvode, nonlin_conv_coef_), "CVodeSetNonlinConvCoef")) {
       return;
     }
-    const bool analytic = problem.has(kHessian);
+    const bool analytic = problem.has_first_order_jacobian();
     analytic_jacobian_ = analytic;
     if (solver_kind_ == LinearSolverKind::kKlu) {
       if (!analytic) {
         setup_status_ = StepStatus::failure(
-            "needs_hessian", "linear_solver=klu needs the sparse Jacobian, i.e. a problem Hessian");
+            "needs_hessian",
+            "linear_solver=klu needs the sparse Jacobian, i.e. a problem Hessian or rhs_jacobian");
         return;
       }
       // Size the sparse matrix from the Jacobian at y0 plus its diagonal (see fill_sparse).
@@ -441,7 +443,7 @@ class Ida final : public SundialsIntegrator {
 
   MethodInfo info() const override {
     if (index_ == 0) {
-      return {"ida", max_order_, kImplicit | kAdaptive,
+      return {"ida", max_order_, kImplicit | kAdaptive | kFirstOrderCapable,
               "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
     }
     return {"ida", max_order_, kImplicit | kAdaptive | kConstrained | kConstraintsOnly | kRheonomic,
@@ -495,7 +497,7 @@ class Ida final : public SundialsIntegrator {
                      "IDASetLinearSolver")) {
       return;
     }
-    analytic_jacobian_ = index_ == 0 && problem.has(kHessian);
+    analytic_jacobian_ = index_ == 0 && problem.has_first_order_jacobian();
     if (analytic_jacobian_) check_setup(IDASetJacFn(ida, &jacobian), "IDASetJacFn");
   }
 
@@ -505,7 +507,7 @@ class Ida final : public SundialsIntegrator {
     // IDA's own too-much-accuracy test (unit roundoff times the weighted RMS norm of y above 1)
     // comes after its initial-step estimate, which overflows first at such tolerances and then
     // reports "tstop is behind current t". The same test here names the real cause.
-    status = check_tolerances_above_roundoff(N_VGetArrayPointer(y_.get()), 2 * dof_, "ida_flag_-2",
+    status = check_tolerances_above_roundoff(N_VGetArrayPointer(y_.get()), ode_size_, "ida_flag_-2",
                                              "ida (IDA_TOO_MUCH_ACC)");
     if (!status.ok) return status;
     void* ida = memory_.get();
@@ -742,7 +744,8 @@ class ArkodeErk final : public SundialsIntegrator {
         api_(is_fsal(erk_tables().at(table_name_).id) ? &kErkStep : &kArkStepExplicit) {}
 
   MethodInfo info() const override {
-    return {"arkode_erk", erk_tables().at(table_name_).order, kExplicit | kAdaptive,
+    return {"arkode_erk", erk_tables().at(table_name_).order,
+            kExplicit | kAdaptive | kFirstOrderCapable,
             fmt::format("SUNDIALS ARKODE {}, table {} (ARKODE user guide v5.4.1, §8.1)", api_->name,
                         table_name_)};
   }

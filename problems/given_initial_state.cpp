@@ -18,7 +18,8 @@ class GivenInitialState final : public Problem {
   GivenInitialState(std::unique_ptr<Problem> base, State initial)
       : base_(std::move(base)), initial_(std::move(initial)) {
     set_mass(base_->mass());
-    set_capabilities(base_->capabilities() & ~(kExact | kPeriod));
+    // The exact solution, period and tabulated end state belong to the problem's own start.
+    set_capabilities(base_->capabilities() & ~(kExact | kPeriod | kEndReference));
     set_defaults(base_->default_dt(), base_->default_t_end());
   }
 
@@ -132,6 +133,12 @@ State read_initial_state(const Problem& problem, const std::string& path) {
 
 std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> problem,
                                                  const std::string& path) {
+  if (problem->has(kFirstOrderOnly)) {
+    throw InputError(
+        fmt::format("initial state: problem '{}' is a first-order ODE y' = f(t, y); "
+                    "initial= (q,p rows) applies to Lagrangian problems only",
+                    problem->name()));
+  }
   State initial = read_initial_state(*problem, path);
   return std::make_unique<GivenInitialState>(std::move(problem), std::move(initial));
 }

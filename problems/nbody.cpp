@@ -22,6 +22,9 @@ struct NBodyData {
   std::vector<double> velocities;
   double dt = 0.01;
   double t_end = 10.0;
+  // A tabulated solution (positions, velocities) at reference_t (kEndReference) when non-empty.
+  double reference_t = 0.0;
+  std::vector<double> reference_positions, reference_velocities;
 };
 
 // GNI Table 2.1: the Sun (with the inner planets' masses), Jupiter, Saturn, Uranus, Neptune,
@@ -82,6 +85,23 @@ NBodyData pleiades_data() {
   // The closest encounters come within ~0.1 at speeds ~10: h = 1e-3 resolves them.
   data.dt = 1e-3;
   data.t_end = 3.0;
+  // The Test Set's reference at t = 3 (plei.f, subroutine solut), in its order (x1…x7, y1…y7,
+  // ẋ1…ẋ7, ẏ1…ẏ7); integrators/nbody_reference_test.cpp keeps an independent copy.
+  constexpr double kReference[28] = {
+      0.3706139143970502,  3.237284092057233,   -3.222559032418324,  0.6597091455775310,
+      0.3425581707156584,  1.562172101400631,   -0.7003092922212495, -3.943437585517392,
+      -3.271380973972550,  5.225081843456543,   -2.590612434977470,  1.198213693392275,
+      -0.2429682344935824, 1.091449240428980,   3.417003806314313,   1.354584501625501,
+      -2.590065597810775,  2.025053734714242,   -1.155815100160448,  -0.8072988170223021,
+      0.5952396354208710,  -3.741244961234010,  0.3773459685750630,  0.9386858869551073,
+      0.3667922227200571,  -0.3474046353808490, 2.344915448180937,   -1.947020434263292};
+  data.reference_t = 3.0;
+  for (int i = 0; i < 7; ++i) {
+    data.reference_positions.insert(data.reference_positions.end(),
+                                    {kReference[i], kReference[7 + i]});
+    data.reference_velocities.insert(data.reference_velocities.end(),
+                                     {kReference[14 + i], kReference[21 + i]});
+  }
   return data;
 }
 
@@ -120,11 +140,21 @@ class NBody final : public Problem {
     }
     set_mass(mass);
     // Gravity depends on differences only: total linear and angular momentum are conserved.
-    set_capabilities(kHessian | kLinearMomentum | kAngularMomentum | kOmegaMax);
+    unsigned capabilities = kHessian | kLinearMomentum | kAngularMomentum | kOmegaMax;
+    if (!data.reference_positions.empty()) {
+      capabilities |= kEndReference;
+      reference_.t = data.reference_t;
+      reference_.q = Eigen::Map<const Vec>(data.reference_positions.data(), Dim * bodies_);
+      reference_.p =
+          mass.cwiseProduct(Eigen::Map<const Vec>(data.reference_velocities.data(), Dim * bodies_));
+    }
+    set_capabilities(capabilities);
     set_defaults(data.dt, data.t_end);
   }
 
   State initial_state() const override { return initial_; }
+  double end_reference_time() const override { return reference_.t; }
+  State end_reference() const override { return reference_; }
 
   double potential(const Vec& q) const override {
     double sum = 0;
@@ -215,6 +245,7 @@ class NBody final : public Problem {
   double gravity_;
   std::vector<double> masses_;
   State initial_;
+  State reference_;  // kEndReference (Pleiades in the given frame)
 };
 
 std::unique_ptr<Problem> build(const NBodyData& data) {
@@ -334,6 +365,9 @@ std::unique_ptr<Problem> make_nbody(Params& params) {
           "coordinates as given, or moved to the centre-of-mass frame (Σ m q = Σ m v = 0)") ==
       "com") {
     to_centre_of_mass_frame(data);
+    // The tabulated solution is in the given frame.
+    data.reference_positions.clear();
+    data.reference_velocities.clear();
   }
   return build(data);
 }

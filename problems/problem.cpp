@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Cholesky>
+#include <limits>
 
 namespace geomint {
 
@@ -106,6 +107,8 @@ std::vector<std::string> capability_names(unsigned capabilities) {
       {kForceJacobian, "force_jacobian"},
       {kConstraints, "constraints"},
       {kTimeDependentConstraints, "time_dependent_constraints"},
+      {kFirstOrderOnly, "first_order_only"},
+      {kEndReference, "end_reference"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -255,9 +258,39 @@ void Problem::set_mass(const Vec& mass) {
 
 double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass_.cwiseProduct(p)); }
 
-double Problem::energy(const Vec& q, const Vec& p) const { return kinetic(p) + potential(q); }
+double Problem::energy(const Vec& q, const Vec& p) const {
+  if (has(kFirstOrderOnly)) return std::numeric_limits<double>::quiet_NaN();
+  return kinetic(p) + potential(q);
+}
+
+void Problem::pack_first_order(const State& state, double* y) const {
+  const int n = dof();
+  Eigen::Map<Vec>(y, n) = state.q;
+  if (!has(kFirstOrderOnly)) Eigen::Map<Vec>(y + n, n) = state.p;
+}
+
+void Problem::unpack_first_order(const double* y, State& state) const {
+  const int n = dof();
+  state.q = Eigen::Map<const Vec>(y, n);
+  if (has(kFirstOrderOnly)) {
+    state.p.resize(0);
+  } else {
+    state.p = Eigen::Map<const Vec>(y + n, n);
+  }
+}
+
+void Problem::rhs(double, const Vec&, Vec&) const { missing(*this, "first-order rhs"); }
+void Problem::rhs_jacobian(double, const Vec&, SparseMatrix&) const {
+  missing(*this, "first-order rhs_jacobian");
+}
+double Problem::end_reference_time() const { missing(*this, "end reference"); }
+State Problem::end_reference() const { missing(*this, "end reference"); }
 
 void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
+  if (has(kFirstOrderOnly)) {
+    rhs(t, y, ydot);
+    return;
+  }
   const int n = dof();
   ydot.resize(2 * n);
   const Vec v = inverse_mass_.cwiseProduct(y.tail(n));
@@ -273,6 +306,10 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
 }
 
 void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const {
+  if (has(kFirstOrderOnly)) {
+    rhs_jacobian(t, y, J);
+    return;
+  }
   const int n = dof();
   const Vec q = y.head(n);
   const Vec v = inverse_mass_.cwiseProduct(y.tail(n));

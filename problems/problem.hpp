@@ -38,6 +38,11 @@ enum Capability : unsigned {
   kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
   kConstraints = 1u << 8,      // holonomic constraints g(q) = 0: constraint_* (PAPER.md §3)
   kTimeDependentConstraints = 1u << 9,  // rheonomic g(q, t) = 0: constraint_*_at (car_axis)
+  // A first-order ODE y' = f(t, y) that is no Lagrangian system (van der Pol, Robertson): y is
+  // State::q, State::p is empty, rhs()/rhs_jacobian() define it; V, ∇V, M and H mean nothing
+  // (energy() is NaN). Only methods with the flag kFirstOrderCapable run it (applicable()).
+  kFirstOrderOnly = 1u << 10,
+  kEndReference = 1u << 11,  // end_reference(): a tabulated state at one time (IVP Test Set)
 };
 
 // Capability names for `geomint list` and error messages.
@@ -151,11 +156,27 @@ class Problem {
   double default_dt() const { return default_dt_; }
   double default_t_end() const { return default_t_end_; }
 
-  // First-order view y = (q, p), y' = (M⁻¹p, −∇V(q) + F(q, M⁻¹p, t)) for ODE solvers.
+  // First-order view y = (q, p), y' = (M⁻¹p, −∇V(q) + F(q, M⁻¹p, t)) for ODE solvers; on a
+  // kFirstOrderOnly problem y = q and y' = rhs(t, y).
   void first_order_rhs(double t, const Vec& y, Vec& ydot) const;
-  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs kHessian; uses kForceJacobian if kForce,
-  // otherwise the force's q/v dependence is differenced numerically).
+  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs has_first_order_jacobian(); uses
+  // kForceJacobian if kForce, otherwise the force's q/v dependence is differenced numerically).
   void first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const;
+  // Whether first_order_jacobian is analytic: a Hessian, or a first-order problem's rhs_jacobian.
+  bool has_first_order_jacobian() const { return has(kHessian) || has(kFirstOrderOnly); }
+  // Length of y: 2·dof, or dof on a kFirstOrderOnly problem.
+  int first_order_size() const { return has(kFirstOrderOnly) ? dof() : 2 * dof(); }
+  // y = (q, p) from a state, and back (p is left empty on a kFirstOrderOnly problem).
+  void pack_first_order(const State& state, double* y) const;
+  void unpack_first_order(const double* y, State& state) const;
+
+  // kFirstOrderOnly problems: y' = f(t, y) and its Jacobian ∂f/∂y (sparse, n × n).
+  virtual void rhs(double t, const Vec& y, Vec& ydot) const;
+  virtual void rhs_jacobian(double t, const Vec& y, SparseMatrix& J) const;
+  // kEndReference: a reference state at end_reference_time() (the IVP Test Set's tabulated
+  // solution at its end time), for error_final and scd (harness/observers.cpp).
+  virtual double end_reference_time() const;
+  virtual State end_reference() const;
 
  protected:
   // Called once by the factory after construction.

@@ -133,6 +133,7 @@ class ProblemTest : public ::testing::TestWithParam<std::string> {
 
 TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
   const Problem& problem = *problem_;
+  if (problem.has(kFirstOrderOnly)) GTEST_SKIP() << "first-order only (problems/first_order_test)";
   const State start = problem.initial_state();
   ASSERT_GT(problem.dof(), 0);
   EXPECT_EQ(start.q.size(), problem.dof());
@@ -163,6 +164,7 @@ TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
 
 TEST_P(ProblemTest, GradientMatchesFiniteDifferences) {
   const Problem& problem = *problem_;
+  if (problem.has(kFirstOrderOnly)) GTEST_SKIP() << "first-order only: no potential";
   for (const Vec& q : sample_configurations(problem)) {
     Vec g;
     problem.gradient(q, g);

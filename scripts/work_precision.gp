@@ -8,8 +8,8 @@ set datafile separator whitespace
 set datafile nocolumnheaders
 groups = system("cat wp/groups")
 # Each group (problem_horizon) in words, for the titles.
-group_keys = "pendulum_1e2 pendulum_1e4 kepler_1e2 kepler_1e4 solar_1e2 fpu_1e2"
-group_words = "pendulum_(theta0_=_1.5),_100_periods_(t_=_730) pendulum_(theta0_=_1.5),_10^4_periods_(t_=_73000) Kepler_(e_=_0.6),_100_periods_(t_=_630) Kepler_(e_=_0.6),_10^4_periods_(t_=_63000) outer_solar_system,_100_Jupiter_periods_(t_=_433000_days) stiff_FPU_chain_(omega_=_50),_t_=_200"
+group_keys = "pendulum_1e2 pendulum_1e4 kepler_1e2 kepler_1e4 solar_1e2 fpu_1e2 pleiades_t3"
+group_words = "pendulum_(theta0_=_1.5),_100_periods_(t_=_730) pendulum_(theta0_=_1.5),_10^4_periods_(t_=_73000) Kepler_(e_=_0.6),_100_periods_(t_=_630) Kepler_(e_=_0.6),_10^4_periods_(t_=_63000) outer_solar_system,_100_Jupiter_periods_(t_=_433000_days) stiff_FPU_chain_(omega_=_50),_t_=_200 Pleiades_(IVP_Test_Set_plei),_t_=_3"
 group_index(g) = sum [i=1:words(group_keys)] (word(group_keys, i) eq g ? i : 0)
 underscores_to_spaces(s) = (r = "", sum [i=1:strlen(s)] (r = r.(s[i:i] eq "_" ? " " : s[i:i]), 0), r)
 group_title(g) = group_index(g) > 0 ? underscores_to_spaces(word(group_words, group_index(g))) : g
