@@ -67,7 +67,7 @@ inline constexpr double kRoundoffFloor = 16 * 2.220446049250313e-16;
 // rounding is that of the gradient's terms, not of the energy's. E may then rise by no more than
 // this fraction of its size (Hager & Zhang's ε = 1e-6), which still rejects a step across a
 // hill of E towards another stationary point. Measured (README "minimize_vs_newton", spinning
-// free elastic bar at t = 2.29): E's rounding ~130ε·objective_scale, above the 16ε the value
+// free elastic bar at t = 2.29): E's rounding ~120ε·objective_scale, above the 16ε the value
 // test allows, while a full Newton step cut ‖R‖ from 1.5e-6 to 7e-14.
 inline constexpr double kApproximateArmijoSlack = 1e-6;
 
