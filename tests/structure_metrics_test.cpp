@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -135,7 +137,19 @@ TEST(PeriodMeasured, MatchesExactPeriodsThroughEachProblemsObservable) {
       {"nbody:preset=custom,masses=3/0.25,G=1.3,positions=0/0/1.5/0,velocities=0.2/-0.1/0.2/1.3",
        two_body_period, 0.002},
   };
-  for (const auto& [spec, period, h] : cases) {
+  // The same orbit from a state file (initial=FILE wraps the problem; the wrapper must forward
+  // the observable).
+  const std::string two_body = cases[2].problem;
+  const std::string state_file = ::testing::TempDir() + "two_body_state.csv";
+  {
+    const State start = make_problem(two_body)->initial_state();
+    std::ofstream out(state_file);
+    out.precision(17);
+    for (int i = 0; i < start.q.size(); ++i) out << start.q[i] << "," << start.p[i] << "\n";
+  }
+  std::vector<Case> all(std::begin(cases), std::end(cases));
+  all.push_back({two_body + ",initial=" + state_file, two_body_period, 0.002});
+  for (const auto& [spec, period, h] : all) {
     const RunRecord record =
         run_with(spec, "stormer_verlet", h, 10.5 * period, {"period_measured"});
     ASSERT_TRUE(record.metrics.count("period_measured")) << spec;
