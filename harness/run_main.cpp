@@ -40,23 +40,32 @@ const std::vector<std::string> kCommands = {"list",  "run",       "order", "swee
 
 // CLI11 says "A subcommand is required" for a missing or unknown verb; say which verbs exist.
 // Returns false (message printed) when argv[1] is not an option and not a command.
-bool check_command(int argc, char** argv) {
+bool check_command(const std::string& program, int argc, char** argv) {
   const std::string commands = fmt::format("{}", fmt::join(kCommands, ", "));
   if (argc < 2) {
-    fmt::print(stderr, "geomint: error: a command is required ({}); see geomint --help\n",
+    fmt::print(stderr, "{0}: error: a command is required ({1}); see {0} --help\n", program,
                commands);
     return false;
   }
   const std::string first = argv[1];
   if (first.empty() || first[0] != '-') {
     if (std::find(kCommands.begin(), kCommands.end(), first) == kCommands.end()) {
-      fmt::print(stderr,
-                 "geomint: error: unknown command '{}' (commands: {}); see geomint --help\n", first,
-                 commands);
+      fmt::print(stderr, "{0}: error: unknown command '{1}' (commands: {2}); see {0} --help\n",
+                 program, first, commands);
       return false;
     }
   }
   return true;
+}
+
+// The name messages start with: argv[0] without its directories, so a user's program built on
+// run_main speaks as itself; "geomint" when argv[0] is missing or empty.
+std::string program_name(int argc, char** argv) {
+  if (argc < 1 || argv[0] == nullptr) return "geomint";
+  std::string name = argv[0];
+  const std::size_t slash = name.find_last_of('/');
+  if (slash != std::string::npos) name.erase(0, slash + 1);
+  return name.empty() ? "geomint" : name;
 }
 
 std::string joined_command_line(int argc, char** argv) {
@@ -148,6 +157,7 @@ void print_problems(bool markdown) {
 }  // namespace
 
 int run_main(int argc, char** argv) {
+  const std::string program = program_name(argc, argv);
   CLI::App app{"geomint: verification and benchmark suite for geometric time integrators"};
   app.require_subcommand(1);
   app.set_version_flag("--version",
@@ -304,7 +314,7 @@ int run_main(int argc, char** argv) {
                    "(results/<scene>, results/<scene>/quick)")
       ->required();
 
-  if (!check_command(argc, argv)) return kExitBadInput;
+  if (!check_command(program, argc, argv)) return kExitBadInput;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -367,7 +377,7 @@ int run_main(int argc, char** argv) {
         write_file_atomic(out_path, csv);
       }
       if (!result.ok) {
-        fmt::print(stderr, "geomint: run failed: {}: {}\n", result.record.status,
+        fmt::print(stderr, "{}: run failed: {}: {}\n", program, result.record.status,
                    result.record.message.value_or(""));
       }
       return result.ok ? 0 : kExitFailed;
@@ -388,7 +398,7 @@ int run_main(int argc, char** argv) {
         write_file_atomic(out_path, records_to_csv(records, provenance(command_line)));
       }
       if (!std::isfinite(study.fit.order)) {
-        fmt::print(stderr, "geomint: no order fit: {}\n", study.fit.note);
+        fmt::print(stderr, "{}: no order fit: {}\n", program, study.fit.note);
         return kExitFailed;
       }
       fmt::print("{:.3f}\n", study.fit.order);
@@ -505,7 +515,7 @@ int run_main(int argc, char** argv) {
               "--shard and --shard-from-env");
         }
         run_timing_only(scene, options);
-        fmt::print(stderr, "geomint: timing passes of '{}' written into {}\n", scene.title,
+        fmt::print(stderr, "{}: timing passes of '{}' written into {}\n", program, scene.title,
                    options.out_dir);
         return 0;
       }
@@ -521,12 +531,12 @@ int run_main(int argc, char** argv) {
         const SceneUnits units = scene_units(scene);
         const auto tables = shard_tables(units.runs, units.orders, units.stability);
         if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
-          fmt::print(stderr, "geomint: shard {}/{} of '{}' is complete on disk; skipped\n",
+          fmt::print(stderr, "{}: shard {}/{} of '{}' is complete on disk; skipped\n", program,
                      id.index, id.count, scene.title);
           return 0;
         }
         if (shard_fails_on_purpose(id)) {
-          fmt::print(stderr, "geomint: GEOMINT_FAIL_SHARD={}: shard {}/{} fails on purpose\n",
+          fmt::print(stderr, "{}: GEOMINT_FAIL_SHARD={}: shard {}/{} fails on purpose\n", program,
                      id.index, id.index, id.count);
           return kExitFailed;
         }
@@ -534,7 +544,7 @@ int run_main(int argc, char** argv) {
         throw InputError("--shards N goes with --shard-from-env");
       }
       const int failed = run_sweep(scene, options);
-      fmt::print(stderr, "geomint: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
+      fmt::print(stderr, "{}: sweep '{}' done: {} failed run(s) reported as rows in {}\n", program,
                  scene.title, failed, options.out_dir);
       return 0;
     }
@@ -559,10 +569,11 @@ int run_main(int argc, char** argv) {
       try {
         merge_shards(scene, options);
       } catch (const MergeRefused& refused) {
-        fmt::print(stderr, "geomint: merge: {}\n", refused.what());
+        fmt::print(stderr, "{}: merge: {}\n", program, refused.what());
         return kExitFailed;
       }
-      fmt::print(stderr, "geomint: merged the shards of '{}' into {}\n", scene.title, merge_dir);
+      fmt::print(stderr, "{}: merged the shards of '{}' into {}\n", program, scene.title,
+                 merge_dir);
       return 0;
     }
     if (*slurm) {
@@ -585,20 +596,20 @@ int run_main(int argc, char** argv) {
         std::string dependency;
         for (const auto& path : scripts) {
           const std::string id = submit_sbatch(path, dependency);
-          fmt::print(stderr, "geomint: submitted {} as job {}\n", path, id);
+          fmt::print(stderr, "{}: submitted {} as job {}\n", program, path, id);
           dependency = id;
         }
       }
       return 0;
     }
   } catch (const InputError& error) {
-    fmt::print(stderr, "geomint: error: {}\n", error.what());
+    fmt::print(stderr, "{}: error: {}\n", program, error.what());
     return kExitBadInput;
   } catch (const std::exception& error) {
-    fmt::print(stderr, "geomint: internal error: {}\n", error.what());
+    fmt::print(stderr, "{}: internal error: {}\n", program, error.what());
     return kExitInternal;
   } catch (...) {
-    fmt::print(stderr, "geomint: internal error: an exception of unknown type\n");
+    fmt::print(stderr, "{}: internal error: an exception of unknown type\n", program);
     return kExitInternal;
   }
   return 0;

@@ -16,20 +16,21 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// period_measured: mean interval between the upward zero crossings of q[0] at step points (each
+// period_measured: mean interval between the upward zero crossings of the problem's
+// period_observable(q, p) (default q[0]; problems/problem.hpp) at step points (each
 // crossing time linearly interpolated between the two step points around it, an O(h²) error
 // that is nearly the same at every crossing and so mostly cancels in the differences);
 // period_err_rel = (period_measured − T)/T when the problem knows its period T. Needs two
-// crossings; q[0] must oscillate about 0 (pendulum angle, harmonic and Kepler x).
+// crossings.
 class ZeroCrossingPeriodObserver : public Observer {
  public:
   void begin(const Problem& problem, const State& state, double) override {
     period_ = problem.has(kPeriod) ? problem.period() : kNaN;
     last_t_ = state.t;
-    last_x_ = state.q[0];
+    last_x_ = problem.period_observable(state.q, state.p);
   }
-  void observe(const Problem&, const State& state) override {
-    const double x = state.q[0];
+  void observe(const Problem& problem, const State& state) override {
+    const double x = problem.period_observable(state.q, state.p);
     if (!std::isfinite(x)) return;
     if (last_x_ < 0 && x >= 0) {
       const double crossing = last_t_ + (-last_x_) / (x - last_x_) * (state.t - last_t_);

@@ -592,6 +592,16 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
         accepted = true;
         break;
       }
+      // The rounding of E can exceed 16ε·objective_scale by far when V sums terms that cancel
+      // (an elastic energy density of a rotated element: μ(tr H + ½|H|²) − μ ln J with H = R − I
+      // of size 1 and W ~ strain²), and then hides a decrease of E that the gradient still
+      // resolves. Armijo in derivative form (the approximate Wolfe test, kApproximateArmijoSlack).
+      if (system.objective && trial_residual.norm() < result.residual_norm &&
+          trial_residual.dot(direction) <= (1 - 2 * options_.armijo) * -slope &&
+          trial_merit <= merit + kApproximateArmijoSlack * merit_size) {
+        accepted = true;
+        break;
+      }
     }
     if (!accepted && stale) {
       --result.iterations;

@@ -60,6 +60,17 @@ const char* linear_solver_name(LinearSolverKind kind);
 // round-off (NewtonResult::at_roundoff).
 inline constexpr double kRoundoffFloor = 16 * 2.220446049250313e-16;
 
+// The minimiser's line search also accepts a step when E's change is lost in E's rounding but
+// the slope along the step, R(x + αd)·d, says E decreased (Hager & Zhang, SIAM J. Optim. 16(1)
+// 2005, "approximate Wolfe" conditions, §4): for a quadratic E, φ(α) − φ(0) = α(φ'(0) + φ'(α))/2,
+// so Armijo φ(α) ≤ φ(0) + c₁αφ'(0) is exactly φ'(α) ≤ (2c₁ − 1)φ'(0), and φ' comes from R, whose
+// rounding is that of the gradient's terms, not of the energy's. E may then rise by no more than
+// this fraction of its size (Hager & Zhang's ε = 1e-6), which still rejects a step across a
+// hill of E towards another stationary point. Measured (README "minimize_vs_newton", spinning
+// free elastic bar at t = 2.29): E's rounding ~120ε·objective_scale, above the 16ε the value
+// test allows, while a full Newton step cut ‖R‖ from 1.5e-6 to 7e-14.
+inline constexpr double kApproximateArmijoSlack = 1e-6;
+
 struct NewtonOptions {
   // Converged when ‖R(x)‖₂ ≤ max(tolerance, kRoundoffFloor) · residual_scale, where
   // residual_scale (passed to solve(), plus NewtonSystem::scale_after_first_residual) is the size

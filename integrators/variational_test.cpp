@@ -470,6 +470,38 @@ TEST(HpSolvers, MinimiserSucceedsWherePlainNewtonFails) {
   }
 }
 
+// A free neo-Hookean bar spinning about (1,1,1)/√3: after ~2.3 rad of rotation H = F − I is of
+// size 1 in every element, so the energy density μ(tr H + ½|H|²) − μ ln J ~ strain² carries
+// rounding ~ε·μ·vol·|H| — about 120ε·objective_scale, beyond what the line search's value test
+// allows — while the gradient stays accurate. Before the derivative-form Armijo test
+// (kApproximateArmijoSlack) the minimiser stopped there (line_search_failed or newton_max_iter)
+// at every scale of the bar, while plain Newton ran through. Scales: SI-sized, 1000× shorter
+// (time and h scale with it), material 1e-9× lighter and softer.
+TEST(HpSolvers, MinimiserRunsTheSpinningFreeBarAtEveryScale) {
+  struct Case {
+    const char* scale;  // appended to the bar's spec
+    double h;
+  };
+  const std::string bar =
+      "elastic_bar:clamp=none,nx=2,ny=1,nz=1,gravity=0,init=velocity,twist=0.5,shake=0.5,";
+  const Case cases[] = {
+      {"spin=1,bend=0.05", 0.01},
+      {"spin=1000,bend=5e-5,length=1e-3,width=2e-4,height=2e-4", 1e-5},
+      {"spin=1,bend=0.05,density=1e-6,young=1e-4", 0.01},
+  };
+  for (const auto& [scale, h] : cases) {
+    const auto problem = make_problem(bar + scale);
+    StepStatus minimize_status, newton_status;
+    const auto minimize = trajectory("hp:solver=minimize", *problem, problem->initial_state(), h,
+                                     300, &minimize_status);
+    const auto newton =
+        trajectory("hp:solver=newton", *problem, problem->initial_state(), h, 300, &newton_status);
+    ASSERT_EQ(newton.size(), 301u) << scale << ": " << newton_status.message;
+    ASSERT_EQ(minimize.size(), 301u) << scale << ": " << minimize_status.message;
+    EXPECT_LE(max_distance(minimize, newton), 1e-12) << scale;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Declared properties, caches, counters and parameters.
 
@@ -677,6 +709,33 @@ TEST(NewtonExtensions, ObjectiveScaleLetsTheLineSearchSeePastCancellation) {
   const NewtonResult result = NewtonSolver().solve(system, x, 1.0);
   ASSERT_TRUE(result.converged) << describe(result);
   EXPECT_LE(std::abs(x[0] - 1), 1e-12);
+}
+
+TEST(NewtonExtensions, DerivativeArmijoDoesNotClimbIntoAnotherWell) {
+  // E = x²(x + 2)² − x/2: the well near x = 0.06 is deeper than the one near −1.94 (E ≈ 0.98).
+  // From x = 0.3 (E ≈ 0.33) a first Jacobian that sends the step to the shallow well's bottom
+  // cuts ‖R‖ and leaves a slope that passes the derivative-form Armijo test, but E rises by 0.66:
+  // the kApproximateArmijoSlack guard must reject it, so the solve ends in the deeper well.
+  NewtonSystem system;
+  system.symmetric = true;
+  system.objective = [](const Vec& x) {
+    const double y = x[0];
+    return y * y * (y + 2) * (y + 2) - 0.5 * y;
+  };
+  const auto gradient = [](double y) { return 4 * y * (y + 1) * (y + 2) - 0.5; };
+  system.residual = [&](const Vec& x, Vec& r) { r = Vec::Constant(1, gradient(x[0])); };
+  const double start = 0.3, shallow_bottom = -1.9375;  // 8(x + 2) ≈ 0.5 there
+  int jacobians = 0;
+  system.jacobian = [&](const Vec& x, SparseMatrix& J) {
+    const double y = x[0];
+    J = one_by_one(jacobians++ == 0 ? gradient(start) / (start - shallow_bottom)
+                                    : 12 * y * y + 24 * y + 8);
+  };
+  Vec x = Vec::Constant(1, start);
+  const NewtonResult result = NewtonSolver().solve(system, x, 1.0);
+  ASSERT_TRUE(result.converged) << describe(result);
+  EXPECT_GT(x[0], -1.0) << "the solve climbed into the shallow well";
+  EXPECT_NEAR(gradient(x[0]), 0.0, 1e-12);
 }
 
 TEST(NewtonExtensions, CentralDifferenceJacobianMatchesTheAnalyticOne) {

@@ -41,6 +41,9 @@ class GivenInitialState final : public Problem {
     return base_->angular_momentum(q, p);
   }
   double omega_max(const Vec& q) const override { return base_->omega_max(q); }
+  double period_observable(const Vec& q, const Vec& p) const override {
+    return base_->period_observable(q, p);
+  }
   int constraint_count() const override { return base_->constraint_count(); }
   void constraint(const Vec& q, Vec& g) const override { base_->constraint(q, g); }
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {

@@ -53,7 +53,12 @@ double eccentric_anomaly(double mean_anomaly, double e) {
     if (!(next >= lo && next <= hi)) next = 0.5 * (lo + hi);
     const double change = std::abs(next - E);
     E = next;
-    if (change < 4 * DBL_EPSILON) return std::copysign(E, mean_anomaly);
+    // Also stop when the bracket has shrunk to a few ulps of E: for E in [2, π] an ulp is 2ε, and
+    // Newton can alternate between two floats 4ε apart, which the absolute test never accepts
+    // (e = 0.3, M = 2.7888146928201127).
+    if (change < 4 * DBL_EPSILON || hi - lo <= 4 * DBL_EPSILON * E) {
+      return std::copysign(E, mean_anomaly);
+    }
   }
   throw std::logic_error("kepler: Newton iteration for Kepler's equation did not converge");
 }

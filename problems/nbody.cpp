@@ -228,6 +228,18 @@ class NBody final : public Problem {
     }
   }
 
+  // The second body's first coordinate relative to the centre of mass, which moves uniformly in
+  // the given frame: in a two-body problem it crosses 0 upwards once per orbit; in the outer
+  // solar system it is Jupiter's.
+  double period_observable(const Vec& q, const Vec&) const override {
+    double weighted = 0, total = 0;
+    for (int b = 0; b < bodies_; ++b) {
+      weighted += masses_[b] * q[Dim * b];
+      total += masses_[b];
+    }
+    return q[Dim] - weighted / total;
+  }
+
   // Gershgorin bound on the eigenvalues of M⁻¹∇²V (similar to M^(−½)∇²V M^(−½)): the largest
   // absolute row sum divided by the row's mass.
   double omega_max(const Vec& q) const override {

@@ -132,6 +132,7 @@ State Problem::exact(double) const { missing(*this, "exact solution"); }
 Vec Problem::linear_momentum(const Vec&, const Vec&) const { missing(*this, "linear momentum"); }
 Vec Problem::angular_momentum(const Vec&, const Vec&) const { missing(*this, "angular momentum"); }
 double Problem::period() const { missing(*this, "period"); }
+double Problem::period_observable(const Vec& q, const Vec&) const { return q[0]; }
 double Problem::omega_max(const Vec&) const { missing(*this, "omega_max"); }
 int Problem::constraint_count() const { missing(*this, "constraints"); }
 void Problem::constraint(const Vec&, Vec&) const { missing(*this, "constraints"); }

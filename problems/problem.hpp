@@ -92,6 +92,11 @@ class Problem {
   virtual Vec angular_momentum(const Vec& q, const Vec& p) const;
   // Period of the exact motion. Only when has(kPeriod).
   virtual double period() const;
+  // The scalar whose upward zero crossings the period_measured metric times
+  // (harness/structure_metrics.cpp): one that crosses 0 upwards once per period of the motion.
+  // Default q[0] (the pendulum angle, the harmonic and Kepler x with the focus at 0); a problem
+  // whose q[0] does not oscillate about 0 (a drifting centre of mass) overrides it.
+  virtual double period_observable(const Vec& q, const Vec& p) const;
   // Highest linearised frequency at q (for stability reports). Only when has(kOmegaMax).
   virtual double omega_max(const Vec& q) const;
   // Whether V is quadratic (∇²V = K constant, needs kHessian): the normal modes K v = ω²M v are

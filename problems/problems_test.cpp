@@ -556,5 +556,16 @@ TEST(KeplerProblem, InvariantsMatchOrbitalElements) {
   }
 }
 
+// Kepler's equation at a mean anomaly where Newton alternates between two floats 4ε apart
+// (E ≈ 2.87, ulp 2ε): the solver stops on its collapsed bracket instead of throwing, and the
+// state still solves the equation: the energy is −½ to rounding.
+TEST(KeplerProblem, ExactSolutionConvergesWhereNewtonAlternatesBetweenTwoFloats) {
+  const auto problem = make_problem("kepler:e=0.3");
+  const double t = 2.7888146928201127;
+  State state;
+  ASSERT_NO_THROW(state = problem->exact(t));
+  EXPECT_NEAR(problem->energy(state.q, state.p), -0.5, 64 * DBL_EPSILON);
+}
+
 }  // namespace
 }  // namespace geomint

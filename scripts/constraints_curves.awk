@@ -2,22 +2,7 @@
 # on summary.csv): writes curves/car_axis_<curve>.dat (wall_s error_final), curves/car_axis.list
 # (the curve names, keys of the method map in scripts/common.gp) and curves/penalty_<dt>.dat
 # (k constraint_err_max energy_err_max, ok runs only).
-# Splits one CSV line (fields may be "quoted", "" is a quote) into f[1..n].
-function split_csv(line, f,    n, i, c, field, quoted) {
-  n = 0; field = ""; quoted = 0
-  for (i = 1; i <= length(line); i++) {
-    c = substr(line, i, 1)
-    if (quoted) {
-      if (c == "\"") {
-        if (substr(line, i + 1, 1) == "\"") { field = field "\""; i++ } else quoted = 0
-      } else field = field c
-    } else if (c == "\"") quoted = 1
-    else if (c == ",") { f[++n] = field; field = "" }
-    else field = field c
-  }
-  f[++n] = field
-  return n
-}
+# split_csv comes from scripts/csv.awk (awk -f csv.awk -f constraints_curves.awk).
 # rattle, composition_rattle_<scheme>, ida_index_<2|3>; anything else keeps its registry name.
 function curve_name(spec,    name, scheme) {
   name = spec; sub(/:.*/, "", name)

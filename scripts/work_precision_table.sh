@@ -11,23 +11,8 @@ set -euo pipefail
 summary=${1:-summary.csv}
 rm -rf wp
 mkdir -p wp
-awk -v out=wp '
-# Splits one CSV line (fields may be "quoted", "" is a quote) into f[1..n].
-function split_csv(line, f,    n, i, c, field, quoted) {
-  n = 0; field = ""; quoted = 0
-  for (i = 1; i <= length(line); i++) {
-    c = substr(line, i, 1)
-    if (quoted) {
-      if (c == "\"") {
-        if (substr(line, i + 1, 1) == "\"") { field = field "\""; i++ } else quoted = 0
-      } else field = field c
-    } else if (c == "\"") quoted = 1
-    else if (c == ",") { f[++n] = field; field = "" }
-    else field = field c
-  }
-  f[++n] = field
-  return n
-}
+# split_csv comes from scripts/csv.awk; the program is read from the here-document.
+awk -v out=wp -f "$(dirname "$0")/csv.awk" -f /dev/stdin "$summary" > time_to_error.md <<'AWK'
 # Curve name: the method spec without its tolerances, file-name safe, library defaults dropped.
 function curve_name(spec,    name, rest, parts, n, i, kept) {
   name = spec; rest = ""
@@ -87,5 +72,6 @@ END {
     }
     printf "\n\n"
   }
-}' "$summary" > time_to_error.md
+}
+AWK
 for file in wp/*/*.dat; do sort -g -o "$file" "$file"; done

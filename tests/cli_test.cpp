@@ -166,6 +166,34 @@ TEST(Cli, ModesPrintsOneRowPerModeAndRejectsNonlinearProblems) {
 
 // --initial appends the spec key initial=FILE: the row's problem names the file, and a file of
 // the wrong length is exit 2 naming the problem's n, for run and order alike.
+// A program built on run_main (harness/run_main.hpp) names itself in its messages: argv[0]
+// without its directories, here a symlink to geomint called my_sim.
+TEST(Cli, MessagesStartWithTheProgramsOwnName) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("geomint_program_name_" + std::to_string(getpid()));
+  fs::create_directories(folder);
+  const fs::path alias = folder / "my_sim";
+  fs::remove(alias);
+  fs::create_symlink(GEOMINT_BINARY, alias);
+  const auto run = [&](const std::string& arguments) {
+    return geomint_shell(alias.string() + " " + arguments);
+  };
+  const Outcome unknown = run("bogus");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_EQ(unknown.output.rfind("my_sim: error: unknown command 'bogus'", 0), 0u)
+      << unknown.output;
+  EXPECT_NE(unknown.output.find("see my_sim --help"), std::string::npos) << unknown.output;
+  const Outcome bad = run("run --problem nope --method rk4");
+  EXPECT_EQ(bad.output.rfind("my_sim: error: unknown problem 'nope'", 0), 0u) << bad.output;
+  const Outcome failed =
+      run("run --problem pendulum:theta0=3 --method implicit_euler:max_iter=1 --dt 2 --t-end 4");
+  EXPECT_EQ(failed.exit_code, 1);
+  EXPECT_NE(failed.output.find("my_sim: run failed: newton_max_iter"), std::string::npos)
+      << failed.output;
+  EXPECT_EQ(geomint("bogus").output.rfind("geomint: error: unknown command", 0), 0u);
+  fs::remove_all(folder);
+}
+
 TEST(Cli, InitialStateFileStartsTheRunAndIsChecked) {
   const auto dir = std::filesystem::temp_directory_path();
   const std::string good = (dir / "geomint_cli_initial.csv").string();

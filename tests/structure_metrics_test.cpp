@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -210,6 +212,48 @@ TEST(PeriodMeasured, PendulumPeriodConvergesAtSecondOrder) {
   // Not asked for: not computed.
   EXPECT_FALSE(run_with("pendulum:theta0=1", "stormer_verlet", 0.02, 60, {})
                    .metrics.count("period_measured"));
+}
+
+// Problems with exact periods, each through its period_observable (problems/problem.hpp): the
+// pendulum's angle and Kepler's x by default, and for nbody the second body's x relative to the
+// centre of mass — here a two-body problem with non-unit masses, G = 1.3 and a centre of mass
+// drifting by 8 (about 7 orbit diameters) over the run, so q[0] itself never crosses 0 twice.
+// Kepler's third law: T = 2π a^{3/2}/√μ, μ = G(m₁ + m₂), 1/a = 2/r − v²/μ (vis-viva).
+TEST(PeriodMeasured, MatchesExactPeriodsThroughEachProblemsObservable) {
+  const double mu = 1.3 * (3 + 0.25), r = 1.5, v = 1.4;  // relative distance and speed
+  const double a = 1 / (2 / r - v * v / mu);
+  const double two_body_period = 2 * std::acos(-1.0) * std::pow(a, 1.5) / std::sqrt(mu);
+  struct Case {
+    std::string problem;
+    double period;
+    double h;
+  };
+  const Case cases[] = {
+      {"pendulum:theta0=2.5", make_problem("pendulum:theta0=2.5")->period(), 0.005},
+      {"kepler:e=0.3", 2 * std::acos(-1.0), 0.002},
+      {"nbody:preset=custom,masses=3/0.25,G=1.3,positions=0/0/1.5/0,velocities=0.2/-0.1/0.2/1.3",
+       two_body_period, 0.002},
+  };
+  // The same orbit from a state file (initial=FILE wraps the problem; the wrapper must forward
+  // the observable).
+  const std::string two_body = cases[2].problem;
+  const std::string state_file = ::testing::TempDir() + "two_body_state.csv";
+  {
+    const State start = make_problem(two_body)->initial_state();
+    std::ofstream out(state_file);
+    out.precision(17);
+    for (int i = 0; i < start.q.size(); ++i) out << start.q[i] << "," << start.p[i] << "\n";
+  }
+  std::vector<Case> all(std::begin(cases), std::end(cases));
+  all.push_back({two_body + ",initial=" + state_file, two_body_period, 0.002});
+  for (const auto& [spec, period, h] : all) {
+    const RunRecord record =
+        run_with(spec, "stormer_verlet", h, 10.5 * period, {"period_measured"});
+    ASSERT_TRUE(record.metrics.count("period_measured")) << spec;
+    const double measured = record.metrics.at("period_measured");
+    std::printf("%s: period_measured %.10g, exact %.10g\n", spec.c_str(), measured, period);
+    EXPECT_NEAR(measured / period, 1.0, 1e-4) << spec;
+  }
 }
 
 // explicit Euler on the harmonic oscillator multiplies H by 1 + h²ω² per step, so while
