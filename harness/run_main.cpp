@@ -13,6 +13,8 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "harness/gate.hpp"
 #include "harness/order.hpp"
@@ -107,37 +109,69 @@ std::string order_column(const IntegratorEntry& entry, int default_order) {
   return fmt::format("{} (variants: {})", default_order, fmt::join(others, ", "));
 }
 
+// Aligned plain-text columns: each as wide as its widest cell (names and capability lists grow
+// with the registry, so fixed widths let a long one push the rest of its row out of line). The
+// last column is left unpadded.
+void print_aligned(const std::vector<std::vector<std::string>>& rows,
+                   const std::vector<bool>& right_aligned) {
+  std::vector<std::size_t> widths(right_aligned.size(), 0);
+  for (const auto& row : rows) {
+    for (std::size_t column = 0; column < row.size(); ++column) {
+      widths[column] = std::max(widths[column], row[column].size());
+    }
+  }
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t column = 0; column < row.size(); ++column) {
+      const bool last = column + 1 == row.size();
+      if (column > 0) line += column == 2 ? "  " : " ";
+      if (last) {
+        line += row[column];
+      } else if (right_aligned[column]) {
+        line += fmt::format("{:>{}}", row[column], widths[column]);
+      } else {
+        line += fmt::format("{:<{}}", row[column], widths[column]);
+      }
+    }
+    line.erase(line.find_last_not_of(' ') + 1);  // an empty last column leaves no padding
+    fmt::print("{}\n", line);
+  }
+}
+
 // `markdown`: the README's table (README.md, between <!-- methods:begin/end -->), one row per
 // built-in registry entry (register_method() ones are not the README's); otherwise aligned
 // columns with every parameter and its default, registered methods included.
 void print_methods(bool markdown) {
+  std::vector<std::vector<std::string>> rows;
   if (markdown) {
     fmt::print("| method | order | flags | what it is |\n|---|---|---|---|\n");
   } else {
-    fmt::print("{:<22} {:>5}  {:<48} {}\n", "method", "order", "flags", "parameters (default)");
+    rows.push_back({"method", "order", "flags", "parameters (default)"});
   }
   for (const auto& entry : integrator_registry()) {
     if (markdown && !entry.builtin) continue;
     Params params(Spec{entry.name, {}}, entry.name);
     const auto integrator = entry.factory(params);
     const MethodInfo info = integrator->info();
-    const std::string flags = fmt::format("{}", fmt::join(flag_names(info.flags), ", "));
     if (markdown) {
-      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, order_column(entry, info.order), flags,
+      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, order_column(entry, info.order),
+                 fmt::format("{}", fmt::join(flag_names(info.flags), ", ")),
                  markdown_cell(entry.summary));
     } else {
-      fmt::print("{:<22} {:>5}  {:<48} {}\n", entry.name, info.order,
-                 fmt::format("{}", fmt::join(flag_names(info.flags), ",")), parameter_list(params));
+      rows.push_back({entry.name, std::to_string(info.order),
+                      fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
+                      parameter_list(params)});
     }
   }
+  if (!markdown) print_aligned(rows, {false, true, false, false});
 }
 
 void print_problems(bool markdown) {
+  std::vector<std::vector<std::string>> rows;
   if (markdown) {
     fmt::print("| problem | dof | capabilities | what it is |\n|---|---|---|---|\n");
   } else {
-    fmt::print("{:<20} {:>5}  {:<58} {}\n", "problem", "dof", "capabilities (defaults)",
-               "parameters (default)");
+    rows.push_back({"problem", "dof", "capabilities (defaults)", "parameters (default)"});
   }
   for (const auto& entry : problem_registry()) {
     if (markdown && !entry.builtin) continue;
@@ -148,10 +182,11 @@ void print_problems(bool markdown) {
       fmt::print("| `{}` | {} | {} | {} |\n", entry.name, problem->dof(),
                  fmt::format("{}", fmt::join(capabilities, ", ")), markdown_cell(entry.summary));
     } else {
-      fmt::print("{:<20} {:>5}  {:<58} {}\n", entry.name, problem->dof(),
-                 fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params));
+      rows.push_back({entry.name, std::to_string(problem->dof()),
+                      fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params)});
     }
   }
+  if (!markdown) print_aligned(rows, {false, true, false, false});
 }
 
 }  // namespace

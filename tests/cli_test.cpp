@@ -312,6 +312,36 @@ TEST(Readme, MethodAndProblemTablesMatchTheRegistry) {
   for (const auto& name : problems) EXPECT_NE(listing.output.find(name), std::string::npos);
 }
 
+// `geomint list` prints aligned columns however long a name or capability list gets: in every
+// row the third and fourth columns start where the header's do.
+TEST(Cli, ListColumnsStayAlignedForTheLongestEntries) {
+  for (const std::string what : {"methods", "problems"}) {
+    const Outcome listing = geomint("list " + what);
+    ASSERT_EQ(listing.exit_code, 0) << listing.output;
+    std::istringstream lines(listing.output);
+    std::string header;
+    std::getline(lines, header);
+    const std::size_t third = header.find(what == "methods" ? "flags" : "capabilities");
+    const std::size_t fourth = header.find("parameters");
+    ASSERT_NE(third, std::string::npos) << header;
+    ASSERT_NE(fourth, std::string::npos) << header;
+    std::string line;
+    int rows = 0;
+    while (std::getline(lines, line)) {
+      if (line.empty()) continue;
+      ++rows;
+      ASSERT_GT(line.size(), third) << line;
+      EXPECT_EQ(line[third - 1], ' ') << what << ": " << line;
+      EXPECT_NE(line[third], ' ') << what << ": " << line;
+      if (line.size() > fourth) {
+        EXPECT_EQ(line[fourth - 1], ' ') << what << ": " << line;
+        EXPECT_NE(line[fourth], ' ') << what << ": " << line;
+      }
+    }
+    EXPECT_GT(rows, 10) << listing.output;
+  }
+}
+
 // The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of README.md.
 std::string readme_block(const std::string& marker) {
   std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
