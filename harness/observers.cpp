@@ -8,6 +8,8 @@
 #include <numbers>
 #include <vector>
 
+#include "integrators/newton.hpp"
+
 namespace geomint {
 namespace {
 
@@ -110,8 +112,7 @@ class ExactErrorObserver : public Observer {
   void begin(const Problem&, const State&, double) override {}
   void observe(const Problem& problem, const State& state) override {
     const State exact = problem.exact(state.t);
-    const double error =
-        std::sqrt((state.q - exact.q).squaredNorm() + (state.p - exact.p).squaredNorm());
+    const double error = robust_norm(state.q - exact.q, state.p - exact.p);
     error_max_ = std::max(error_max_, error);
     error_final_ = error;
   }
@@ -298,8 +299,7 @@ class EndReferenceObserver : public Observer {
   void observe(const Problem&, const State& state) override {
     if (std::abs(state.t - time_) > 1e-9 * std::max(1.0, std::abs(time_))) return;
     reached_ = true;
-    error_ =
-        std::sqrt((state.q - reference_.q).squaredNorm() + (state.p - reference_.p).squaredNorm());
+    error_ = robust_norm(state.q - reference_.q, state.p - reference_.p);
     worst_relative_ =
         std::max(worst_relative(state.q, reference_.q), worst_relative(state.p, reference_.p));
   }

@@ -12,6 +12,7 @@
 
 #include "harness/paths.hpp"
 #include "harness/table.hpp"
+#include "integrators/newton.hpp"
 
 namespace geomint {
 namespace {
@@ -27,8 +28,7 @@ class ReferenceErrorObserver : public Observer {
   void observe(const Problem&, const State& state) override {
     const int row = reference_->row_at(state.t);
     if (row < 0) return;
-    const double error = std::sqrt((state.q - reference_->q[row]).squaredNorm() +
-                                   (state.p - reference_->p[row]).squaredNorm());
+    const double error = robust_norm(state.q - reference_->q[row], state.p - reference_->p[row]);
     error_max_ = std::max(error_max_, error);
     if (reference_->row_at(t_last_) == row) {
       error_final_ = error;

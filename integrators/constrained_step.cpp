@@ -102,11 +102,11 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
     system.residual(x, point.F1);
     ++result.residual_evals;
     const Vec multiplier_force = G0_transpose * impulse;
-    point.multiplier_force_norm = multiplier_force.norm();
+    point.multiplier_force_norm = robust_norm(multiplier_force);
     point.F1 += multiplier_force;
     point.F2 = point.g / h;
     point.finite = point.F1.allFinite() && point.g.allFinite() && point.q_next.allFinite();
-    point.f1_norm = point.F1.norm();
+    point.f1_norm = robust_norm(point.F1);
     point.g_norm = m > 0 ? point.g.lpNorm<Eigen::Infinity>() : 0.0;
   };
 

@@ -154,7 +154,7 @@ class DiscreteLagrangianVI final : public Integrator {
       implicit_terms(problem, v);
       // The sizes of the terms the residual balances, at the start iterate.
       const double residual_scale =
-          state.p.norm() + (constant_ + state.p).norm() + implicit_term_.norm();
+          robust_norm(state.p) + robust_norm(constant_ + state.p) + robust_norm(implicit_term_);
       if (problem.has(kConstraints)) {
         // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
         const ConstrainedStepResult constrained = solve_constrained_step(

@@ -115,9 +115,9 @@ class ImplicitEuler final : public Integrator {
     if (!(std::isfinite(end_force_norm_) && end_q_.size() == state.q.size() && end_q_ == state.q)) {
       eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
                        force_);
-      end_force_norm_ = force_.norm();
+      end_force_norm_ = robust_norm(force_);
     }
-    const double residual_scale = state.p.norm() + std::abs(h) * end_force_norm_;
+    const double residual_scale = robust_norm(state.p) + std::abs(h) * end_force_norm_;
 
     double latest_force_norm = 0.0, inner_scale = 0.0;
     NewtonSystem system;
@@ -125,7 +125,7 @@ class ImplicitEuler final : public Integrator {
     system.residual = [&](const Vec& v, Vec& residual) {
       q_next_ = state.q + h * v;
       eval_total_force(problem, q_next_, v, t_next, force_);
-      latest_force_norm = force_.norm();
+      latest_force_norm = robust_norm(force_);
       residual = mass.cwiseProduct(v) - state.p - h * force_;
     };
     system.jacobian = [&](const Vec& v, SparseMatrix& jacobian) {
@@ -169,7 +169,7 @@ class ImplicitEuler final : public Integrator {
     const Vec& y = state.q;
     ++counters_.force_evals;
     problem.first_order_rhs(state.t, y, force_);
-    const double residual_scale = y.norm() + std::abs(h) * force_.norm();
+    const double residual_scale = robust_norm(y) + std::abs(h) * robust_norm(force_);
     NewtonSystem system;
     system.residual = [&](const Vec& x, Vec& residual) {
       ++counters_.force_evals;

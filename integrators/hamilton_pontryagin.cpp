@@ -241,7 +241,8 @@ class HamiltonPontryagin final : public Integrator {
     }
 
     implicit_terms(problem, v);
-    const double residual_scale = state.p.norm() + (b_ - state.p).norm() + implicit_term_.norm();
+    const double residual_scale =
+        robust_norm(state.p) + robust_norm(b_ - state.p) + robust_norm(implicit_term_);
     if (problem.has(kConstraints)) {
       // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
       const ConstrainedStepResult constrained = solve_constrained_step(
@@ -274,7 +275,7 @@ class HamiltonPontryagin final : public Integrator {
   // that makes the minus impulse a dissipation gradient. Checked once per run.
   bool force_is_affine(const Problem& problem, const State& state, const Vec& v_start) {
     Vec v_test = v_start;
-    if (v_test.norm() == 0.0) v_test.setOnes();
+    if (robust_norm(v_test) == 0.0) v_test.setOnes();
     Vec f_zero, f_test;
     SparseMatrix c_zero, c_test;
     eval_counted_force(problem, state.q, Vec::Zero(v_test.size()), state.t, f_zero);
@@ -282,9 +283,9 @@ class HamiltonPontryagin final : public Integrator {
     problem.force_jacobian_v(state.q, Vec::Zero(v_test.size()), state.t, c_zero);
     problem.force_jacobian_v(state.q, v_test, state.t, c_test);
     const Vec model = f_zero - c_zero * v_test;
-    const double scale = f_test.norm() + f_zero.norm() + (c_zero * v_test).norm();
-    return (f_test - model).norm() <= 1e-12 * scale &&
-           (c_test - c_zero).norm() <= 1e-12 * c_zero.norm();
+    const double scale = robust_norm(f_test) + robust_norm(f_zero) + robust_norm(c_zero * v_test);
+    return robust_norm(f_test - model) <= 1e-12 * scale &&
+           robust_norm(c_test - c_zero) <= 1e-12 * robust_norm(c_zero);
   }
 
   void eval_counted_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {

@@ -100,7 +100,7 @@ class ImplicitMidpoint final : public Integrator {
 
     // Start v̄ = M⁻¹p₀ (linear momentum exact through every iterate, as for del and hp).
     impulse(v, impulse_);
-    const double residual_scale = state.p.norm() + impulse_.norm();
+    const double residual_scale = robust_norm(state.p) + robust_norm(impulse_);
     const NewtonResult result = newton_.solve(system, v, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;

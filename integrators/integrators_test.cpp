@@ -162,6 +162,37 @@ NewtonSystem convex_gradient(int n) {
   return system;
 }
 
+// robust_norm: the same bits as Eigen's norm() where squaring stays in range, the right value
+// (to a few ulps) where it does not, and finite for subnormal entries.
+TEST(RobustNorm, MatchesNormInRangeAndStaysRightOutsideIt) {
+  Vec v(5);
+  v << 0.3, -1.7, 2.5e-3, 4.0, -0.01;
+  for (double scale : {1.0, 3e-7, 1e12, 1e-140, 1e140}) {
+    const Vec scaled = scale * v;
+    EXPECT_EQ(robust_norm(scaled), scaled.norm()) << scale;  // bit for bit
+  }
+  const double exact = v.norm();
+  for (double scale : {1e-170, 1e-250, 1e-300, 1e170, 1e250, 1e300}) {
+    const double norm = robust_norm(scale * v);
+    EXPECT_NEAR(norm / scale, exact, 4 * std::numeric_limits<double>::epsilon() * exact)
+        << scale;
+  }
+  EXPECT_EQ((1e-170 * v).norm(), 0.0);  // why robust_norm exists
+  EXPECT_TRUE(std::isinf((1e170 * v).norm()));
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  Vec subnormal(2);
+  subnormal << 3 * tiny, 4 * tiny;
+  EXPECT_EQ(robust_norm(subnormal), 5 * tiny);
+  EXPECT_EQ(robust_norm(Vec::Zero(3)), 0.0);
+  EXPECT_EQ(robust_norm(Vec()), 0.0);
+  Vec with_nan = v;
+  with_nan[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(robust_norm(with_nan)));
+  EXPECT_EQ(power_of_two_unit(3.0), 0.5);
+  EXPECT_EQ(power_of_two_unit(0.0), 1.0);
+  EXPECT_TRUE(std::isfinite(power_of_two_unit(tiny)));
+}
+
 TEST(NewtonSolver, ConvergesQuadraticallyWithSparseLU) {
   NewtonOptions options;
   options.record_history = true;

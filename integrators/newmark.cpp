@@ -169,8 +169,9 @@ class Newmark final : public Integrator {
       system.symmetric = !forced || (problem.has(kForceJacobian) && *damping_symmetric_);
       // total_ holds the force at q₁(a₀) after the first residual: h‖M a‖ and h‖∇V‖ are the
       // terms R cancels, and for hω ≫ 1 the latter dominates ‖p‖ + h‖M a₀‖ by (hω)².
-      system.scale_after_first_residual = [&] { return std::abs(h) * total_.norm(); };
-      const double residual_scale = state.p.norm() + std::abs(h) * mass.cwiseProduct(a0_).norm();
+      system.scale_after_first_residual = [&] { return std::abs(h) * robust_norm(total_); };
+      const double residual_scale =
+          robust_norm(state.p) + std::abs(h) * robust_norm(mass.cwiseProduct(a0_));
       const NewtonResult result = newton_.solve(system, a1, residual_scale);
       counters_.newton_iters += result.iterations;
       counters_.linear_solves += result.linear_solves;

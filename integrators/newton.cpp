@@ -38,7 +38,7 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
                             const Vec& b, double target, int max_iterations, Vec& x) {
   x = Vec::Zero(b.size());
   Vec r = b;
-  if (r.norm() <= target) return CgOutcome::kConverged;
+  if (robust_norm(r) <= target) return CgOutcome::kConverged;
   Vec z = preconditioner.solve(r);
   Vec p = z, Ap;
   double rz = r.dot(z);
@@ -49,7 +49,7 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
     const double alpha = rz / curvature;
     x += alpha * p;
     r -= alpha * Ap;
-    if (r.norm() <= target) return CgOutcome::kConverged;
+    if (robust_norm(r) <= target) return CgOutcome::kConverged;
     z = preconditioner.solve(r);
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
@@ -346,6 +346,27 @@ SparseMatrix central_difference_jacobian(const std::function<void(const Vec& x, 
   return out;
 }
 
+double power_of_two_unit(double magnitude) {
+  if (!(magnitude > 0.0) || !std::isfinite(magnitude)) return 1.0;
+  // Clamped so that a subnormal magnitude (exponent down to −1074) still gets a finite unit.
+  return std::ldexp(1.0, std::clamp(-std::ilogb(magnitude), -1000, 1000));
+}
+
+double robust_norm(const Vec& v) {
+  if (v.size() == 0) return 0.0;
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0) || !std::isfinite(largest)) return v.norm();  // 0, or inf/NaN propagate
+  const double unit = power_of_two_unit(largest);
+  return (v * unit).norm() / unit;
+}
+
+double robust_norm(const Vec& a, const Vec& b) {
+  const double largest = std::max(a.size() > 0 ? a.cwiseAbs().maxCoeff() : 0.0,
+                                  b.size() > 0 ? b.cwiseAbs().maxCoeff() : 0.0);
+  const double unit = std::isfinite(largest) ? power_of_two_unit(largest) : 1.0;
+  return std::sqrt((unit * a).squaredNorm() + (unit * b).squaredNorm()) / unit;
+}
+
 double gradient_term_scale(const SparseMatrix& H, const Vec& q) {
   Vec terms = Vec::Zero(H.rows());
   for (int k = 0; k < H.outerSize(); ++k) {
@@ -353,7 +374,7 @@ double gradient_term_scale(const SparseMatrix& H, const Vec& q) {
       terms[it.row()] += std::abs(it.value()) * std::abs(q[it.col()]);
     }
   }
-  return terms.norm();
+  return robust_norm(terms);
 }
 
 std::string describe(const NewtonResult& result) {
@@ -374,7 +395,7 @@ std::string describe(const NewtonResult& result) {
 NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
   NewtonResult result;
   const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
-  result.threshold = relative_tolerance * residual_scale;
+  result.threshold = std::max(relative_tolerance * residual_scale, kSubnormalResidual);
   double scale = residual_scale;
   Factorisation& f = *factorisation_;
 
@@ -387,9 +408,13 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
           fmt::format("Newton residual has size {} for {} unknowns", r.size(), at.size()));
     }
   };
-  // Merit of a finite residual: the objective when the system has one, else ½‖R‖².
+  // Merit of a finite residual: the objective when the system has one, else ½‖R‖² in units of
+  // the power of two nearest the residual scale (merit_unit), so that it neither underflows for a
+  // state of size 1e-300 nor overflows for 1e+150; merits and slopes are only compared with each
+  // other, and scaling by 2ᵏ keeps every comparison bit for bit.
+  double merit_unit = 1.0;
   auto merit_of = [&](const Vec& at, const Vec& r) {
-    return system.objective ? system.objective(at) : 0.5 * r.squaredNorm();
+    return system.objective ? system.objective(at) : 0.5 * (merit_unit * r).squaredNorm();
   };
   auto fail = [&](const char* reason) {
     result.reason = reason;
@@ -400,12 +425,16 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   evaluate(x, residual);
   if (system.scale_after_first_residual) {
     scale = residual_scale + system.scale_after_first_residual();
-    result.threshold = relative_tolerance * scale;
+    result.threshold = std::max(relative_tolerance * scale, kSubnormalResidual);
   }
-  result.residual_norm = residual.norm();
+  merit_unit = power_of_two_unit(scale);
+  result.residual_norm = robust_norm(residual);
   if (options_.record_history) result.residual_history.push_back(result.residual_norm);
   if (!all_finite(residual)) return fail("nan");
   double merit = merit_of(x, residual);
+  // An objective is an energy, quadratic in the state: it overflows for a state above ~1e154
+  // where the residual (linear in it) is still finite. Say so rather than "nan".
+  if (system.objective && std::isinf(merit)) return fail("objective_overflow");
   if (!std::isfinite(merit)) return fail("nan");
 
   const bool safeguard = system.symmetric && system.objective && system.spd_shift.size() > 0;
@@ -492,7 +521,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
         if (solve_held(-residual, direction)) {
           trial = x + direction;
           evaluate(trial, trial_residual);
-          const double polished_norm = trial_residual.norm();
+          const double polished_norm = robust_norm(trial_residual);
           if (all_finite(trial_residual) && polished_norm < result.residual_norm) {
             x.swap(trial);
             result.residual_norm = polished_norm;
@@ -521,7 +550,8 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       if (system.inner_term_scale) {
         const double inner = system.inner_term_scale();
         if (std::isfinite(inner)) {
-          result.threshold = std::max(relative_tolerance * scale, kRoundoffFloor * (scale + inner));
+          result.threshold = std::max(
+              {relative_tolerance * scale, kRoundoffFloor * (scale + inner), kSubnormalResidual});
         }
       }
       // A nearly singular matrix factorises without a zero pivot but yields inf/NaN directions.
@@ -533,13 +563,13 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     // own rounding, so the residual left is the rounding of R's terms — which can exceed
     // tolerance·residual_scale when a term's inner magnitude (h·K·q of a stiff spring whose
     // elongation is small) is far above its value. Take the correction and stop.
-    if (direction.norm() <= kRoundoffFloor * x.norm()) {
+    if (robust_norm(direction) <= std::max(kRoundoffFloor * robust_norm(x), kSubnormalResidual)) {
       trial = x + direction;
       evaluate(trial, trial_residual);
       if (all_finite(trial_residual)) {
         x.swap(trial);
         residual.swap(trial_residual);
-        result.residual_norm = residual.norm();
+        result.residual_norm = robust_norm(residual);
         if (options_.record_history) result.residual_history.push_back(result.residual_norm);
         result.converged = true;
         result.at_roundoff = true;
@@ -549,12 +579,18 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
 
     // Directional derivative of the merit along the step. For ½‖R‖² it is Rᵀ J d = −‖R‖² for
     // the exact Newton step, whatever J is, so the step is always a descent direction.
-    const double slope = system.objective ? residual.dot(direction) : -residual.squaredNorm();
+    const double slope =
+        system.objective ? residual.dot(direction) : -(merit_unit * residual).squaredNorm();
     if (system.objective && options_.line_search && !(slope < 0.0)) {
       if (stale) {  // an old Jacobian's direction: retry this iteration with the current one
         --result.iterations;
         reuse_factor = false;
         continue;
+      }
+      // R·d = 0 with R and d nonzero: the product underflowed (a state below ~1e-160, whose
+      // energy is below the smallest double), not a non-descent direction.
+      if (slope == 0.0 && result.residual_norm > 0.0 && robust_norm(direction) > 0.0) {
+        return fail("objective_underflow");
       }
       return fail("not_descent");
     }
@@ -579,7 +615,8 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       any_finite = true;
       // Without a line search a full step is taken whatever it does to R; from an old Jacobian
       // only if it reduces ‖R‖ (otherwise the iteration is redone with the current one).
-      if (stale && !options_.line_search && !(trial_residual.norm() < result.residual_norm)) break;
+      if (stale && !options_.line_search && !(robust_norm(trial_residual) < result.residual_norm))
+        break;
       if (!options_.line_search || trial_merit <= merit + options_.armijo * step * slope) {
         accepted = true;
         break;
@@ -587,7 +624,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       // Close to the root an objective's decrease (~‖R‖²) drops below its round-off
       // (~ε|E|) long before ‖R‖ reaches the tolerance; the residual still measures progress.
       const double merit_size = std::max(std::abs(merit), system.objective_scale);
-      if (system.objective && trial_residual.norm() < result.residual_norm &&
+      if (system.objective && robust_norm(trial_residual) < result.residual_norm &&
           trial_merit <= merit + 16 * std::numeric_limits<double>::epsilon() * merit_size) {
         accepted = true;
         break;
@@ -596,7 +633,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       // (an elastic energy density of a rotated element: μ(tr H + ½|H|²) − μ ln J with H = R − I
       // of size 1 and W ~ strain²), and then hides a decrease of E that the gradient still
       // resolves. Armijo in derivative form (the approximate Wolfe test, kApproximateArmijoSlack).
-      if (system.objective && trial_residual.norm() < result.residual_norm &&
+      if (system.objective && robust_norm(trial_residual) < result.residual_norm &&
           trial_residual.dot(direction) <= (1 - 2 * options_.armijo) * -slope &&
           trial_merit <= merit + kApproximateArmijoSlack * merit_size) {
         accepted = true;
@@ -614,7 +651,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     residual.swap(trial_residual);
     merit = trial_merit;
     const double previous_norm = result.residual_norm;
-    result.residual_norm = residual.norm();
+    result.residual_norm = robust_norm(residual);
     reuse_factor = modified && f.has_factor && step == 1.0 &&
                    result.residual_norm <= kModifiedNewtonContraction * previous_norm;
     if (options_.record_history) result.residual_history.push_back(result.residual_norm);

@@ -60,6 +60,12 @@ const char* linear_solver_name(LinearSolverKind kind);
 // round-off (NewtonResult::at_roundoff).
 inline constexpr double kRoundoffFloor = 16 * 2.220446049250313e-16;
 
+// The only absolute floor of the stopping tests: a residual (or correction) below the smallest
+// normal double counts as zero. Below it, numbers lose relative precision (subnormals), so a
+// relative test can no longer be met; it matters only for states smaller than ~1e-290 (a
+// dissipative run decaying towards 0, say), which it lets end as converged steps.
+inline constexpr double kSubnormalResidual = 2.2250738585072014e-308;  // DBL_MIN
+
 // The minimiser's line search also accepts a step when E's change is lost in E's rounding but
 // the slope along the step, R(x + αd)·d, says E decreased (Hager & Zhang, SIAM J. Optim. 16(1)
 // 2005, "approximate Wolfe" conditions, §4): for a quadratic E, φ(α) − φ(0) = α(φ'(0) + φ'(α))/2,
@@ -75,9 +81,10 @@ struct NewtonOptions {
   // Converged when ‖R(x)‖₂ ≤ max(tolerance, kRoundoffFloor) · residual_scale, where
   // residual_scale (passed to solve(), plus NewtonSystem::scale_after_first_residual) is the size
   // of the terms that R balances, e.g. ‖p_k‖ + h‖∇V‖ for a momentum residual. The test is
-  // relative to the physics with no absolute floor, so a state of size 1e-100 or 1e+100 is solved
-  // to the same relative accuracy as one of size 1 (scale-free); kRoundoffFloor keeps a
-  // tolerance far below ε from asking for a residual below the rounding of its own terms.
+  // relative to the physics, with no absolute floor above the subnormals (kSubnormalResidual),
+  // and its norms are robust_norm's, so a state of any size from 1e-250 to 1e+250 is solved to
+  // the same relative accuracy as one of size 1 (scale-free); kRoundoffFloor keeps a tolerance
+  // far below ε from asking for a residual below the rounding of its own terms.
   double tolerance = 1e-12;
   int max_iterations = 50;  // Newton updates (Jacobian factorisations) allowed per solve
   // Backtracking on the merit function (½‖R‖², or the system's objective when it has one).
@@ -151,6 +158,21 @@ struct NewtonSystem {
   std::function<double()> inner_term_scale;
 };
 
+// ‖v‖₂ without the under- and overflow of squaring the entries: v is scaled by the power of two
+// nearest its largest entry, so the result is bit-identical to v.norm() wherever that one neither
+// underflows nor overflows (scaling by 2ᵏ is exact), and right from the smallest normal double
+// to the largest, where v.norm() is 0 below ~1e-162 and inf above ~1e154. Every test and scale
+// of the Newton solve and of the implicit methods' residual scales uses it, so a state of size
+// 1e-300 or 1e+150 is solved like one of size 1 (tests/methods_test.cpp, scale-free).
+double robust_norm(const Vec& v);
+// ‖(a, b)‖₂ of the two stacked, the same way: bit-identical to √(‖a‖² + ‖b‖²) in range (the
+// harness's phase-space errors ‖(q − q_ref, p − p_ref)‖₂ use it).
+double robust_norm(const Vec& a, const Vec& b);
+
+// The power of two 2⁻ᵏ that brings `magnitude` into [1, 2) (1 for 0, inf or NaN): multiplying by
+// it is exact, so quantities compared with each other keep their order bit for bit.
+double power_of_two_unit(double magnitude);
+
 // ‖ |H|·|q| ‖₂ for a Hessian H = ∇²V(q): the size of the terms a gradient ∇V(q) sums when V is
 // built from coordinate differences (springs, elements), so ε·‖|H||q|‖ estimates its rounding.
 double gradient_term_scale(const SparseMatrix& H, const Vec& q);
@@ -159,7 +181,10 @@ struct NewtonResult {
   bool converged = false;
   // "" when converged; otherwise "newton_max_iter", "nan", "linear_solve_failed",
   // "line_search_failed" (no acceptable step length: R is at its round-off floor or x is near
-  // a stationary point of the merit function that is not a root), "not_descent".
+  // a stationary point of the merit function that is not a root), "not_descent",
+  // "objective_underflow" / "objective_overflow" (the objective, an energy quadratic in the
+  // state, is not representable at this state's size: below ~1e-160 or above ~1e154; the
+  // residual-only path, e.g. hp:solver=newton, has no such limit).
   std::string reason;
   int iterations = 0;            // Newton updates taken
   int linear_solves = 0;         // factorise + solve pairs

@@ -169,8 +169,8 @@ class ImplicitPartitionedRk final : public Integrator {
         v.segment(i * n, n) = inverse_mass.cwiseProduct(p0 + (c_[i] * h) * force0);
       }
     }
-    const double residual_scale =
-        std::sqrt(static_cast<double>(stages_)) * (p0.norm() + std::abs(h) * force0.norm());
+    const double residual_scale = std::sqrt(static_cast<double>(stages_)) *
+                                  (robust_norm(p0) + std::abs(h) * robust_norm(force0));
     const NewtonResult result = newton_.solve(system, v, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
