@@ -1,10 +1,11 @@
 # Long runs (results/long_run): Brouwer's law with and without compensated summation, and the
 # energy drift of adaptive Verlet. Run inside the scene folder (scripts/reproduce.sh does); reads
-# series/{kepler_roundoff,solar_roundoff,kepler_adaptive}/. Errors are relative (dimensionless).
+# series/{kepler_roundoff,solar_roundoff,solar_roundoff_com,kepler_adaptive}/. Errors are relative (dimensionless).
 load scripts."/common.gp"
 file(l, m) = "series/".l."/".m.".csv"
 # Per-window maximum of |H - H0|/|H0| (scripts/envelope.awk); width = one orbital period.
-envelope(f, width) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=%g -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", H0, width, scripts, f)
+envelope_at(f, width, ref) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=%g -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", ref, width, scripts, f)
+envelope(f, width) = envelope_at(f, width, H0)
 plain = "composition_scheme_kahan_li8"
 compensated = "composition_scheme_kahan_li8_compensated_true"
 
@@ -27,9 +28,19 @@ do for [format in "png pdf"] {
     stats file(label, plain) using "energy" every ::0::0 nooutput; H0 = STATS_min
     stats envelope(file(label, plain), width) using 1 every ::0::0 nooutput; t1 = STATS_min
     stats envelope(file(label, plain), width) using 2 every ::0::0 nooutput; e1 = STATS_min
-    plot envelope(file(label, plain), width) using 1:2 with linespoints ls 41 pn 12 title "plain summation", \
-         envelope(file(label, compensated), width) using 1:2 with linespoints ls 46 pn 12 title "compensated (Kahan)", \
-         e1 * sqrt(x / t1) with lines lw 1 dt (6,4) lc rgb "#555555" title "slope 1/2 (Brouwer's law)"
+    if (panel == 1) {
+      plot envelope(file(label, plain), width) using 1:2 with linespoints ls 41 pn 12 title "plain summation", \
+           envelope(file(label, compensated), width) using 1:2 with linespoints ls 46 pn 12 title "compensated (Kahan)", \
+           e1 * sqrt(x / t1) with lines lw 1 dt (6,4) lc rgb "#555555" title "slope 1/2 (Brouwer's law)"
+    } else {
+      # The centre-of-mass frame runs have their own H0 (the drift's kinetic energy is gone).
+      stats file("solar_roundoff_com", plain) using "energy" every ::0::0 nooutput; H0_com = STATS_min
+      plot envelope(file(label, plain), width) using 1:2 with linespoints ls 41 pn 12 title "plain, given frame (drifts 68 AU)", \
+           envelope(file(label, compensated), width) using 1:2 with linespoints ls 46 pn 12 title "compensated, given frame", \
+           envelope_at(file("solar_roundoff_com", plain), width, H0_com) using 1:2 with linespoints lw 2 lc rgb "#d62728" pt 6 pn 12 title "plain, centre-of-mass frame", \
+           envelope_at(file("solar_roundoff_com", compensated), width, H0_com) using 1:2 with linespoints lw 2 lc rgb "#9467bd" pt 8 pn 12 title "compensated, centre-of-mass frame", \
+           e1 * sqrt(x / t1) with lines lw 1 dt (6,4) lc rgb "#555555" title "slope 1/2 (Brouwer's law)"
+    }
   }
   unset multiplot
 
