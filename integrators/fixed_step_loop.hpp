@@ -17,7 +17,17 @@ AdvanceOutcome run_grid(State& state, const StepGrid& grid, StepVisitor visit, S
   double t = state.t;
   for (long k = 1; k <= grid.n; ++k) {
     const double t_next = grid.time(k);
-    step(t_next - t);
+    // A body that can fail returns its StepStatus; the run then ends as that failure after the
+    // last good step (outcome.steps).
+    if constexpr (std::is_same_v<std::invoke_result_t<Step&, double>, StepStatus>) {
+      StepStatus status = step(t_next - t);
+      if (!status.ok) {
+        outcome.status = std::move(status);
+        return outcome;
+      }
+    } else {
+      step(t_next - t);
+    }
     t = t_next;
     state.t = t;  // the grid time, as the per-step path sets it, for bodies that read state.t
     if (visit && !visit(state, k)) return outcome;
@@ -26,14 +36,19 @@ AdvanceOutcome run_grid(State& state, const StepGrid& grid, StepVisitor visit, S
   return outcome;
 }
 
-// Base of explicit methods whose step is one non-failing body `Derived::advance_by(problem,
-// state, h)`: step() and advance() both run it, so the two paths cannot drift apart.
+// Base of explicit methods whose step is one body `Derived::advance_by(problem, state, h)`:
+// step() and advance() both run it, so the two paths cannot drift apart. The body returns void
+// (it cannot fail) or a StepStatus (position Verlet's implicit force kick can).
 template <class Derived>
 class ExplicitStepper : public Integrator {
  public:
   StepStatus step(const Problem& problem, State& state, double h) final {
-    derived().advance_by(problem, state, h);
-    return StepStatus::success();
+    if constexpr (std::is_same_v<decltype(derived().advance_by(problem, state, h)), StepStatus>) {
+      return derived().advance_by(problem, state, h);
+    } else {
+      derived().advance_by(problem, state, h);
+      return StepStatus::success();
+    }
   }
   AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
                          StepVisitor visit) final {

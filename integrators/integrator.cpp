@@ -7,6 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "integrators/newton.hpp"
+
 namespace geomint {
 
 #define GEOMINT_METHOD(name, factory, variants, summary) \
@@ -86,6 +88,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kConstraintsOnly, "constraints_only"},
       {kRheonomic, "rheonomic"},
       {kFirstOrderCapable, "first_order"},
+      {kConservativeOnly, "conservative_only"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -167,6 +170,13 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                                "over rattle or hp_midpoint, ida:index=2 or ida:index=3 solve it)",
                                method.spec(), problem.name())};
   }
+  if ((info.flags & kConservativeOnly) && problem.has(kForce)) {
+    return {false, fmt::format("method '{}' integrates separable conservative systems only; "
+                               "problem '{}' has a non-conservative force F(q, v, t) (damping, "
+                               "driving or a modulation); methods without the flag "
+                               "conservative_only take it",
+                               method.spec(), problem.name())};
+  }
   if ((info.flags & kConstraintsOnly) && !problem.has(kConstraints)) {
     return {false, fmt::format("method '{}' is for problems with holonomic constraints; problem "
                                "'{}' has none (use an unconstrained method)",
@@ -233,6 +243,30 @@ void Integrator::eval_hessian(const Problem& problem, const Vec& q, SparseMatrix
 
 void Integrator::eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {
   problem.force(q, v, t, f);
+}
+
+StepStatus Integrator::solve_force_kick(const Problem& problem, const Vec& q, double t,
+                                        const Vec& p_base, double weight, Vec& velocity,
+                                        Vec& force) {
+  const Vec& inverse_mass = problem.inverse_mass();
+  eval_force(problem, q, velocity, t, force);
+  double change = 0.0;
+  for (int pass = 0; pass < kMaxForceKickIterations; ++pass) {
+    kick_velocity_ = inverse_mass.cwiseProduct(p_base + weight * force);
+    kick_change_ = kick_velocity_ - velocity;  // into a kept vector: advance() must not allocate
+    change = robust_norm(kick_change_);
+    velocity.swap(kick_velocity_);
+    if (change <= kRoundoffFloor * robust_norm(velocity)) return StepStatus::success();
+    if (!velocity.allFinite()) break;
+    ++counters_.force_evals;
+    eval_force(problem, q, velocity, t, force);
+  }
+  return StepStatus::failure(
+      "force_kick_max_iter",
+      fmt::format("the velocity of the force kick did not settle in {} fixed-point passes "
+                  "(last change {:.3g} relative to |v| = {:.3g}): the step is beyond the explicit "
+                  "method's stability for this damping (h·c/m ≥ 2)",
+                  kMaxForceKickIterations, change, robust_norm(velocity)));
 }
 
 void Integrator::eval_total_force(const Problem& problem, const Vec& q, const Vec& v, double t,

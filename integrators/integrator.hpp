@@ -28,6 +28,9 @@ enum MethodFlag : unsigned {
   // Runs a generic first-order system y' = f(t, y) (Problem::first_order_rhs/_jacobian), so
   // also the kFirstOrderOnly problems (van der Pol, Robertson); the others need (q, p, M, ∇V).
   kFirstOrderCapable = 1u << 10,
+  // Integrates separable conservative systems only (Boost.Odeint's symplectic steppers): not run
+  // on problems with a force F(q, v, t) (kForce), and applicable() says so.
+  kConservativeOnly = 1u << 11,
 };
 std::vector<std::string> flag_names(unsigned flags);
 
@@ -190,12 +193,28 @@ class Integrator {
   void eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
   // −∇V(q) + F(q, v, t): the total generalized force.
   void eval_total_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
+  // The kick of an explicit method whose force F(q, v, t) must be taken at the velocity the kick
+  // produces (Störmer–Verlet's last half-kick, position Verlet's kick at the mean velocity):
+  // solves v = M⁻¹(p_base + weight·F(q, v, t)) for v by fixed-point iteration from the
+  // guess in `velocity`, leaving that v in `velocity` and F(q, v, t) in `force` (the caller forms
+  // its momentum from them in its own order of operations). The iteration contracts by
+  // weight·‖M⁻¹∂F/∂v‖ per pass, below 1 wherever the explicit method is stable for the damping
+  // (h·c/m < 2); a force that does not depend on v settles at its second evaluation with the
+  // same bits as the first; `force` is the one v was formed from, so the two are consistent to
+  // the last bit. Taking F at the guess instead ("Verlet with forces") is only first
+  // order for a velocity-dependent F. Returns a failure "force_kick_max_iter" when v has not
+  // settled (change ≤ 16ε‖v‖) after kMaxForceKickIterations passes. Extra evaluations count as
+  // force evaluations.
+  StepStatus solve_force_kick(const Problem& problem, const Vec& q, double t, const Vec& p_base,
+                              double weight, Vec& velocity, Vec& force);
+  static constexpr int kMaxForceKickIterations = 100;
 
   Counters counters_;
   std::optional<ConstraintImpulses> constraint_impulses_;  // cleared by reset()
 
  private:
   Vec extra_force_;  // eval_total_force's F(q, v, t), kept to avoid an allocation per call
+  Vec kick_velocity_, kick_change_;  // solve_force_kick's next iterate and its change
   friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
   std::string spec_;
 };

@@ -174,8 +174,7 @@ TEST(RobustNorm, MatchesNormInRangeAndStaysRightOutsideIt) {
   const double exact = v.norm();
   for (double scale : {1e-170, 1e-250, 1e-300, 1e170, 1e250, 1e300}) {
     const double norm = robust_norm(scale * v);
-    EXPECT_NEAR(norm / scale, exact, 4 * std::numeric_limits<double>::epsilon() * exact)
-        << scale;
+    EXPECT_NEAR(norm / scale, exact, 4 * std::numeric_limits<double>::epsilon() * exact) << scale;
   }
   EXPECT_EQ((1e-170 * v).norm(), 0.0);  // why robust_norm exists
   EXPECT_TRUE(std::isinf((1e170 * v).norm()));
@@ -410,9 +409,11 @@ hand_steps() {
        }},
       {"stormer_verlet",
        [](double m, double k, double c, double q, double p, double h) {
+         // The last half-kick takes the damping at the new velocity (implicit, second order):
+         // p⁺ = p½ + (h/2)(−k q⁺ − c p⁺/m).
          const double p_half = p + (h / 2) * (-k * q - c * p / m);
          const double q1 = q + h * p_half / m;
-         return Step{q1, p_half + (h / 2) * (-k * q1 - c * p_half / m)};
+         return Step{q1, (p_half - (h / 2) * k * q1) / (1 + h * c / (2 * m))};
        }},
       {"rk4",
        [](double m, double k, double c, double q, double p, double h) {

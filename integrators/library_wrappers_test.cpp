@@ -468,6 +468,11 @@ TEST(Forces, SymplecticWrappersRefuseForcedProblems) {
     EXPECT_FALSE(status.ok) << method;
     EXPECT_EQ(status.reason, "unsupported_force") << method;
     EXPECT_NE(status.message.find("non-conservative"), std::string::npos) << method;
+    // The harness never gets that far: applicable() refuses the pair (exit 2 for `run`, a
+    // skipped row in a sweep) through the flag conservative_only.
+    const Applicability applies = applicable(*integrator, problem);
+    EXPECT_FALSE(applies.ok) << method;
+    EXPECT_NE(applies.reason.find("conservative systems only"), std::string::npos) << method;
   }
 }
 
@@ -596,8 +601,10 @@ TEST(Registry, LibraryWrappersDeclareOrderAndFlags) {
            Expected{"gsl_rk4imp", 4, implicit_adaptive | kNeedsHessian},
            Expected{"odeint_dopri5", 5, explicit_adaptive},
            Expected{"odeint_rosenbrock4", 4, implicit_adaptive | kNeedsHessian},
-           Expected{"odeint_velocity_verlet", 2, kExplicit | kSymplectic | kSymmetric},
-           Expected{"odeint_mclachlan4", 4, kExplicit | kSymplectic | kSymmetric},
+           Expected{"odeint_velocity_verlet", 2,
+                    kExplicit | kSymplectic | kSymmetric | kConservativeOnly},
+           Expected{"odeint_mclachlan4", 4,
+                    kExplicit | kSymplectic | kSymmetric | kConservativeOnly},
            Expected{"adaptive_verlet", 2, kExplicit | kAdaptive},
        }) {
     const MethodInfo info = make_integrator(e.spec)->info();

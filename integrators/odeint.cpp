@@ -241,7 +241,8 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
 
 // ---------------------------------------------------------------------------------------------
 // Fixed-step symplectic steppers. Odeint's symplectic steppers assume a separable conservative
-// system, so problems with a non-conservative force are refused rather than silently changed.
+// system, so problems with a non-conservative force are refused rather than silently changed:
+// by applicable() (flag kConservativeOnly), and by step() for a caller that bypasses it.
 
 StepStatus refuse_force(const Problem& problem, const char* method) {
   if (!problem.has(kForce)) return StepStatus::success();
@@ -259,7 +260,7 @@ StepStatus refuse_force(const Problem& problem, const char* method) {
 class OdeintVelocityVerlet final : public Integrator {
  public:
   MethodInfo info() const override {
-    return {"odeint_velocity_verlet", 2, kExplicit | kSymplectic | kSymmetric,
+    return {"odeint_velocity_verlet", 2, kExplicit | kSymplectic | kSymmetric | kConservativeOnly,
             "Boost.Odeint velocity_verlet (Swope et al. 1982; GNI §I.1.4)"};
   }
 
@@ -319,7 +320,7 @@ class OdeintVelocityVerlet final : public Integrator {
 class OdeintMcLachlan4 final : public Integrator {
  public:
   MethodInfo info() const override {
-    return {"odeint_mclachlan4", 4, kExplicit | kSymplectic | kSymmetric,
+    return {"odeint_mclachlan4", 4, kExplicit | kSymplectic | kSymmetric | kConservativeOnly,
             "Boost.Odeint symplectic_rkn_sb3a_mclachlan (McLachlan, SIAM J. Sci. Comput. 16, "
             "1995)"};
   }

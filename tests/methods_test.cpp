@@ -63,6 +63,19 @@ TEST_P(EveryMethod, DeclaredOrderWithNonUnitMass) {
   expect_declared_order(GetParam(), kHeavyChainLadder);
 }
 
+// Time in the force: the driven damped oscillator (exact transient plus steady state), whose
+// force F = −c v + A cos(Ωt) depends on t. Every method that takes forces keeps its declared
+// order; one that evaluates F at the wrong time of its step (t_k where t_k + h/2 belongs) drops
+// to first order here and passes every unforced test above.
+const verify::Ladder kDrivenLadder{"damped_oscillator:omega=2,zeta=0.1,drive=0.8,drive_omega=1.3",
+                                   0.1, 7, 5.0};
+TEST_P(EveryMethod, DeclaredOrderWithATimeDependentForce) {
+  const auto problem = make_problem(kDrivenLadder.problem);
+  const Applicability applies = applicable(*make_integrator(GetParam()), *problem);
+  if (!applies.ok) GTEST_SKIP() << applies.reason;
+  expect_declared_order(GetParam(), kDrivenLadder);
+}
+
 // Scale invariance: on a linear problem the discrete map of every fixed-step method commutes
 // with scaling the state, Φ(s·y) = s·Φ(y), so the trajectory from s·y₀ is s times the one from
 // y₀ — provided every solver test is relative to the state. An absolute floor in a Newton
