@@ -275,7 +275,7 @@ class HamiltonPontryagin final : public Integrator {
   // that makes the minus impulse a dissipation gradient. Checked once per run.
   bool force_is_affine(const Problem& problem, const State& state, const Vec& v_start) {
     Vec v_test = v_start;
-    if (robust_norm(v_test) == 0.0) v_test.setOnes();
+    if (v_test.norm() == 0.0) v_test.setOnes();
     Vec f_zero, f_test;
     SparseMatrix c_zero, c_test;
     eval_counted_force(problem, state.q, Vec::Zero(v_test.size()), state.t, f_zero);
@@ -283,9 +283,9 @@ class HamiltonPontryagin final : public Integrator {
     problem.force_jacobian_v(state.q, Vec::Zero(v_test.size()), state.t, c_zero);
     problem.force_jacobian_v(state.q, v_test, state.t, c_test);
     const Vec model = f_zero - c_zero * v_test;
-    const double scale = robust_norm(f_test) + robust_norm(f_zero) + robust_norm(c_zero * v_test);
-    return robust_norm(f_test - model) <= 1e-12 * scale &&
-           robust_norm(c_test - c_zero) <= 1e-12 * robust_norm(c_zero);
+    const double scale = f_test.norm() + f_zero.norm() + (c_zero * v_test).norm();
+    return (f_test - model).norm() <= 1e-12 * scale &&
+           (c_test - c_zero).norm() <= 1e-12 * c_zero.norm();
   }
 
   void eval_counted_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {

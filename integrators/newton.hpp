@@ -165,6 +165,10 @@ struct NewtonSystem {
 // of the Newton solve and of the implicit methods' residual scales uses it, so a state of size
 // 1e-300 or 1e+150 is solved like one of size 1 (tests/methods_test.cpp, scale-free).
 double robust_norm(const Vec& v);
+// Not for matrices: a sparse argument would otherwise convert to a Vec (Eigen allows it), which
+// is not a Frobenius norm and, without Eigen's assertions, writes out of shape.
+template <class Derived>
+double robust_norm(const Eigen::SparseMatrixBase<Derived>&) = delete;
 // ‖(a, b)‖₂ of the two stacked, the same way: bit-identical to √(‖a‖² + ‖b‖²) in range (the
 // harness's phase-space errors ‖(q − q_ref, p − p_ref)‖₂ use it).
 double robust_norm(const Vec& a, const Vec& b);
