@@ -91,33 +91,15 @@ void parse_legacy_file(const std::string& file, Gate& gate, const std::string& w
   gate.table = path.stem().string();
 }
 
-// `# key: value` provenance lines at the top of a result CSV.
-std::map<std::string, std::string> provenance_of(const std::string& text) {
-  std::map<std::string, std::string> out;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line) && !line.empty() && line[0] == '#') {
-    const auto colon = line.find(": ");
-    if (colon == std::string::npos || colon < 2) continue;
-    out[line.substr(2, colon - 2)] = line.substr(colon + 2);
-  }
-  return out;
-}
-
 ResultFile read_result_file(const fs::path& path) {
-  std::ifstream stream(path);
-  if (!stream) throw InputError(fmt::format("gate: cannot read result file '{}'", path.string()));
-  std::stringstream text;
-  text << stream.rdbuf();
+  // A damaged table is refused whole (read_csv_file): a row cut inside a number would read as
+  // another number and could pass a band the intact table fails.
+  const CsvTable table = read_csv_file(path.string());
   ResultFile file;
   file.path = path.string();
   file.table = path.stem().string();
-  try {
-    file.rows = parse_csv(text.str());
-  } catch (const std::runtime_error& error) {
-    throw InputError(fmt::format("gate: result file '{}': {}", path.string(), error.what()));
-  }
-  const auto lines = provenance_of(text.str());
+  file.rows = table.rows;
+  const std::map<std::string, std::string> lines(table.provenance.begin(), table.provenance.end());
   const auto scene = lines.find("scene");
   const auto variant = lines.find("variant");
   if (scene != lines.end() && !scene->second.empty()) {

@@ -75,6 +75,13 @@ std::shared_ptr<const ReferenceSolution> load_reference(const std::string& path,
         path, what));
   };
 
+  // A file cut short is refused before any of its lines is believed.
+  std::vector<Row> rows;
+  try {
+    rows = parse_csv(text);  // fail() names the file
+  } catch (const std::exception& error) {
+    throw fail(error.what());
+  }
   auto solution = std::make_shared<ReferenceSolution>();
   solution->path = path;
   bool has_error = false;
@@ -98,12 +105,6 @@ std::shared_ptr<const ReferenceSolution> load_reference(const std::string& path,
   }
   if (!has_error) throw fail("no numeric '# estimated_error_max:' line");
 
-  std::vector<Row> rows;
-  try {
-    rows = parse_csv(text);
-  } catch (const std::exception& error) {
-    throw fail(error.what());
-  }
   if (rows.empty()) throw fail("no rows");
   const int dof = problem.dof();
   for (size_t r = 0; r < rows.size(); ++r) {

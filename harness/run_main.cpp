@@ -193,6 +193,8 @@ void print_problems(bool markdown) {
 
 int run_main(int argc, char** argv) {
   const std::string program = program_name(argc, argv);
+  // A sweep stopped by Slurm's time limit (SIGTERM) or Ctrl-C leaves no temporary file behind.
+  remove_temporaries_on_signals();
   CLI::App app{"geomint: verification and benchmark suite for geometric time integrators"};
   app.require_subcommand(1);
   app.set_version_flag("--version",
@@ -286,7 +288,7 @@ int run_main(int argc, char** argv) {
                   "take i/N from SLURM_ARRAY_TASK_ID and --shards, or from "
                   "OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE");
   sweep->add_option("--shards", shard_count, "N for --shard-from-env")
-      ->check(CLI::Range(1, 1000000));
+      ->check(CLI::Range(1, kMaxShards));
   sweep->add_flag("--timing-only", timing_only,
                   "run only the timing passes, one at a time, into the merged tables of the "
                   "output folder (after `geomint merge`), with this node's CPU in provenance");
@@ -309,7 +311,7 @@ int run_main(int argc, char** argv) {
       "Write sweep.sbatch, merge.sbatch and timing.sbatch next to the scene (and submit them)");
   slurm->add_option("scene", slurm_scene, "results/<scene>/scene.toml")->required();
   slurm->add_option("--shards", slurm_shards, "array size N (default: min(units, 1000))")
-      ->check(CLI::Range(1, 1000000));
+      ->check(CLI::Range(1, kMaxShards));
   slurm->add_option("--max-parallel", slurm_max_parallel, "at most K array tasks at once")
       ->check(CLI::Range(1, 1000000));
   slurm->add_option("--partition", slurm_partition, "Slurm partition");
@@ -540,7 +542,7 @@ int run_main(int argc, char** argv) {
       options.variant = quick ? "quick" : "full";
       check_output_dir(options.out_dir, sweep_out.empty() ? "output folder" : "--out");
       if (markdown_only) {
-        rewrite_scene_markdown(scene, options.out_dir);
+        rewrite_scene_markdown(scene, options);
         return 0;
       }
       if (timing_only) {
@@ -564,6 +566,13 @@ int run_main(int argc, char** argv) {
         options.shard_count = id.count;
         options.scene_hash = scene_content_hash(scene_path, quick);
         const SceneUnits units = scene_units(scene);
+        if (static_cast<size_t>(id.count) > units.total()) {
+          // Merge refuses such a set: shards past the last unit would hold nothing.
+          throw InputError(
+              fmt::format("--shard {}/{}: the scene has {} unit(s) (runs, order studies, stability "
+                          "searches); use at most that many shards",
+                          id.index, id.count, units.total()));
+        }
         const auto tables = shard_tables(units.runs, units.orders, units.stability);
         if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
           fmt::print(stderr, "{}: shard {}/{} of '{}' is complete on disk; skipped\n", program,
@@ -616,9 +625,14 @@ int run_main(int argc, char** argv) {
       SlurmOptions options;
       options.scene_path = slurm_scene;
       options.quick = slurm_quick;
+      const size_t units = scene_units(scene).total();
+      if (static_cast<size_t>(slurm_shards) > units) {
+        throw InputError(
+            fmt::format("--shards {}: the scene has {} unit(s); use at most that many shards",
+                        slurm_shards, units));
+      }
       options.shards =
-          slurm_shards ? slurm_shards
-                       : static_cast<int>(std::clamp<size_t>(scene_units(scene).total(), 1, 1000));
+          slurm_shards ? slurm_shards : static_cast<int>(std::clamp<size_t>(units, 1, 1000));
       options.max_parallel = slurm_max_parallel;
       options.partition = slurm_partition;
       options.time_limit = slurm_time;

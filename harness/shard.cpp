@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "harness/record.hpp"
+#include "harness/shard_files.hpp"
 #include "harness/stability.hpp"
 #include "harness/sweep.hpp"
 #include "problems/spec.hpp"
@@ -42,12 +43,6 @@ long parse_count(const std::string& text) {
   return std::stol(text);
 }
 
-std::string host_name() {
-  char name[256] = {};
-  if (::gethostname(name, sizeof name - 1) != 0) return "unknown";
-  return name;
-}
-
 std::string this_version() { return provenance("").front().second; }
 
 // A shard table as read back: its `# key: value` lines, its header and its rows.
@@ -63,17 +58,15 @@ ShardTable read_shard_table(const fs::path& path) {
   ShardTable table;
   table.path = path;
   try {
-    const std::string text = read_text(path);
-    for (auto& [key, value] : csv_provenance(text)) table.header[key] = value;
-    table.columns = csv_header(text);
-    table.rows = parse_csv(text);
+    CsvTable csv = read_csv_file(path.string());
+    for (auto& [key, value] : csv.provenance) table.header[key] = value;
+    table.columns = std::move(csv.columns);
+    table.rows = std::move(csv.rows);
   } catch (const std::exception& error) {
     table.error = error.what();
   }
   return table;
 }
-
-std::string shard_text(ShardId id) { return fmt::format("{}/{}", id.index, id.count); }
 
 // The resubmission advice of a refused merge.
 std::string resubmission(const std::set<int>& shards, const MergeOptions& options,
@@ -91,37 +84,15 @@ std::string resubmission(const std::set<int>& shards, const MergeOptions& option
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> csv_provenance(const std::string& text) {
-  std::vector<std::pair<std::string, std::string>> lines;
-  std::istringstream stream(text);
-  for (std::string line; std::getline(stream, line) && !line.empty() && line[0] == '#';) {
-    const auto colon = line.find(": ");
-    if (line.rfind("# ", 0) == 0 && colon != std::string::npos) {
-      lines.emplace_back(line.substr(2, colon - 2), line.substr(colon + 2));
-    }
-  }
-  return lines;
-}
-
-std::vector<std::string> csv_header(const std::string& text) {
-  std::istringstream stream(text);
-  std::string line;
-  while (std::getline(stream, line) && !line.empty() && line[0] == '#') {
-  }
-  std::vector<std::string> columns;
-  std::istringstream names(line);  // column names hold no ',' or '"'
-  for (std::string name; std::getline(names, name, ',');) columns.push_back(name);
-  return columns;
-}
-
 ShardId parse_shard(const std::string& text) {
   const auto slash = text.find('/');
   const long index = slash == std::string::npos ? -1 : parse_count(text.substr(0, slash));
   const long count = slash == std::string::npos ? -1 : parse_count(text.substr(slash + 1));
-  if (index < 0 || count < 1 || index >= count) {
+  if (index < 0 || count < 1 || index >= count || count > kMaxShards) {
     throw InputError(fmt::format(
-        "--shard '{}': expected i/N with 0 <= i < N (e.g. --shard 3/8, the fourth of eight)",
-        text));
+        "--shard '{}': expected i/N with 0 <= i < N <= {} (e.g. --shard 3/8, the fourth of "
+        "eight)",
+        text, kMaxShards));
   }
   return {static_cast<int>(index), static_cast<int>(count)};
 }
@@ -153,7 +124,7 @@ ShardId shard_from_env(int count) {
           rank_name));
     }
     const long index = parse_count(rank);
-    if (index < 0 || size < 1 || index >= size) {
+    if (index < 0 || size < 1 || index >= size || size > kMaxShards) {
       throw InputError(
           fmt::format("--shard-from-env: {}={} is not a shard of {}", rank_name, rank, size));
     }
@@ -174,11 +145,6 @@ std::string scene_content_hash(const std::string& scene_path, bool quick) {
     hash *= 1099511628211ull;
   }
   return fmt::format("fnv1a64:{:016x}", hash);
-}
-
-std::string shard_file(const std::string& out_dir, const std::string& table, ShardId id) {
-  return (fs::path(out_dir) / "shards" / fmt::format("{}.{}-of-{}.csv", table, id.index, id.count))
-      .string();
 }
 
 std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability) {
@@ -205,20 +171,6 @@ std::string merged_sweep_command(const std::string& shard_command) {
   }
   if (!no_timing) kept.push_back("--no-timing");
   return fmt::format("{}", fmt::join(kept, " "));
-}
-
-void write_shard_table(const std::string& out_dir, const std::string& table, ShardId id,
-                       const std::string& scene_hash, std::vector<Row> rows,
-                       const std::vector<size_t>& indices, std::vector<std::string> columns,
-                       std::vector<std::pair<std::string, std::string>> lines) {
-  for (size_t r = 0; r < rows.size(); ++r) {
-    rows[r][kCanonicalIndexColumn] = std::to_string(indices[r]);
-  }
-  columns.insert(columns.begin(), kCanonicalIndexColumn);
-  lines.emplace_back("host", host_name());
-  lines.emplace_back("scene_hash", scene_hash);
-  lines.emplace_back("shard", shard_text(id));
-  write_file_atomic(shard_file(out_dir, table, id), to_csv(rows, columns, lines));
 }
 
 bool shard_complete(const std::string& out_dir, const std::vector<std::string>& tables, ShardId id,
@@ -262,6 +214,7 @@ std::string shards_variant(const std::string& out_dir) {
 
 void merge_shards(const Scene& scene, const MergeOptions& options) {
   const SceneUnits units = scene_units(scene);
+  remove_stale_temporaries(scene, options.out_dir);
   const fs::path dir = fs::path(options.out_dir) / "shards";
   static const std::regex kName(R"(^([a-z_]+)\.([0-9]+)-of-([0-9]+)\.csv$)");
   // count → the file names of that count
@@ -289,7 +242,15 @@ void merge_shards(const Scene& scene, const MergeOptions& options) {
         "the stale set and merge again",
         dir.string(), fmt::join(sets, ", ")));
   }
+  // Merge walks every shard id of the set: a count the file names claim is checked against the
+  // cap and the scene before it sizes any loop or list.
   const int count = by_count.begin()->first;
+  if (count < 1 || count > kMaxShards || static_cast<size_t>(count) > units.total()) {
+    throw InputError(fmt::format(
+        "'{}' holds shard files of {} shards ({}...): a sweep has 1 to {} shards, at most one "
+        "per unit of the scene ({} units); remove them and run the sweep's shards again",
+        dir.string(), count, by_count.begin()->second.front(), kMaxShards, units.total()));
+  }
   const auto tables = shard_tables(units.runs, units.orders, units.stability);
   // The first index of each table's units in the canonical order, and how many it has.
   const std::map<std::string, std::pair<size_t, size_t>> ranges = {

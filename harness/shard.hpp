@@ -1,6 +1,7 @@
 // Sweeps beyond one machine (README "Running on a cluster", docs/DESIGN.md §3, §5): shard ids
-// and their file names, the provenance a shard carries, `geomint merge` (tables byte-identical
-// to a single-machine sweep) and the Slurm scripts of `geomint slurm`.
+// from the command line or the environment, the provenance a shard carries, `geomint merge`
+// (tables byte-identical to a single-machine sweep) and the Slurm scripts of `geomint slurm`.
+// Shard ids, file names and the shard writer the sweep uses are in shard_files.hpp.
 #pragma once
 
 #include <stdexcept>
@@ -9,18 +10,10 @@
 #include <vector>
 
 #include "harness/scene.hpp"
+#include "harness/shard_files.hpp"
 #include "harness/table.hpp"
 
 namespace geomint {
-
-struct ShardId {
-  int index = 0, count = 0;  // shard index of count shards: units k with k mod count == index
-};
-
-// A CSV's `# key: value` provenance lines and its header's column names (parse_csv drops empty
-// cells, so a column whose cells are all empty is known only from the header).
-std::vector<std::pair<std::string, std::string>> csv_provenance(const std::string& text);
-std::vector<std::string> csv_header(const std::string& text);
 
 // "i/N" with 0 <= i < N (InputError naming --shard otherwise).
 ShardId parse_shard(const std::string& text);
@@ -35,26 +28,13 @@ ShardId shard_from_env(int count);
 // merge must come from the same scene text. InputError when the file cannot be read.
 std::string scene_content_hash(const std::string& scene_path, bool quick);
 
-// <out_dir>/shards/<table>.<i>-of-<N>.csv
-std::string shard_file(const std::string& out_dir, const std::string& table, ShardId id);
-
 // The tables a shard of a scene with these unit counts writes (summary; order and order_points;
 // stability), whether or not the shard holds a unit of them, so completeness is file presence.
 std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability);
 
-// The column that carries a row's unit index k in the canonical expansion order.
-inline const char* const kCanonicalIndexColumn = "canonical_index";
-
 // The command of the single-machine sweep a merge reproduces: the shard command without
 // --shard, --shard-from-env and --shards, with --no-timing (a shard is never timed).
 std::string merged_sweep_command(const std::string& shard_command);
-
-// Writes one shard table atomically: `lines` plus host, scene hash and `shard: i/N`, then the
-// rows with their canonical index first.
-void write_shard_table(const std::string& out_dir, const std::string& table, ShardId id,
-                       const std::string& scene_hash, std::vector<Row> rows,
-                       const std::vector<size_t>& indices, std::vector<std::string> columns,
-                       std::vector<std::pair<std::string, std::string>> lines);
 
 // True when every table of the shard is on disk with this binary's version, this scene hash and
 // this shard id: a rerun (a requeued array task) then has nothing to do.

@@ -221,6 +221,27 @@ TEST_F(ShardedSweep, MergeRefusesAShardOfAnotherSceneVersion) {
   EXPECT_NE(message.find("sbatch --array=1 "), std::string::npos) << message;
 }
 
+// A shard cut short (a node lost while copying, a full disk) is refused like a missing one,
+// naming the file and the line, never merged with its last row cut inside a number.
+TEST_F(ShardedSweep, MergeRefusesAShardCutShortNamingTheLine) {
+  const fs::path out = copy_of_shards("cut_short");
+  const fs::path shard = out / "shards/summary.2-of-4.csv";
+  std::string text = read_text(shard);
+  ASSERT_GT(text.size(), 10u);
+  text.resize(text.size() - 5);
+  std::ofstream(shard, std::ios::trunc) << text;
+  const std::string message = refusal(out);
+  EXPECT_NE(message.find("shard 2/4: summary.2-of-4.csv cannot be read"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("no terminating newline"), std::string::npos) << message;
+  EXPECT_NE(message.find("sbatch --array=2 "), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(out / "summary.csv"));
+  // Nor is such a shard complete: a requeued task runs it again.
+  const auto tables = shard_tables(scene_units(*scene_).runs, scene_units(*scene_).orders,
+                                   scene_units(*scene_).stability);
+  EXPECT_FALSE(shard_complete(out.string(), tables, {2, 4}, hash_));
+}
+
 TEST_F(ShardedSweep, MergeRefusesADuplicatedShard) {
   const fs::path out = copy_of_shards("duplicated");
   fs::copy_file(out / "shards/summary.0-of-4.csv", out / "shards/summary.3-of-4.csv",

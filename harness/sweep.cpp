@@ -12,8 +12,10 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -21,7 +23,7 @@
 #include "harness/order.hpp"
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
-#include "harness/shard.hpp"
+#include "harness/shard_files.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
@@ -153,6 +155,24 @@ std::vector<Row> with_short_specs(std::vector<Row> rows) {
     }
   }
   return rows;
+}
+
+// A message that quotes the method's canonical spec, with the short label table.md shows
+// instead: the reason a row was skipped reads "method 'hp'", not every default of hp.
+std::string short_specs_in(std::string message, const std::string& method) {
+  std::string canonical;
+  try {
+    canonical = make_integrator(method)->spec();
+  } catch (const InputError&) {
+    return message;
+  }
+  const std::string from = "'" + canonical + "'";
+  const std::string to = "'" + short_spec("method", canonical) + "'";
+  for (auto at = message.find(from); at != std::string::npos; at = message.find(from, at)) {
+    message.replace(at, from.size(), to);
+    at += to.size();
+  }
+  return message;
 }
 
 struct OrderJob {
@@ -319,12 +339,43 @@ std::string without_provenance(const std::string& text) {
   return text.substr(start);
 }
 
+// The temporaries a killed sweep, merge or shard of this scene left in the folders they write
+// (the tables, shards/, the series folders), removed by the next of them (table.hpp).
+void remove_stale_outputs(const Plan& plan, const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  static const std::set<std::string> tables = {"summary.csv",   "order.csv", "order_points.csv",
+                                               "stability.csv", "table.md",  "hosts.csv"};
+  geomint::remove_stale_temporaries(out_dir,
+                                    [](const std::string& name) { return tables.count(name) > 0; });
+  static const std::regex shard_name(R"(^[a-z_]+\.[0-9]+-of-[0-9]+\.csv$)");
+  geomint::remove_stale_temporaries(
+      (fs::path(out_dir) / "shards").string(),
+      [](const std::string& name) { return std::regex_match(name, shard_name); });
+  std::map<std::string, std::set<std::string>> series;
+  for (const auto& job : plan.jobs) {
+    if (job.config.series_path.empty()) continue;
+    const fs::path path(job.config.series_path);
+    series[path.parent_path().string()].insert(path.filename().string());
+  }
+  for (const auto& [folder, names] : series) {
+    geomint::remove_stale_temporaries(
+        folder, [&names = names](const std::string& name) { return names.count(name) > 0; });
+  }
+}
+
 }  // namespace
+
+void remove_stale_temporaries(const Scene& scene, const std::string& out_dir) {
+  SweepOptions options;
+  options.out_dir = out_dir;
+  remove_stale_outputs(expand_scene(scene, options), out_dir);
+}
 
 int run_sweep(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
+  remove_stale_outputs(plan, options.out_dir);
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;
   auto& stability_jobs = plan.stability_jobs;
@@ -356,7 +407,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         if (const auto reason = inapplicable(job.problem, job.method)) {
           // A scene's problems × methods product may pair an unconstrained method with a
           // constrained problem (or the reverse): a row that says why, not a run.
-          job.record = error_record(job.problem, job.method, *reason);
+          job.record = error_record(job.problem, job.method, short_specs_in(*reason, job.method));
           job.record.status = "skipped";
           job.ok = false;
           job.record.label = job.label;
@@ -474,6 +525,7 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
+  remove_stale_outputs(plan, options.out_dir);
   const fs::path out(options.out_dir);
   const fs::path summary_path = out / "summary.csv";
   if (!fs::exists(summary_path)) {
@@ -482,19 +534,11 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
         "first",
         summary_path.string(), options.out_dir));
   }
-  const std::string summary_text = read_table_text(summary_path);
+  CsvTable summary = read_csv_file(summary_path.string());
   SceneTables tables;
-  std::vector<std::string> columns;
-  try {
-    tables.summary = parse_csv(summary_text);
-    columns = csv_header(summary_text);
-  } catch (const std::runtime_error& error) {
-    throw InputError(fmt::format("'{}': {}", summary_path.string(), error.what()));
-  }
-  std::string command;
-  for (const auto& [key, value] : csv_provenance(summary_text)) {
-    if (key == "command") command = value;
-  }
+  tables.summary = std::move(summary.rows);
+  const std::vector<std::string> columns = std::move(summary.columns);
+  const std::string command = summary.value("command");
   if (tables.summary.size() != plan.jobs.size()) {
     throw InputError(fmt::format(
         "--timing-only: '{}' has {} rows, the scene {} runs: merge or sweep this scene again",
@@ -555,8 +599,10 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     const fs::path path = out / name;
     if (!fs::exists(path)) continue;
     const std::string text = read_table_text(path);
-    if (std::string(name) == "order.csv") tables.order = parse_csv(text);
-    if (std::string(name) == "stability.csv") tables.stability = parse_csv(text);
+    // Read for table.md and checked whole, as every table geomint reads back.
+    const auto rows = parse_csv(text, path.string());
+    if (std::string(name) == "order.csv") tables.order = rows;
+    if (std::string(name) == "stability.csv") tables.stability = rows;
     write_file_atomic(path.string(), header + without_provenance(text));
   }
   write_file_atomic(summary_path.string(), to_csv(tables.summary, ordered, lines));
@@ -593,37 +639,61 @@ std::string scene_markdown(const Scene& scene, const SceneTables& tables,
   return markdown;
 }
 
-void rewrite_scene_markdown(const Scene& scene, const std::string& out_dir) {
+void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
+  const Plan plan = expand_scene(scene, options);
+  std::vector<std::string> run_labels, order_labels, stability_labels;
+  for (const auto& job : plan.jobs) run_labels.push_back(job.label);
+  for (const auto& job : plan.order_jobs) order_labels.push_back(job.label);
+  for (const auto& job : plan.stability_jobs) stability_labels.push_back(job.label);
   SceneTables tables;
   std::string command_line;
-  const auto read = [&](const char* name, std::vector<Row>& rows) {
-    const fs::path path = fs::path(out_dir) / name;
+  // A table of another scene or variant (a copied folder, a wrong --out) would put this scene's
+  // title over its rows: its provenance and its rows' blocks must be this scene's.
+  const auto read = [&](const char* name, std::vector<Row>& rows,
+                        const std::vector<std::string>& labels) {
+    const fs::path path = fs::path(options.out_dir) / name;
     if (!fs::exists(path)) return;
-    std::ifstream stream(path);
-    std::stringstream text;
-    text << stream.rdbuf();
-    if (!stream) throw InputError(fmt::format("cannot read '{}'", path.string()));
-    try {
-      rows = parse_csv(text.str());
-    } catch (const std::runtime_error& error) {
-      throw InputError(fmt::format("'{}': {}", path.string(), error.what()));
+    const CsvTable table = read_csv_file(path.string());
+    const std::string scene_name = table.value("scene"), variant = table.value("variant");
+    if (!options.scene_name.empty() && !scene_name.empty() && scene_name != options.scene_name) {
+      throw InputError(fmt::format(
+          "--markdown-only: '{}' is a table of scene '{}', not of scene '{}': sweep this scene "
+          "into its own folder",
+          path.string(), scene_name, options.scene_name));
     }
-    const std::string key = "# command: ";
-    for (std::string line; command_line.empty() && std::getline(text, line) && line[0] == '#';) {
-      if (line.rfind(key, 0) == 0) command_line = line.substr(key.size());
+    if (!variant.empty() && variant != options.variant) {
+      throw InputError(fmt::format(
+          "--markdown-only: '{}' is a table of the {} variant, not of the {} one{}", path.string(),
+          variant, options.variant, options.variant == "quick" ? "" : " (give --quick)"));
     }
+    if (table.rows.size() != labels.size()) {
+      throw InputError(
+          fmt::format("--markdown-only: '{}' has {} rows, the scene {}: sweep this scene again",
+                      path.string(), table.rows.size(), labels.size()));
+    }
+    for (size_t k = 0; k < labels.size(); ++k) {
+      const auto label = table.rows[k].find("label");
+      if (label == table.rows[k].end() || label->second != labels[k]) {
+        throw InputError(fmt::format(
+            "--markdown-only: row {} of '{}' is not of the scene's block '{}': sweep this scene "
+            "again",
+            k + 1, path.string(), labels[k]));
+      }
+    }
+    rows = table.rows;
+    if (command_line.empty()) command_line = table.value("command");
   };
-  read("summary.csv", tables.summary);
-  read("order.csv", tables.order);
-  read("stability.csv", tables.stability);
+  read("summary.csv", tables.summary, run_labels);
+  read("order.csv", tables.order, order_labels);
+  read("stability.csv", tables.stability, stability_labels);
   if (command_line.empty()) {
     throw InputError(fmt::format(
         "'{}' holds no table with a '# command:' line (summary.csv, order.csv, stability.csv): "
         "run the sweep first",
-        out_dir));
+        options.out_dir));
   }
-  write_file_atomic((fs::path(out_dir) / "table.md").string(),
+  write_file_atomic((fs::path(options.out_dir) / "table.md").string(),
                     scene_markdown(scene, tables, command_line));
 }
 

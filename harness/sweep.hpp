@@ -47,6 +47,11 @@ SceneUnits scene_units(const Scene& scene);
 // or does not list the scene's runs in order.
 void run_timing_only(const Scene& scene, const SweepOptions& options);
 
+// Removes the temporary files (`<output>.<pid>.<n>.tmp`) that a killed sweep, shard or merge of
+// this scene left in <out_dir>, <out_dir>/shards and the series folders, when their process is
+// gone. run_sweep and run_timing_only call it; so does `geomint merge`.
+void remove_stale_temporaries(const Scene& scene, const std::string& out_dir);
+
 // The rows of a scene's tables, as run_sweep produces them or parse_csv reads them back.
 struct SceneTables {
   std::vector<Row> summary, order, stability;
@@ -61,7 +66,8 @@ std::string scene_markdown(const Scene& scene, const SceneTables& tables,
 
 // Rewrites <out_dir>/table.md from the CSVs a sweep wrote there, without running anything
 // (`geomint sweep --markdown-only`); the `Produced by` line keeps the CSVs' `# command:`.
-// InputError when the folder holds none of the tables.
-void rewrite_scene_markdown(const Scene& scene, const std::string& out_dir);
+// InputError when the folder holds none of the tables, or a table of another scene or variant
+// (its `# scene:`/`# variant:` lines, or rows that are not the scene's blocks in order).
+void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options);
 
 }  // namespace geomint

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "harness/table.hpp"
 #include "harness/toml_reader.hpp"
 #include "problems/spec.hpp"
 
@@ -60,10 +61,36 @@ TEST_F(SweepTables, MarkdownShowsShortLabelsAndCsvCanonicalSpecs) {
 TEST_F(SweepTables, MarkdownOnlyRebuildsTheSameTableFromTheCsvs) {
   const std::string written = read_text(dir_ / "table.md");
   fs::remove(dir_ / "table.md");
-  rewrite_scene_markdown(scene_, dir_.string());
+  SweepOptions options;
+  options.out_dir = dir_.string();
+  rewrite_scene_markdown(scene_, options);
   EXPECT_EQ(read_text(dir_ / "table.md"), written);
   fs::remove(dir_ / "summary.csv");
-  EXPECT_THROW(rewrite_scene_markdown(scene_, dir_.string()), InputError);
+  EXPECT_THROW(rewrite_scene_markdown(scene_, options), InputError);
+}
+
+// A skipped row says why with the short label table.md shows, not the canonical spec with
+// every default: "method 'hp' integrates Lagrangian systems ...".
+TEST(SweepSkippedRows, MessageNamesTheMethodByItsShortLabel) {
+  const fs::path dir = fs::path(testing::TempDir()) / "geomint_sweep_skipped";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"van_der_pol\"]\n"
+         "methods = [\"hp:alpha=0\", \"rk4\"]\ndt = 0.1\nt_end = 0.5\ntiming_repeats = 0\n";
+  const Scene scene = load_scene((dir / "scene.toml").string(), false);
+  SweepOptions options;
+  options.out_dir = dir.string();
+  options.progress = false;
+  options.command_line = "geomint sweep scene.toml";
+  EXPECT_EQ(run_sweep(scene, options), 1);
+  const CsvTable summary = read_csv_file((dir / "summary.csv").string());
+  ASSERT_EQ(summary.rows.size(), 2u);
+  EXPECT_EQ(summary.rows[0].at("status"), "skipped");
+  const std::string& message = summary.rows[0].at("message");
+  EXPECT_EQ(message.rfind("method 'hp:alpha=0' integrates Lagrangian systems", 0), 0u) << message;
+  EXPECT_EQ(message.find("force_slot"), std::string::npos) << message;
+  fs::remove_all(dir);
 }
 
 // Scene and gates files share one reader: its messages name the block and the key.

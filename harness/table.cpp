@@ -4,17 +4,24 @@
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <gsl/gsl_version.h>
+#include <signal.h>
 #include <sundials/sundials_config.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <boost/version.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -141,50 +148,135 @@ std::vector<std::string> column_union(const std::vector<Row>& rows,
   return columns;
 }
 
-std::vector<Row> parse_csv(const std::string& text) {
-  // Splits one record; a quoted field runs to the next unpaired quote ("" is a literal quote).
-  auto split = [](const std::string& line) {
-    std::vector<std::string> fields(1);
-    bool quoted = false;
-    for (size_t i = 0; i < line.size(); ++i) {
-      const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        fields.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = !quoted;
-      } else if (c == ',' && !quoted) {
-        fields.emplace_back();
-      } else {
-        fields.back() += c;
+namespace {
+
+// "'<source>' line <n>: " (or "CSV line <n>: " for text of no named file).
+std::string csv_where(const std::string& source, size_t line_number) {
+  return source.empty() ? fmt::format("CSV line {}: ", line_number)
+                        : fmt::format("'{}' line {}: ", source, line_number);
+}
+
+// Splits one record as to_csv writes it: a field is either unquoted (no '"') or quoted from
+// its first to its last character ("" is a literal quote). to_csv never lets a quoted field span
+// lines, so a quote still open at the end of the line is damage, as is text after a closing
+// quote. Returns the fields, or the reason the line is malformed in `error`.
+std::vector<std::string> split_csv_line(const std::string& line, std::string& error) {
+  std::vector<std::string> fields(1);
+  size_t i = 0;
+  while (true) {
+    if (i < line.size() && line[i] == '"') {
+      const size_t open = i++;
+      while (true) {
+        if (i >= line.size()) {
+          error = fmt::format("the quote opened at column {} is not closed", open + 1);
+          return fields;
+        }
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') {
+            fields.back() += '"';
+            i += 2;
+            continue;
+          }
+          ++i;
+          break;
+        }
+        fields.back() += line[i++];
+      }
+      if (i < line.size() && line[i] != ',') {
+        error = fmt::format("text after the closing quote at column {}", i);
+        return fields;
+      }
+    } else {
+      while (i < line.size() && line[i] != ',') {
+        if (line[i] == '"') {
+          error = fmt::format("a quote inside an unquoted field at column {}", i + 1);
+          return fields;
+        }
+        fields.back() += line[i++];
       }
     }
-    return fields;
-  };
-  std::vector<Row> rows;
-  std::vector<std::string> header;
-  std::istringstream in(text);
-  std::string line;
-  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    if (i >= line.size()) return fields;
+    ++i;  // the ','
+    fields.emplace_back();
+  }
+}
+
+}  // namespace
+
+std::string CsvTable::value(const std::string& key, const std::string& absent) const {
+  for (const auto& [name, text] : provenance) {
+    if (name == key) return text;
+  }
+  return absent;
+}
+
+CsvTable parse_csv_table(const std::string& text, const std::string& source) {
+  CsvTable table;
+  table.path = source;
+  // Every writer ends every line with '\n': a last line without one is a table cut short (a
+  // number cut inside reads as another number, so it must not be parsed at all).
+  if (!text.empty() && text.back() != '\n') {
+    const size_t lines = static_cast<size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+    throw InputError(csv_where(source, lines) +
+                     "the last line has no terminating newline (the table is cut short)");
+  }
+  bool header_seen = false;
+  size_t line_number = 0;
+  for (size_t start = 0; start < text.size();) {
+    const size_t end = text.find('\n', start);
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
+    ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    const auto fields = split(line);
-    if (header.empty()) {
-      header = fields;
+    if (!line.empty() && line[0] == '#') {
+      if (!header_seen && line.rfind("# ", 0) == 0) {
+        const auto colon = line.find(": ");
+        if (colon != std::string::npos && colon >= 2) {
+          table.provenance.emplace_back(line.substr(2, colon - 2), line.substr(colon + 2));
+        }
+      }
       continue;
     }
-    if (fields.size() > header.size()) {
-      throw std::runtime_error("CSV line " + std::to_string(line_number) + " has " +
-                               std::to_string(fields.size()) + " fields, the header " +
-                               std::to_string(header.size()));
+    if (line.empty()) continue;
+    std::string error;
+    auto fields = split_csv_line(line, error);
+    if (!error.empty()) throw InputError(csv_where(source, line_number) + error);
+    if (!header_seen) {
+      table.columns = std::move(fields);
+      header_seen = true;
+      continue;
+    }
+    if (fields.size() != table.columns.size()) {
+      throw InputError(csv_where(source, line_number) +
+                       fmt::format("{} fields, the header has {} (a damaged or truncated table)",
+                                   fields.size(), table.columns.size()));
     }
     Row row;
     for (size_t i = 0; i < fields.size(); ++i) {
-      if (!fields[i].empty()) row[header[i]] = fields[i];
+      if (!fields[i].empty()) row[table.columns[i]] = std::move(fields[i]);
     }
-    rows.push_back(std::move(row));
+    table.rows.push_back(std::move(row));
   }
-  return rows;
+  if (!header_seen) {
+    throw InputError((source.empty() ? std::string("CSV text") : fmt::format("'{}'", source)) +
+                     " has no header line (an empty or truncated table)");
+  }
+  return table;
+}
+
+std::vector<Row> parse_csv(const std::string& text, const std::string& source) {
+  return parse_csv_table(text, source).rows;
+}
+
+CsvTable read_csv_file(const std::string& path) {
+  if (std::filesystem::is_directory(path)) {
+    throw InputError(fmt::format("'{}' is a folder, not a CSV table", path));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot read '{}'", path));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(fmt::format("cannot read '{}'", path));
+  return parse_csv_table(text, path);
 }
 
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
@@ -232,37 +324,158 @@ std::string temporary_name(const std::string& path) {
   return fmt::format("{}.{}.{}.tmp", path, ::getpid(), counter++);
 }
 
+// The temporaries this process has open, for the SIGTERM/SIGINT handler. A signal handler may
+// call only async-signal-safe functions, so the registry is a fixed array of fixed buffers whose
+// slots are claimed with lock-free atomics: no allocation, no lock a handler could wait on. A
+// path that does not fit, or a writer beyond the last slot, is simply not registered (a rerun
+// removes what it leaves, remove_stale_temporaries).
+struct TemporarySlot {
+  std::atomic<int> state{0};  // kFree, kFilling (being written or cleared), kLive
+  char path[4096];
+};
+constexpr int kFree = 0, kFilling = 1, kLive = 2;
+constexpr size_t kTemporarySlots = 256;
+TemporarySlot g_temporaries[kTemporarySlots];
+
+int register_temporary(const std::string& path) {
+  if (path.size() >= sizeof(TemporarySlot::path)) return -1;
+  for (size_t i = 0; i < kTemporarySlots; ++i) {
+    int expected = kFree;
+    if (g_temporaries[i].state.compare_exchange_strong(expected, kFilling)) {
+      std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
+      g_temporaries[i].state.store(kLive);
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+void unregister_temporary(int slot) {
+  if (slot < 0) return;
+  g_temporaries[slot].state.store(kFilling);
+  g_temporaries[slot].path[0] = '\0';
+  g_temporaries[slot].state.store(kFree);
+}
+
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+  const int saved_errno = errno;
+  for (auto& slot : g_temporaries) {
+    if (slot.state.load() == kLive) ::unlink(slot.path);
+  }
+  // The default action then ends the process as the signal would have: a shell, Slurm or a
+  // parent sees "killed by SIGTERM", not an exit code.
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  sigemptyset(&default_action.sa_mask);
+  ::sigaction(signal_number, &default_action, nullptr);
+  ::raise(signal_number);
+  errno = saved_errno;
+}
+
+// "<name>.<digits>.<digits>.tmp" → the pid, or -1 when `file` is no temporary of `name`.
+long temporary_pid(const std::string& file, const std::string& name) {
+  const std::string suffix = ".tmp";
+  if (file.size() <= name.size() + suffix.size() + 4 || file.compare(0, name.size(), name) != 0 ||
+      file[name.size()] != '.' ||
+      file.compare(file.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    return -1;
+  }
+  const std::string middle =
+      file.substr(name.size() + 1, file.size() - name.size() - 1 - suffix.size());
+  const auto dot = middle.find('.');
+  const auto digits = [](const std::string& text) {
+    return !text.empty() && text.size() <= 18 &&
+           std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (dot == std::string::npos || !digits(middle.substr(0, dot)) ||
+      !digits(middle.substr(dot + 1))) {
+    return -1;
+  }
+  return std::stol(middle.substr(0, dot));
+}
+
 }  // namespace
+
+void remove_temporaries_on_signals() {
+  for (const int signal_number : {SIGTERM, SIGINT}) {
+    struct sigaction previous {};
+    ::sigaction(signal_number, nullptr, &previous);
+    // A signal the caller ignores (nohup, a background job's SIGINT) stays ignored.
+    if (previous.sa_handler == SIG_IGN) continue;
+    struct sigaction action {};
+    action.sa_handler = remove_temporaries_and_reraise;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+size_t remove_stale_temporaries(const std::string& folder,
+                                const std::function<bool(const std::string&)>& is_output) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return 0;
+  size_t removed = 0;
+  const long self = ::getpid();
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    const std::string file = it->path().filename().string();
+    if (file.size() < 4 || file.compare(file.size() - 4, 4, ".tmp") != 0) continue;
+    // The output name is what precedes ".<pid>.<n>.tmp".
+    const auto last = file.rfind('.', file.size() - 5);
+    if (last == std::string::npos || last == 0) continue;
+    const auto before = file.rfind('.', last - 1);
+    if (before == std::string::npos) continue;
+    const std::string name = file.substr(0, before);
+    const long pid = temporary_pid(file, name);
+    if (pid < 0 || pid == self || !is_output(name)) continue;
+    // A writer still alive on this machine keeps its file; a dead one (kill -9, a node lost)
+    // left debris.
+    if (pid <= std::numeric_limits<pid_t>::max() &&
+        (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM)) {
+      continue;
+    }
+    std::error_code ignored;
+    removed += fs::remove(it->path(), ignored);
+  }
+  return removed;
+}
 
 AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path) {
   const std::filesystem::path target(path);
   if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
   temporary_ = temporary_name(path);
+  // Registered before the file exists, so a signal between open and registration cannot
+  // leave it behind.
+  slot_ = register_temporary(temporary_);
   out_.open(temporary_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw std::runtime_error(fmt::format("cannot write '{}'", temporary_));
+  if (!out_) {
+    unregister_temporary(slot_);
+    throw std::runtime_error(fmt::format("cannot write '{}'", temporary_));
+  }
 }
 
 AtomicFileWriter::~AtomicFileWriter() {
   if (committed_) return;
   out_.close();
   std::remove(temporary_.c_str());
+  unregister_temporary(slot_);
 }
 
 void AtomicFileWriter::commit() {
   out_.flush();
   const bool written = static_cast<bool>(out_);
   out_.close();
+  committed_ = true;
   if (!written || out_.fail()) {
     std::remove(temporary_.c_str());
-    committed_ = true;
+    unregister_temporary(slot_);
     throw std::runtime_error(fmt::format("cannot write '{}'", path_));
   }
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     std::remove(temporary_.c_str());
-    committed_ = true;
+    unregister_temporary(slot_);
     throw std::runtime_error(fmt::format("cannot rename '{}' to '{}'", temporary_, path_));
   }
-  committed_ = true;
+  unregister_temporary(slot_);
 }
 
 void write_file_atomic(const std::string& path, const std::string& text) {

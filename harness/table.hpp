@@ -4,6 +4,7 @@
 #pragma once
 
 #include <fstream>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -26,8 +27,30 @@ std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>&
 
 // Parses CSV text as written by to_csv: `#` provenance lines are skipped, the first other line
 // is the header, quoted fields may contain ',' and '""'. Empty fields are left out of the row.
-// Throws std::runtime_error naming the line when a row has more fields than the header.
-std::vector<Row> parse_csv(const std::string& text);
+// A damaged table is an InputError naming `source` (the file, when given) and the line: a row
+// with fewer or more fields than the header, a text whose last line has no terminating newline
+// (a table cut short), a quote that is not closed or stray text after a closing quote, no header.
+std::vector<Row> parse_csv(const std::string& text, const std::string& source = "");
+
+// A CSV table as read back: its leading `# key: value` provenance lines, its header's column
+// names (parse_csv drops empty cells, so a column whose cells are all empty is known only from
+// the header) and its rows.
+struct CsvTable {
+  std::string path;
+  std::vector<std::pair<std::string, std::string>> provenance;
+  std::vector<std::string> columns;
+  std::vector<Row> rows;
+  // The value of a provenance line, or `absent` when the table has none.
+  std::string value(const std::string& key, const std::string& absent = "") const;
+};
+
+// Parses `text` (see parse_csv); `source` names it in messages.
+CsvTable parse_csv_table(const std::string& text, const std::string& source);
+
+// Reads and parses the CSV file at `path`: the one reader of every table geomint reads back
+// (gate, merge, --markdown-only, --timing-only, shards). InputError naming the file when it
+// cannot be read or is damaged (see parse_csv).
+CsvTable read_csv_file(const std::string& path);
 
 // Markdown pipe table; numbers are shortened to `digits` significant digits for reading.
 std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::string>& columns,
@@ -54,7 +77,20 @@ class AtomicFileWriter {
   std::string path_, temporary_;
   std::ofstream out_;
   bool committed_ = false;
+  int slot_ = -1;  // in the registry of live temporaries (remove_temporaries_on_signals)
 };
+
+// Installs handlers of SIGTERM (what Slurm sends at a time limit) and SIGINT that remove the
+// temporary files of this process's unfinished AtomicFileWriters, then end the process by the
+// signal's default action. Signals the process ignores stay ignored. Called by `geomint` at start;
+// a library user decides for their own program.
+void remove_temporaries_on_signals();
+
+// Removes the temporaries `<name>.<pid>.<n>.tmp` in `folder` that an AtomicFileWriter left when
+// its process was killed (kill -9, a lost node): `name` must satisfy is_output and the pid must
+// be neither this process nor a live process on this machine. Returns how many were removed.
+size_t remove_stale_temporaries(const std::string& folder,
+                                const std::function<bool(const std::string&)>& is_output);
 
 // The column order every geomint CSV uses.
 const std::vector<std::string>& standard_columns();

@@ -9,14 +9,18 @@
 // Add a case here for every new option and every new way of rejecting input.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace geomint {
@@ -505,6 +509,171 @@ const std::vector<Case>& cases() {
        {"scene.toml", "summary.csv", "table.md", "series", "series/a",
         "series/a/odeint_dopri5_max_steps_100.csv", "series/a/rk4.csv"},
        60},
+      // --- issue 23 (tables, shards, debris) ---
+      // A damaged table is refused whole, naming the file and the line: the intact row
+      // "a,12.5" fails the band, the same row cut inside its number passes it.
+      {"GateTableCutInsideANumber",
+       "gate {dir}/g.toml {dir}/s/summary.csv",
+       2,
+       "summary.csv' line 3",
+       {{"g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmax = 10\n"},
+        {"s/", ""},
+        {"s/summary.csv", "# scene: s\nlabel,x\na,1"}},
+       {"g.toml", "s", "s/summary.csv"}},
+      {"GateRowWithTooFewFields",
+       "gate {dir}/g.toml {dir}/s/summary.csv",
+       2,
+       "summary.csv' line 4",
+       {{"g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmax = 10\n"},
+        {"s/", ""},
+        {"s/summary.csv", "# scene: s\nlabel,x,y\na,1,2\nb,1\n"}},
+       {"g.toml", "s", "s/summary.csv"}},
+      {"GateRowWithTooManyFields",
+       "gate {dir}/g.toml {dir}/s/summary.csv",
+       2,
+       "summary.csv' line 3",
+       {{"g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmax = 10\n"},
+        {"s/", ""},
+        {"s/summary.csv", "# scene: s\nlabel,x\na,1,2\n"}},
+       {"g.toml", "s", "s/summary.csv"}},
+      {"GateUnterminatedQuote",
+       "gate {dir}/g.toml {dir}/s/summary.csv",
+       2,
+       "quote",
+       {{"g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmax = 10\n"},
+        {"s/", ""},
+        {"s/summary.csv", "# scene: s\nlabel,x\na,1\n\"b,2\n"}},
+       {"g.toml", "s", "s/summary.csv"}},
+      {"GateHeaderOnlyCutShort",
+       "gate {dir}/g.toml {dir}/s/summary.csv",
+       2,
+       "summary.csv' line 2",
+       {{"g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmax = 10\n"},
+        {"s/", ""},
+        {"s/summary.csv", "# scene: s\nlabel,x"}},
+       {"g.toml", "s", "s/summary.csv"}},
+      {"MarkdownOnlyTableCutShort",
+       "sweep {dir}/scene.toml --markdown-only",
+       2,
+       "summary.csv' line 3",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"summary.csv", "# command: geomint sweep\nlabel,problem,method,status\na,pendulum,st"}},
+       {"scene.toml", "summary.csv"}},
+      // --- merge: shard counts the file names claim are checked before anything is sized ---
+      {"MergeShardCountZero",
+       "merge {dir}",
+       2,
+       "0 shards",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-0.csv", "# variant: full\ncanonical_index,label\n"}},
+       {"scene.toml", "shards", "shards/summary.0-of-0.csv"},
+       10},
+      {"MergeShardCountHuge",
+       "merge {dir}",
+       2,
+       "999999999 shards",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-999999999.csv", "# variant: full\ncanonical_index,label\n"}},
+       {"scene.toml", "shards", "shards/summary.0-of-999999999.csv"},
+       10},
+      {"MergeShardCountAboveUnits",
+       "merge {dir}",
+       2,
+       "1 units",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-2.csv", "# variant: full\ncanonical_index,label\n"}},
+       {"scene.toml", "shards", "shards/summary.0-of-2.csv"},
+       10},
+      // --shard and --shards share one cap, and no shard may be past the scene's last unit (the
+      // run below would take far longer than the timeout if it were computed).
+      {"ShardCountAboveCap",
+       "sweep {dir}/scene.toml --shard 0/1000001",
+       2,
+       "--shard",
+       {{"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
+       {"scene.toml"},
+       10},
+      {"ShardCountAboveUnits",
+       "sweep {dir}/scene.toml --shard 0/2",
+       2,
+       "1 unit(s)",
+       {{"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
+       {"scene.toml"},
+       10},
+      {"SlurmShardsAboveUnits",
+       "slurm {dir}/scene.toml --shards 5",
+       2,
+       "1 unit(s)",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"}},
+      // --markdown-only checks the tables are this scene's, as --timing-only does ({dir} is the
+      // folder "work", so the scene is "work").
+      {"MarkdownOnlyOtherScene",
+       "sweep {dir}/scene.toml --markdown-only",
+       2,
+       "scene 'other'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"summary.csv",
+         "# command: geomint sweep\n# scene: other\n# variant: full\nlabel,problem,method,status\n"
+         "a,pendulum,stormer_verlet,ok\n"}},
+       {"scene.toml", "summary.csv"}},
+      {"MarkdownOnlyOtherVariant",
+       "sweep {dir}/scene.toml --markdown-only",
+       2,
+       "quick variant",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"summary.csv",
+         "# command: geomint sweep\n# scene: work\n# variant: quick\nlabel,problem,method,status\n"
+         "a,pendulum,stormer_verlet,ok\n"}},
+       {"scene.toml", "summary.csv"}},
+      {"MarkdownOnlyOtherBlocks",
+       "sweep {dir}/scene.toml --markdown-only",
+       2,
+       "block 'a'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"summary.csv",
+         "# command: geomint sweep\nlabel,problem,method,status\nz,pendulum,stormer_verlet,ok\n"}},
+       {"scene.toml", "summary.csv"}},
+      // --- debris: a rerun removes the temporaries a killed run left (pid 2147483646 is no
+      // live process), in the tables' folder, shards/ and the series folders ---
+      {"SweepRemovesStaleTemporaries",
+       "sweep {dir}/scene.toml",
+       0,
+       "done",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n"
+                                         "series_every = 1\n")},
+        {"summary.csv.2147483646.0.tmp", "partial"},
+        {"table.md.2147483646.7.tmp", "partial"},
+        {"series/a/", ""},
+        {"series/a/stormer_verlet.csv.2147483646.3.tmp", "partial"}},
+       {"scene.toml", "summary.csv", "table.md", "series", "series/a",
+        "series/a/stormer_verlet.csv"},
+       60},
+      {"ShardRemovesStaleTemporaries",
+       "sweep {dir}/scene.toml --shard 0/1",
+       0,
+       "done",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-1.csv.2147483646.0.tmp", "partial"}},
+       {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
+       60},
+      {"MergeRemovesStaleTemporaries",
+       "merge {dir}",
+       1,
+       "another scene version",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-1.csv",
+         "# variant: full\n# scene_hash: x\n# shard: 0/1\ncanonical_index,label\n"},
+        {"shards/summary.0-of-1.csv.2147483646.2.tmp", "partial"},
+        {"summary.csv.2147483646.0.tmp", "partial"},
+        {"hosts.csv.2147483646.1.tmp", "partial"}},
+       {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
+       60},
   };
   return all;
 }
@@ -570,6 +739,55 @@ TEST(BadInputRegistry, NamesAreUniqueAndEveryCaseHasAWord) {
     EXPECT_FALSE(c.word.empty()) << c.name;
     EXPECT_TRUE(c.exit_code == 0 || c.exit_code == 1 || c.exit_code == 2) << c.name;
   }
+}
+
+// SIGTERM (what Slurm sends at a time limit) and SIGINT (Ctrl-C) end a sweep as the signal
+// would, without the temporary file of its open series writer: `git add results/` after an
+// interrupted sweep commits no debris.
+void expect_signal_leaves_no_temporary(int signal_number, const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "geomint_bad_input" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // 10^9 Stormer-Verlet steps with a series: the run is still writing when the signal comes.
+  std::ofstream(dir / "scene.toml") << scene(kRunBlock +
+                                             "dt = 1e-5\nt_end = 1e4\ntiming_repeats = 0\n"
+                                             "series_every = 100000\n");
+  const std::string program = binary(), scene_path = (dir / "scene.toml").string();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen("/dev/null", "w", stderr);
+    execl(program.c_str(), program.c_str(), "sweep", scene_path.c_str(), "--jobs", "1",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto has_temporary = [&] {
+    for (const auto& entry : tree(dir)) {
+      if (entry.size() > 4 && entry.substr(entry.size() - 4) == ".tmp") return true;
+    }
+    return false;
+  };
+  bool seen = false;
+  for (int i = 0; i < 300 && !(seen = has_temporary()); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  kill(child, signal_number);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(seen) << "the sweep never opened its series file";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
+      << "not ended by the signal: status " << status;
+  EXPECT_FALSE(has_temporary()) << "temporary file left after signal " << signal_number;
+  fs::remove_all(dir);
+}
+
+TEST(Debris, SigtermLeavesNoTemporaryFile) {
+  expect_signal_leaves_no_temporary(SIGTERM, "SigtermDebris");
+}
+
+TEST(Debris, SigintLeavesNoTemporaryFile) {
+  expect_signal_leaves_no_temporary(SIGINT, "SigintDebris");
 }
 
 }  // namespace
