@@ -559,6 +559,13 @@ const std::vector<Case>& cases() {
        {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
         {"summary.csv", "# command: geomint sweep\nlabel,problem,method,status\na,pendulum,st"}},
        {"scene.toml", "summary.csv"}},
+      {"TimingOnlyTableCutShort",
+       "sweep {dir}/scene.toml --timing-only",
+       2,
+       "summary.csv' line 3",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"summary.csv", "# command: geomint sweep\nlabel,problem,method,status\na,pendulum,st"}},
+       {"scene.toml", "summary.csv"}},
       // --- merge: shard counts the file names claim are checked before anything is sized ---
       {"MergeShardCountZero",
        "merge {dir}",
