@@ -357,9 +357,9 @@ TEST_P(AdaptiveTolerances, EachToleranceBitesWhereItDominates) {
     EXPECT_LT(dominant_error, 0.2 * base_error)
         << "amplitude " << amplitude << ": tightening " << (relative_dominates ? "rtol" : "atol")
         << " alone did not reduce the error";
-    // The other weight changes by 1e-3 relative at most. BDF's order and step selection may
-    // still take another path (measured: CVODE's error moves by up to 30%), so the check is that
-    // the error stays at its level, not that the result stays put.
+    // The other weight changes by 1e-3 relative at most, yet BDF's order and step selection may
+    // take another path (measured: 0.99-1.06 times the error, IDA at amplitude 1e-6 6 times), so
+    // the check is that the error is not bought down, not that the result stays put.
     EXPECT_GT(other_error, 0.3 * base_error)
         << "amplitude " << amplitude << ": tightening " << (relative_dominates ? "atol" : "rtol")
         << " alone reduced the error";
