@@ -156,37 +156,53 @@ TEST(NormalModes, DiscreteFrequenciesFollowTheClosedForms) {
 
 // Full relative precision for the slow modes of a long chain: the dense eigensolver leaves λ_j
 // an absolute error of about ε λ_max, (ω_max/ω_1)² ≈ 1.6e4 times ω_1² here, and ω̃ taken from
-// the trace of DΦ loses another 1/(hω)². Fixed ends, 199 masses of 0.7 on springs of 1.3:
-// ω_j = 2√(k/m) sin(jπ/(2(n + 1))) and Störmer–Verlet's sin(hω̃/2) = hω/2, both evaluated in
-// long double from the same double k and m the problem holds. A few ulps relative, every mode.
+// the trace of DΦ loses another 1/(hω)². 199 masses of 0.7 on springs of 1.3, fixed ends
+// (ω_j = 2√(k/m) sin(jπ/(2(n + 1))), j = 1..n) and free ends (2√(k/m) sin(jπ/(2n)),
+// j = 0..n−1, j = 0 the translation); Störmer–Verlet's sin(hω̃/2) = hω/2 and the implicit
+// midpoint rule's tan(hω̃/2) = hω/2, all evaluated in long double from the same double k and m
+// the problem holds. A few ulps relative, every mode.
 TEST(NormalModes, SlowModesOfALongChainToFullRelativePrecision) {
   constexpr int kMasses = 199;
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   const double mass = 0.7, stiffness = 1.3, h = 0.5;
-  const auto chain = make_problem("spring_chain:n=199,mass=0.7,stiffness=1.3");
-  const std::vector<DiscreteMode> modes = discrete_normal_modes("stormer_verlet", *chain, h);
-  ASSERT_EQ(modes.size(), static_cast<size_t>(kMasses));
   const long double scale =
       2 * std::sqrt(static_cast<long double>(stiffness) / static_cast<long double>(mass));
   const long double pi = 3.141592653589793238462643383279502884L;
-  double worst_omega = 0, worst_discrete = 0;
-  for (int j = 1; j <= kMasses; ++j) {
-    const long double omega = scale * std::sin(j * pi / (2 * (kMasses + 1)));
-    const long double discrete = 2 / static_cast<long double>(h) * std::asin(h * omega / 2);
-    const DiscreteMode& mode = modes[j - 1];
-    const double omega_error = static_cast<double>(std::abs((mode.omega - omega) / omega));
-    const double discrete_error =
-        static_cast<double>(std::abs((mode.omega_discrete - discrete) / discrete));
-    worst_omega = std::max(worst_omega, omega_error);
-    worst_discrete = std::max(worst_discrete, discrete_error);
-    if (j <= 3) {
-      std::printf("mode %d omega %.17g error %.2e, discrete %.17g error %.2e\n", j, mode.omega,
-                  omega_error, mode.omega_discrete, discrete_error);
+  for (const bool fixed : {true, false}) {
+    const auto chain = make_problem(std::string("spring_chain:n=199,mass=0.7,stiffness=1.3,") +
+                                    (fixed ? "ends=fixed" : "ends=free"));
+    for (const std::string method : {"stormer_verlet", "implicit_midpoint"}) {
+      const std::vector<DiscreteMode> modes = discrete_normal_modes(method, *chain, h);
+      ASSERT_EQ(modes.size(), static_cast<size_t>(kMasses)) << method;
+      double worst_omega = 0, worst_discrete = 0;
+      for (int i = 0; i < kMasses; ++i) {
+        const int j = fixed ? i + 1 : i;
+        const DiscreteMode& mode = modes[i];
+        if (j == 0) {  // the free chain's translation: ω = 0 to rounding, no relative error
+          EXPECT_LE(mode.omega, 1e-7) << method;
+          continue;
+        }
+        const long double omega = scale * std::sin(j * pi / (2 * (fixed ? kMasses + 1 : kMasses)));
+        const long double half_angle = h * omega / 2;
+        const long double discrete =
+            2 / static_cast<long double>(h) *
+            (method == "stormer_verlet" ? std::asin(half_angle) : std::atan(half_angle));
+        const double omega_error = static_cast<double>(std::abs((mode.omega - omega) / omega));
+        const double discrete_error =
+            static_cast<double>(std::abs((mode.omega_discrete - discrete) / discrete));
+        worst_omega = std::max(worst_omega, omega_error);
+        worst_discrete = std::max(worst_discrete, discrete_error);
+        EXPECT_LE(omega_error, 4 * kEpsilon) << method << " mode " << j;
+        EXPECT_LE(discrete_error, 4 * kEpsilon) << method << " mode " << j;
+        EXPECT_NEAR(mode.amplitude, 1.0, 4 * kEpsilon) << method << " mode " << j;
+      }
+      std::printf(
+          "%-17s %s ends: lowest omega %.17g; largest relative error omega %.2e, "
+          "discrete %.2e\n",
+          method.c_str(), fixed ? "fixed" : "free ", modes[fixed ? 0 : 1].omega, worst_omega,
+          worst_discrete);
     }
-    EXPECT_LE(omega_error, 4 * std::numeric_limits<double>::epsilon()) << "mode " << j;
-    EXPECT_LE(discrete_error, 4 * std::numeric_limits<double>::epsilon()) << "mode " << j;
-    EXPECT_NEAR(mode.amplitude, 1.0, 4 * std::numeric_limits<double>::epsilon()) << "mode " << j;
   }
-  std::printf("largest relative error: omega %.2e, discrete %.2e\n", worst_omega, worst_discrete);
 }
 
 // The columns: Störmer–Verlet's largest relative frequency error on the harmonic oscillator is
