@@ -463,7 +463,9 @@ const std::map<std::string, std::vector<std::string>>& exact_branches() {
         "zeta=0,omega=2,drive=0.7,drive_omega=2",      // undamped resonance: secular growth
         "zeta=0.5,omega=2,drive=1.5,drive_omega=2",    // damped, driven at ω
         "zeta=3,omega=1,drive=0.4,drive_omega=0.3"}},  // overdamped and driven
-      {"spring_chain", {"n=4,ends=free,velocity=0.5,mode=3", "n=5,init=node,node=5,ends=free"}},
+      {"spring_chain",
+       {"n=4,ends=free,velocity=0.5,mode=3", "n=5,init=node,node=5,ends=free",
+        "n=7,init=node,node=7,ends=fixed_free,stiffness=2.5"}},
       {"stiff_spring", {"ratio=1,stretch=0.3"}},
       {"cartesian_pendulum", {"theta0=3.0,length=1.5", "theta0=0.2,v0=-2.5,length=0.8,gravity=2"}},
       {"spherical_pendulum", {"theta0=1.3,length=0.6,gravity=9.81"}},
