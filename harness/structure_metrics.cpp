@@ -170,6 +170,65 @@ std::string normal_modes_not_applicable(const Integrator& method, const Problem&
   return symplecticity_defect_not_applicable(method, problem);
 }
 
+namespace {
+
+// One normal mode as a problem of its own: unit mass, stiffness ω², so that its one-step map is
+// the mode's 2×2 block of DΦ in the M-orthonormal modal coordinates (every method here is a
+// function of hM⁻¹K on a linear problem).
+class ModalOscillator final : public Problem {
+ public:
+  explicit ModalOscillator(double stiffness) : stiffness_(stiffness) {
+    set_mass(Vec::Ones(1));
+    set_capabilities(kHessian);
+  }
+  State initial_state() const override { return {0.0, Vec::Ones(1), Vec::Zero(1)}; }
+  double potential(const Vec& q) const override { return 0.5 * stiffness_ * q.squaredNorm(); }
+  void gradient(const Vec& q, Vec& g) const override { g = stiffness_ * q; }
+  void hessian(const Vec&, SparseMatrix& H) const override {
+    H.resize(1, 1);
+    H.setZero();
+    H.insert(0, 0) = stiffness_;
+    H.makeCompressed();
+  }
+  bool is_linear() const override { return true; }
+
+ private:
+  double stiffness_;
+};
+
+// ρ and θ of the eigenvalues λ = (a + d)/2 ± √δ of the block [[a, b], [c, d]]. The
+// discriminant is formed as δ = ((a − d)/2)² + bc, not as ((a + d)/2)² − det: for a slow mode
+// a ≈ d ≈ 1 and δ ≈ −(hω)², which the second form would leave with an absolute error of ε, a
+// relative error of ε/(hω)² in ω̃.
+void block_eigenvalues(double a, double b, double c, double d, DiscreteMode& mode, double h) {
+  const double half_trace = (a + d) / 2;
+  const double half_difference = (a - d) / 2;
+  const std::complex<double> root =
+      std::sqrt(std::complex<double>(half_difference * half_difference + b * c));
+  const std::complex<double> plus = half_trace + root, minus = half_trace - root;
+  mode.omega_discrete = std::max(std::abs(std::arg(plus)), std::abs(std::arg(minus))) / h;
+  mode.amplitude = std::max(std::abs(plus), std::abs(minus));
+}
+
+// λ = vᵀKv / vᵀMv in long double. The dense solver's λ_j carries an absolute error of about
+// ε λ_max, so the slow modes of a long chain lose (ω_max/ω_j)² in relative accuracy; the
+// Rayleigh quotient of its eigenvector is off by only O(ε² λ_max²/gap), and long double keeps
+// the cancellation in Kv (a second difference of a smooth shape) below double's rounding.
+double rayleigh_quotient(const SparseMatrix& stiffness, const Vec& mass, const Vec& shape) {
+  long double numerator = 0, denominator = 0;
+  for (long k = 0; k < stiffness.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(stiffness, k); it; ++it) {
+      numerator += static_cast<long double>(shape[it.row()]) * it.value() * shape[it.col()];
+    }
+  }
+  for (long i = 0; i < shape.size(); ++i) {
+    denominator += static_cast<long double>(shape[i]) * mass[i] * shape[i];
+  }
+  return static_cast<double>(numerator / denominator);
+}
+
+}  // namespace
+
 std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
                                                 const Problem& problem, double h) {
   const auto method = make_integrator(method_spec);
@@ -188,6 +247,10 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
   // Modal coordinates: (x, y) = (VᵀM q, Vᵀp), inverse (q, p) = (V x, M V y).
   const Eigen::MatrixXd modal_q = shapes.transpose() * mass;
   const Eigen::MatrixXd mass_shapes = mass * shapes;
+  // Entries of the projected blocks carry rounding of about n ε ‖DΦ‖; a block of the modal
+  // oscillator further away than this bound means the method is no function of hM⁻¹K.
+  const double block_tolerance = 1e-8 * std::max(1.0, tangent.cwiseAbs().maxCoeff());
+  const auto modal_method = make_integrator(method_spec);
   std::vector<DiscreteMode> modes;
   for (long j = 0; j < n; ++j) {
     const double x_x = modal_q.row(j) * tangent.topLeftCorner(n, n) * shapes.col(j);
@@ -195,15 +258,23 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
     const double y_x = shapes.col(j).transpose() * tangent.bottomLeftCorner(n, n) * shapes.col(j);
     const double y_y =
         shapes.col(j).transpose() * tangent.bottomRightCorner(n, n) * mass_shapes.col(j);
-    // λ = tr/2 ± √(tr²/4 − det) of the block [[x_x, x_y], [y_x, y_y]].
-    const double half_trace = (x_x + y_y) / 2;
-    const std::complex<double> root =
-        std::sqrt(std::complex<double>(half_trace * half_trace - (x_x * y_y - x_y * y_x)));
-    const std::complex<double> plus = half_trace + root, minus = half_trace - root;
     DiscreteMode mode;
-    mode.omega = std::sqrt(std::max(0.0, solver.eigenvalues()[j]));
-    mode.omega_discrete = std::max(std::abs(std::arg(plus)), std::abs(std::arg(minus))) / h;
-    mode.amplitude = std::max(std::abs(plus), std::abs(minus));
+    const double eigenvalue =
+        std::max(0.0, rayleigh_quotient(hessian, problem.mass(), shapes.col(j)));
+    mode.omega = std::sqrt(eigenvalue);
+    // The projected block inherits the rounding of every entry of DΦ (ε ‖K‖ against the mode's
+    // own hω² in its lower left entry); the step of the mode's oscillator has only its own.
+    block_eigenvalues(x_x, x_y, y_x, y_y, mode, h);
+    const ModalOscillator oscillator(eigenvalue);
+    State modal_state = oscillator.initial_state();
+    modal_method->reset(oscillator, modal_state, h);
+    Eigen::MatrixXd block;
+    if (modal_method->has_step_tangent(oscillator) &&
+        modal_method->step_tangent(oscillator, modal_state, h, block).ok && block.allFinite() &&
+        std::max({std::abs(block(0, 0) - x_x), std::abs(block(0, 1) - x_y),
+                  std::abs(block(1, 0) - y_x), std::abs(block(1, 1) - y_y)}) <= block_tolerance) {
+      block_eigenvalues(block(0, 0), block(0, 1), block(1, 0), block(1, 1), mode, h);
+    }
     modes.push_back(mode);
   }
   return modes;

@@ -51,7 +51,10 @@ std::string normal_modes_not_applicable(const Integrator& method, const Problem&
 // problem's initial state (the map is linear, so any state gives the same), transformed to the
 // M-orthonormal modal coordinates (q = V x, p = M V y), where every method here (a function of
 // hM⁻¹K) is block diagonal with one 2×2 block per mode; the eigenvalues of DΦ are those of the
-// blocks. Empty when not applicable or the step fails.
+// blocks. To full relative precision for slow modes too: ω is the long-double Rayleigh quotient
+// of the dense eigenvector, and each block is the method's step on the mode's own oscillator
+// (unit mass, stiffness ω²) unless that differs from the projected block (then the projected
+// one). Empty when not applicable or the step fails.
 std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
                                                 const Problem& problem, double h);
 // mode_freq_err_max = max over modes with ω > 0 of |ω̃ − ω|/ω, mode_damping_max = max |ρ − 1|;

@@ -1,14 +1,21 @@
 // Registry-driven checks of every problem (docs/DESIGN.md §7): derivatives against finite
 // differences, the exact solution against the equations of motion and an independent RK4 run,
 // invariants along the exact solution, and validation of spec strings.
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <boost/numeric/odeint/integrate/integrate_adaptive.hpp>
+#include <boost/numeric/odeint/stepper/bulirsch_stoer.hpp>
 #include <cctype>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <map>
 #include <numbers>
 #include <random>
 #include <string>
@@ -421,6 +428,216 @@ TEST_P(ProblemTest, RejectsUnknownKeysAndMalformedValues) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, ProblemTest, ::testing::ValuesIn(problem_test_specs()),
+                         test_name);
+
+// ---------------------------------------------------------------------------------------------
+// Every closed form on every branch of its parameters, against two library integrators that
+// share no code with it or with each other: GSL's Prince–Dormand 8(9) and Boost.Odeint's
+// Bulirsch–Stoer extrapolation, both at rtol 1e-13. The registry's variants are joined by the
+// branches a closed form switches between (libration and rotation of the pendulum on both sides
+// of the separatrix and with whole turns in θ0, Kepler at e ≥ 0.9, the three damping regimes and
+// their borders, resonance), and the period is checked as a return time that no shorter
+// twelfth of it is.
+
+// The branches beyond the registry's variants, per problem with an exact solution. A problem
+// with an exact solution and no entry here fails ExactSolutionBranches.EveryExactProblemIsListed.
+const std::map<std::string, std::vector<std::string>>& exact_branches() {
+  static const std::map<std::string, std::vector<std::string>> branches = {
+      {"harmonic", {"omega=7,mass=0.3,q0=-2,v0=5"}},
+      {"pendulum",
+       {"theta0=0.1,omega0=2.5",          // small libration
+        "theta0=3.1",                     // libration, k' = 0.02
+        "theta0=0,v0=1.98",               // libration from the bottom, just below
+        "theta0=0,v0=2.02",               // rotation just above the separatrix
+        "theta0=0,v0=-2.02",              // the same, turning the other way
+        "theta0=-2.5,v0=1.5,omega0=0.8",  // rotation from a high start
+        "theta0=0.3,v0=-3,omega0=1.5",    // rotation, negative direction
+        "theta0=12.9,v0=0.4",             // libration about 4π (turns offset)
+        "theta0=-9.5,v0=-4"}},            // rotation with a turns offset
+      {"kepler", {"e=0.3", "e=0.95"}},
+      {"damped_oscillator",
+       {"zeta=0,omega=1.7,q0=0.3,v0=-1",               // no damping (no force)
+        "zeta=0.999999,omega=2",                       // just underdamped
+        "zeta=1.000001,omega=2",                       // just overdamped (μt < 1 for long)
+        "zeta=1,omega=1.5,q0=0,v0=2",                  // critical from the equilibrium
+        "zeta=0,omega=2,drive=0.7,drive_omega=2",      // undamped resonance: secular growth
+        "zeta=0.5,omega=2,drive=1.5,drive_omega=2",    // damped, driven at ω
+        "zeta=3,omega=1,drive=0.4,drive_omega=0.3"}},  // overdamped and driven
+      {"spring_chain",
+       {"n=4,ends=free,velocity=0.5,mode=3", "n=5,init=node,node=5,ends=free",
+        "n=7,init=node,node=7,ends=fixed_free,stiffness=2.5"}},
+      {"stiff_spring", {"ratio=1,stretch=0.3"}},
+      {"cartesian_pendulum", {"theta0=3.0,length=1.5", "theta0=0.2,v0=-2.5,length=0.8,gravity=2"}},
+      {"spherical_pendulum", {"theta0=1.3,length=0.6,gravity=9.81"}},
+  };
+  return branches;
+}
+
+// The registry's default and variants of `entry` plus its listed branches.
+std::vector<std::string> branch_specs(const ProblemEntry& entry) {
+  std::vector<std::string> specs = {entry.name};
+  for (const auto& variant : entry.variants) specs.push_back(entry.name + ":" + variant);
+  const auto listed = exact_branches().find(entry.name);
+  if (listed != exact_branches().end()) {
+    for (const auto& branch : listed->second) specs.push_back(entry.name + ":" + branch);
+  }
+  return specs;
+}
+
+// The states at `times` (increasing, > 0) of Hamilton's equations from the initial state.
+using Trajectory = std::vector<Vec>;
+using Rhs = std::function<Vec(double, const Vec&)>;
+
+struct GslSystem {
+  const Rhs* rhs;
+  int dimension;
+};
+
+Trajectory integrate_gsl_rk8pd(const Rhs& rhs, const Vec& y0, const std::vector<double>& times,
+                               double rtol, double atol) {
+  GslSystem data{&rhs, static_cast<int>(y0.size())};
+  const auto function = [](double t, const double y[], double dydt[], void* params) -> int {
+    const auto* system = static_cast<GslSystem*>(params);
+    const Vec rate = (*system->rhs)(t, Eigen::Map<const Vec>(y, system->dimension));
+    std::copy(rate.data(), rate.data() + rate.size(), dydt);
+    return GSL_SUCCESS;
+  };
+  gsl_odeiv2_system system{function, nullptr, static_cast<size_t>(y0.size()), &data};
+  gsl_odeiv2_driver* driver =
+      gsl_odeiv2_driver_alloc_y_new(&system, gsl_odeiv2_step_rk8pd, 1e-6, atol, rtol);
+  gsl_odeiv2_driver_set_nmax(driver, 100'000'000);
+  Vec y = y0;
+  double t = 0;
+  Trajectory out;
+  for (double stop : times) {
+    const int status = gsl_odeiv2_driver_apply(driver, &t, stop, y.data());
+    EXPECT_EQ(status, GSL_SUCCESS) << "gsl_rk8pd at t = " << t;
+    out.push_back(y);
+  }
+  gsl_odeiv2_driver_free(driver);
+  return out;
+}
+
+Trajectory integrate_odeint_bulirsch_stoer(const Rhs& rhs, const Vec& y0,
+                                           const std::vector<double>& times, double rtol,
+                                           double atol) {
+  using Buffer = std::vector<double>;
+  namespace odeint = boost::numeric::odeint;
+  const auto system = [&](const Buffer& y, Buffer& dydt, double t) {
+    const Vec rate = rhs(t, Eigen::Map<const Vec>(y.data(), static_cast<long>(y.size())));
+    dydt.assign(rate.data(), rate.data() + rate.size());
+  };
+  odeint::bulirsch_stoer<Buffer> stepper(atol, rtol);
+  Buffer y(y0.data(), y0.data() + y0.size());
+  double t = 0;
+  Trajectory out;
+  for (double stop : times) {
+    odeint::integrate_adaptive(stepper, system, y, t, stop, (stop - t) / 100);
+    t = stop;
+    out.push_back(Eigen::Map<const Vec>(y.data(), static_cast<long>(y.size())));
+  }
+  return out;
+}
+
+TEST(ExactSolutionBranches, EveryExactProblemIsListed) {
+  for (const auto& entry : problem_registry()) {
+    if (!entry.builtin) continue;
+    bool exact = false;
+    for (const auto& spec : branch_specs(entry)) exact = exact || make_problem(spec)->has(kExact);
+    EXPECT_TRUE(!exact || exact_branches().count(entry.name))
+        << entry.name << " has an exact solution: list its branches in exact_branches()";
+  }
+  for (const auto& [name, branches] : exact_branches()) {
+    for (const auto& branch : branches) {
+      EXPECT_TRUE(make_problem(name + ":" + branch)->has(kExact)) << name << ":" << branch;
+    }
+  }
+}
+
+// Closed form and period against both integrators, on each branch of each problem.
+class ExactBranch : public ::testing::TestWithParam<std::string> {};
+
+std::vector<std::string> all_exact_branch_specs() {
+  std::vector<std::string> specs;
+  for (const auto& entry : problem_registry()) {
+    if (!entry.builtin) continue;
+    for (const auto& spec : branch_specs(entry)) {
+      if (make_problem(spec)->has(kExact)) specs.push_back(spec);
+    }
+  }
+  return specs;
+}
+
+TEST_P(ExactBranch, MatchesTwoLibraryIntegrators) {
+  const auto problem = make_problem(GetParam());
+  ASSERT_TRUE(problem->has(kExact));
+  const int n = problem->dof();
+  const State start = problem->initial_state();
+  // Past one period when there is one (phase, period and argument reduction all exercised),
+  // sampled at twelfths of it: a declared period that is a multiple of the true one returns
+  // early. Otherwise the default run, at most 20 time units.
+  const bool periodic = problem->has(kPeriod);
+  const double period = periodic ? problem->period() : 0;
+  std::vector<double> times;
+  if (periodic) {
+    for (int k = 1; k <= 12; ++k) times.push_back(k * period / 12);
+    times.push_back(1.37 * period);
+  } else {
+    // A stiff problem (stiff_spring at ratio 1e8) is followed for 2·10⁴ periods of its fastest
+    // mode: explicit integrators at rtol 1e-13 need about 10⁸ stages for its default run.
+    double t_end = std::min(problem->default_t_end(), 20.0);
+    if (problem->has(kOmegaMax)) t_end = std::min(t_end, 2e4 / problem->omega_max(start.q));
+    for (int k = 1; k <= 8; ++k) times.push_back(k * t_end / 8);
+  }
+  const Rhs rhs = [&](double t, const Vec& y) {
+    return hamilton_rhs(*problem, t, y.head(n), y.tail(n));
+  };
+  // Absolute tolerance at 1e-13 of the state's size, so that neither integrator crawls on a
+  // component that passes through zero.
+  const double size = std::max(inf_norm(stacked(start)), 1e-300);
+  constexpr double kRtol = 1e-13;
+  const std::vector<Trajectory> runs = {
+      integrate_gsl_rk8pd(rhs, stacked(start), times, kRtol, kRtol * size),
+      integrate_odeint_bulirsch_stoer(rhs, stacked(start), times, kRtol, kRtol * size)};
+  const char* names[] = {"gsl_rk8pd", "odeint bulirsch_stoer"};
+  double worst = 0;
+  for (size_t k = 0; k < times.size(); ++k) {
+    const Vec exact = stacked(problem->exact(times[k]));
+    // Relative to the state's size over the run; 1e-9 leaves the integrators' global error (4e-10
+    // at most, measured over these branches, at the pendulum's θ0 = 3.1) and catches any wrong
+    // phase, period or branch formula.
+    const double scale = std::max(inf_norm(exact), inf_norm(stacked(start)));
+    // Near-collision orbits (Kepler at e ≥ 0.99) magnify the integrators' own error at each
+    // perihelion; ten times their disagreement bounds it there.
+    const double allowed = 1e-9 + 10 * inf_norm(runs[0][k] - runs[1][k]) / scale;
+    for (size_t r = 0; r < runs.size(); ++r) {
+      const double error = inf_norm(runs[r][k] - exact) / scale;
+      worst = std::max(worst, error);
+      EXPECT_LE(error, allowed) << names[r] << " at t = " << times[k] << "\n exact      "
+                                << exact.transpose() << "\n integrated " << runs[r][k].transpose();
+    }
+    if (!periodic) continue;
+    // A period is a return time of the integrated motion (angles modulo whole turns), and no
+    // earlier twelfth of it is.
+    for (size_t r = 0; r < runs.size(); ++r) {
+      Vec change = runs[r][k] - stacked(start);
+      if (problem->name() == "pendulum") {
+        change[0] -= 2 * std::numbers::pi * std::round(change[0] / (2 * std::numbers::pi));
+      }
+      const double distance = inf_norm(change) / scale;
+      if (k == 11) {
+        EXPECT_LE(distance, allowed)
+            << names[r] << ": no return after the declared period " << period;
+      } else if (k < 11) {
+        EXPECT_GT(distance, 1e-6) << names[r] << ": returns after " << k + 1
+                                  << "/12 of the declared period " << period;
+      }
+    }
+  }
+  std::printf("%s: largest difference to the integrators %.2e\n", GetParam().c_str(), worst);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllBranches, ExactBranch, ::testing::ValuesIn(all_exact_branch_specs()),
                          test_name);
 
 // The variants of problems/registry.def are parameter sets of their own entry ("e=0.9", not

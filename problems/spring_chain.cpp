@@ -1,5 +1,6 @@
 // One-dimensional chain of n equal masses joined by springs φ(d) = ½k d² + ⅓α d³ + ¼β d⁴ in the
-// extension d (linear, Fermi–Pasta–Ulam α and β models; GNI §I.5), with fixed or free ends. The
+// extension d (linear, Fermi–Pasta–Ulam α and β models; GNI §I.5), with fixed, free or fixed–free
+// (a wall on the left only) ends. The
 // linear chain has the exact normal-mode solution q(t) = Σ_j φ_j (a_j cos ω_j t + b_j sin ω_j t).
 #include <fmt/format.h>
 
@@ -18,7 +19,8 @@ constexpr int kMaxExactMasses = 4096;
 
 struct SpringChainConfig {
   int n = 8;
-  bool fixed = true;  // walls at both ends (q_wall = 0) or free ends
+  bool fixed = true;        // a wall at the left end (q_wall = 0) …
+  bool fixed_right = true;  // … and one at the right end; free ends have neither
   double mass = 1;
   double stiffness = 1;
   double alpha = 0;  // cubic coefficient of φ (fpu_alpha only)
@@ -39,7 +41,7 @@ class SpringChain final : public Problem {
     unsigned capabilities = kHessian | kOmegaMax;
     if (exact) capabilities |= kExact;
     // Only the walls exert external forces, so the free chain keeps Σ p.
-    if (!config.fixed) capabilities |= kLinearMomentum;
+    if (!config.fixed && !config.fixed_right) capabilities |= kLinearMomentum;
     set_capabilities(capabilities);
     // 20 steps per period of the fastest linear mode (ω ≤ 2√(k/m)), ten periods of the slowest
     // oscillating one.
@@ -141,8 +143,11 @@ class SpringChain final : public Problem {
     double a, b;  // modal displacement and velocity at t = 0
   };
 
-  // Springs: fixed ends have n + 1 (node −1 and node n are the walls), free ends n − 1.
-  int springs() const { return config_.fixed ? config_.n + 1 : config_.n - 1; }
+  // Springs: fixed ends have n + 1 (node −1 and node n are the walls), fixed–free n (the wall
+  // at node −1 only), free ends n − 1.
+  int springs() const {
+    return config_.n - 1 + (config_.fixed ? 1 : 0) + (config_.fixed_right ? 1 : 0);
+  }
   int left(int s) const { return config_.fixed ? s - 1 : s; }
   int right(int s) const {
     const int node = config_.fixed ? s : s + 1;
@@ -159,20 +164,26 @@ class SpringChain final : public Problem {
   }
 
   // Eigenvectors of the discrete Laplacian: sin((i + 1) j π/(n + 1)) with Dirichlet ends,
-  // j = 1..n, and cos((i + ½) j π/n) with Neumann (free) ends, j = 0..n−1 (j = 0: translation);
-  // ω_j = 2√(k/m) sin(jπ/(2(n + 1))) resp. 2√(k/m) sin(jπ/(2n)).
+  // j = 1..n, cos((i + ½) j π/n) with Neumann (free) ends, j = 0..n−1 (j = 0: translation), and
+  // sin((i + 1)(2j − 1)π/(2n + 1)), j = 1..n, with a Dirichlet left and a Neumann right end;
+  // ω_j = 2√(k/m) sin(jπ/(2(n + 1))), 2√(k/m) sin(jπ/(2n)) resp. 2√(k/m) sin((2j − 1)π/(2(2n +
+  // 1))).
   Vec mode_shape(int j) const {
     const int n = config_.n;
     const double pi = std::numbers::pi;
     Vec shape(n);
     for (int i = 0; i < n; ++i) {
-      shape[i] =
-          config_.fixed ? std::sin((i + 1) * j * pi / (n + 1)) : std::cos((i + 0.5) * j * pi / n);
+      shape[i] = !config_.fixed        ? std::cos((i + 0.5) * j * pi / n)
+                 : config_.fixed_right ? std::sin((i + 1) * j * pi / (n + 1))
+                                       : std::sin((i + 1) * (2 * j - 1) * pi / (2 * n + 1));
     }
     return shape;
   }
   double mode_frequency(int j) const {
     const double scale = 2 * std::sqrt(config_.stiffness / config_.mass);
+    if (config_.fixed && !config_.fixed_right) {
+      return scale * std::sin((2 * j - 1) * std::numbers::pi / (2.0 * (2 * config_.n + 1)));
+    }
     const int denominator = config_.fixed ? config_.n + 1 : config_.n;
     return scale * std::sin(j * std::numbers::pi / (2.0 * denominator));
   }
@@ -202,8 +213,10 @@ std::unique_ptr<Problem> make_spring_chain(Params& params) {
   SpringChainConfig config;
   config.n = static_cast<int>(params.integer("n", 8, "number of masses", 2, 10'000'000));
   const std::string ends =
-      params.choice("ends", "fixed", {"fixed", "free"}, "walls at both ends, or free ends");
-  config.fixed = ends == "fixed";
+      params.choice("ends", "fixed", {"fixed", "free", "fixed_free"},
+                    "walls at both ends, free ends, or a wall at the left end only");
+  config.fixed = ends != "free";
+  config.fixed_right = ends == "fixed";
   const std::string model = params.choice("model", "linear", {"linear", "fpu_alpha", "fpu_beta"},
                                           "spring law: 1/2 k d^2, plus alpha d^3/3, or beta d^4/4");
   config.mass = params.real("mass", 1.0, "mass of each node", positive, "> 0");

@@ -38,6 +38,14 @@ TEST(SpringChain, HessianSpectrumIsTheDiscreteLaplacians) {
     const double omega = 2 * std::sqrt(k / m) * std::sin(j * std::numbers::pi / (2 * n));
     EXPECT_NEAR(free[j], omega * omega, 1e-13) << "free mode " << j;
   }
+  // A wall on the left only: 2√(k/m) sin((2j − 1)π/(2(2n + 1))), j = 1..n.
+  const Vec fixed_free =
+      squared_frequencies(*make_problem("spring_chain:n=7,stiffness=3,mass=2,ends=fixed_free"));
+  for (int j = 1; j <= n; ++j) {
+    const double omega =
+        2 * std::sqrt(k / m) * std::sin((2 * j - 1) * std::numbers::pi / (2 * (2 * n + 1)));
+    EXPECT_NEAR(fixed_free[j - 1], omega * omega, 1e-13) << "fixed-free mode " << j;
+  }
 }
 
 TEST(SpringChain, ModeShapedStartOscillatesInThatModeOnly) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -149,6 +150,59 @@ TEST(NormalModes, DiscreteFrequenciesFollowTheClosedForms) {
                   mode.omega_discrete, mode.amplitude);
       EXPECT_NEAR(mode.omega_discrete, c.frequency(h, mode.omega), 1e-13) << c.spec;
       EXPECT_NEAR(mode.amplitude, c.amplitude(h, mode.omega), 1e-13) << c.spec;
+    }
+  }
+}
+
+// Full relative precision for the slow modes of a long chain: the dense eigensolver leaves λ_j
+// an absolute error of about ε λ_max, (ω_max/ω_1)² ≈ 1.6e4 times ω_1² here, and ω̃ taken from
+// the trace of DΦ loses another 1/(hω)². 199 masses of 0.7 on springs of 1.3, fixed ends
+// (ω_j = 2√(k/m) sin(jπ/(2(n + 1))), j = 1..n), fixed–free (2√(k/m) sin((2j − 1)π/(2(2n + 1))),
+// j = 1..n) and free ends (2√(k/m) sin(jπ/(2n)), j = 0..n−1, j = 0 the translation);
+// Störmer–Verlet's sin(hω̃/2) = hω/2 and the implicit
+// midpoint rule's tan(hω̃/2) = hω/2, all evaluated in long double from the same double k and m
+// the problem holds. A few ulps relative, every mode.
+TEST(NormalModes, SlowModesOfALongChainToFullRelativePrecision) {
+  constexpr int kMasses = 199;
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+  const double mass = 0.7, stiffness = 1.3, h = 0.5;
+  const long double scale =
+      2 * std::sqrt(static_cast<long double>(stiffness) / static_cast<long double>(mass));
+  const long double pi = 3.141592653589793238462643383279502884L;
+  for (const std::string ends : {"fixed", "fixed_free", "free"}) {
+    const bool fixed = ends != "free";
+    const auto chain = make_problem("spring_chain:n=199,mass=0.7,stiffness=1.3,ends=" + ends);
+    for (const std::string method : {"stormer_verlet", "implicit_midpoint"}) {
+      const std::vector<DiscreteMode> modes = discrete_normal_modes(method, *chain, h);
+      ASSERT_EQ(modes.size(), static_cast<size_t>(kMasses)) << method;
+      double worst_omega = 0, worst_discrete = 0;
+      for (int i = 0; i < kMasses; ++i) {
+        const int j = fixed ? i + 1 : i;
+        const DiscreteMode& mode = modes[i];
+        if (j == 0) {  // the free chain's translation: ω = 0 to rounding, no relative error
+          EXPECT_LE(mode.omega, 1e-7) << method;
+          continue;
+        }
+        const long double omega =
+            ends == "fixed_free" ? scale * std::sin((2 * j - 1) * pi / (2 * (2 * kMasses + 1)))
+                                 : scale * std::sin(j * pi / (2 * (fixed ? kMasses + 1 : kMasses)));
+        const long double half_angle = h * omega / 2;
+        const long double discrete =
+            2 / static_cast<long double>(h) *
+            (method == "stormer_verlet" ? std::asin(half_angle) : std::atan(half_angle));
+        const double omega_error = static_cast<double>(std::abs((mode.omega - omega) / omega));
+        const double discrete_error =
+            static_cast<double>(std::abs((mode.omega_discrete - discrete) / discrete));
+        worst_omega = std::max(worst_omega, omega_error);
+        worst_discrete = std::max(worst_discrete, discrete_error);
+        EXPECT_LE(omega_error, 4 * kEpsilon) << method << " mode " << j;
+        EXPECT_LE(discrete_error, 4 * kEpsilon) << method << " mode " << j;
+        EXPECT_NEAR(mode.amplitude, 1.0, 4 * kEpsilon) << method << " mode " << j;
+      }
+      std::printf(
+          "%-17s %s ends: lowest omega %.17g; largest relative error omega %.2e, "
+          "discrete %.2e\n",
+          method.c_str(), ends.c_str(), modes[fixed ? 0 : 1].omega, worst_omega, worst_discrete);
     }
   }
 }
