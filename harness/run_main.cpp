@@ -538,7 +538,13 @@ int run_main(int argc, char** argv) {
       // that holds scene.toml, whatever --out says.
       options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
       options.variant = quick ? "quick" : "full";
-      check_output_dir(options.out_dir, sweep_out.empty() ? "output folder" : "--out");
+      const std::string out_option = sweep_out.empty() ? "output folder" : "--out";
+      check_output_dir(options.out_dir, out_option);
+      const auto out_file = [&](const char* name) {
+        return (std::filesystem::path(options.out_dir) / name).string();
+      };
+      if (markdown_only || timing_only) check_output_file(out_file("table.md"), out_option);
+      if (timing_only) check_output_file(out_file("summary.csv"), out_option);
       if (markdown_only) {
         rewrite_scene_markdown(scene, options.out_dir);
         return 0;
@@ -601,6 +607,13 @@ int run_main(int argc, char** argv) {
       options.scene_name = fs::absolute(scene_file).parent_path().filename().string();
       options.sbatch_path = (fs::path(scene_file).parent_path() / "sweep.sbatch").string();
       check_output_dir(merge_dir, "scene_dir");
+      const SceneUnits units = scene_units(scene);
+      std::vector<std::string> merged = {"table.md", "hosts.csv"};
+      for (const auto& table : shard_tables(units.runs, units.orders, units.stability)) {
+        merged.push_back(table + ".csv");
+      }
+      for (const auto& name : merged)
+        check_output_file((fs::path(merge_dir) / name).string(), "scene_dir");
       try {
         merge_shards(scene, options);
       } catch (const MergeRefused& refused) {

@@ -319,12 +319,32 @@ std::string without_provenance(const std::string& text) {
   return text.substr(start);
 }
 
+// Every file the sweep will write, checked before its first run: a folder where summary.csv
+// goes, a file named `series`, a name too long are bad input, not an error after the runs.
+void check_sweep_outputs(const Plan& plan, const SweepOptions& options) {
+  const auto tables =
+      shard_tables(plan.jobs.size(), plan.order_jobs.size(), plan.stability_jobs.size());
+  const std::filesystem::path out(options.out_dir);
+  for (const auto& table : tables) {
+    check_output_file(
+        options.shard_count > 0
+            ? shard_file(options.out_dir, table, {options.shard_index, options.shard_count})
+            : (out / (table + ".csv")).string(),
+        "output");
+  }
+  if (options.shard_count == 0) check_output_file((out / "table.md").string(), "output");
+  for (const auto& job : plan.jobs) {
+    if (!job.config.series_path.empty()) check_output_file(job.config.series_path, "output");
+  }
+}
+
 }  // namespace
 
 int run_sweep(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
+  check_sweep_outputs(plan, options);
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;
   auto& stability_jobs = plan.stability_jobs;
