@@ -642,6 +642,15 @@ const std::vector<Case>& cases() {
       {"ModesTooLargeForDenseEigensolver",
        "modes --problem spring_chain:n=1000000 --method stormer_verlet --dt 0.1", 2,
        "more than the 2000"},
+      // Parse errors say what the option takes, or which options the verb has, and its --help.
+      {"CliNotANumberSaysWhatTheOptionTakes",
+       "run --problem pendulum --method rk4 --dt 1e-5x --t-end 1", 2, "--dt takes a number"},
+      {"CliRangeSaysTheRange", "sweep {dir}/scene.toml --jobs 0", 2,
+       "--jobs takes an integer in [1 - 256]"},
+      {"CliUnknownOptionListsTheVerbsOptions", "run --problem pendulum --method rk4 --frob 1", 2,
+       "run takes: --problem, --method"},
+      {"CliExtraArgumentPointsToTheVerbsHelp", "sweep {dir}/a.toml {dir}/b.toml", 2,
+       "see geomint sweep --help"},
   };
   return all;
 }
