@@ -563,5 +563,29 @@ TEST(Cli, SlurmRefusesAFolderNameWithANewline) {
   fs::remove_all(root);
 }
 
+// --series and --out that name one file through a symbolic link are refused before the run, as
+// the same spelling is (the bad-input registry has "./x.csv" and "sub/../x.csv"; it cannot make
+// links): a link to the folder, and a link to an existing series file.
+TEST(Cli, SeriesAndOutThroughASymbolicLinkAreOneFile) {
+  const fs::path folder = scratch("same_file_link");
+  fs::create_directories(folder);
+  fs::create_directory_symlink(".", folder / "here");
+  std::ofstream(folder / "s.csv") << "old\n";
+  fs::create_symlink("s.csv", folder / "alias.csv");
+  const std::string run =
+      "cd " + sh_word(folder.string()) + " && " + GEOMINT_BINARY +
+      " run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 ";
+  for (const char* outputs :
+       {"--series new.csv --out here/new.csv", "--series s.csv --out alias.csv"}) {
+    const Outcome outcome = geomint_shell(run + outputs);
+    EXPECT_EQ(outcome.exit_code, 2) << outputs << "\n" << outcome.output;
+    EXPECT_NE(outcome.output.find("name the same file"), std::string::npos) << outcome.output;
+  }
+  EXPECT_FALSE(fs::exists(folder / "new.csv"));
+  std::ifstream series(folder / "s.csv");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(series), {}), "old\n");
+  fs::remove_all(folder);
+}
+
 }  // namespace
 }  // namespace geomint
