@@ -68,8 +68,8 @@ void probe_folder(const fs::path& folder, const std::string& option, const std::
 // in which a file can be created, and every missing component below it, and `leaf` (a file to
 // be written there; may be empty), a name its file system allows; the missing folders are
 // created later. A path longer than PATH_MAX is refused in one pass over its bytes before any
-// component is looked at (walking up a 100 kB path one parent_path() at a time was quadratic);
-// below that bound the components are walked once, from the start.
+// component is looked at (walking up a long path one parent_path() at a time is quadratic in
+// its length); below that bound the components are walked once, from the start.
 void check_creatable_below(const fs::path& folder, const std::string& leaf,
                            const std::string& option, const std::string& shown) {
   if (shown.size() + kTemporarySuffix >= PATH_MAX) {

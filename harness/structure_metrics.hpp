@@ -30,7 +30,8 @@ double symplecticity_defect(const std::string& method_spec, const Problem& probl
 double symplecticity_defect(const Eigen::MatrixXd& tangent);
 
 // The largest problem whose linearised step (a dense 2n x 2n matrix) and normal modes (a dense
-// eigensolver) are computed: about 0.5 GB and half a minute at the limit.
+// eigensolver) are computed: at the limit `geomint modes` takes 0.3 GB and about 100 s (a
+// spring_chain on the 2-core development VM); far above it the allocation fails.
 inline constexpr int kMaxDenseTangentDof = 2000;
 
 // Why the defect does not apply to `method` on `problem`, or "" when it does: it needs a
