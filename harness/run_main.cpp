@@ -189,6 +189,66 @@ void print_problems(bool markdown) {
   if (!markdown) print_aligned(rows, {false, true, false, false});
 }
 
+// What a CLI11 type name means to a user: "FLOAT" → "a number", "INT:INT in [1 - 256]" → "an
+// integer in [1 - 256]".
+std::string value_phrase(const std::string& type_name) {
+  const std::string type = type_name.substr(0, type_name.find(':'));
+  std::string check =
+      type_name.find(':') == std::string::npos ? "" : type_name.substr(type_name.find(':') + 1);
+  if (check.rfind(type + " ", 0) == 0) check.erase(0, type.size() + 1);
+  std::string phrase = type == "FLOAT"  ? "a number"
+                       : type == "INT"  ? "an integer"
+                       : type == "UINT" ? "a non-negative integer"
+                       : type == "TEXT" ? "text"
+                       : type.empty()   ? "no value (a flag)"
+                                        : type;
+  if (!check.empty()) phrase += " " + check;
+  return phrase;
+}
+
+// CLI11 says what was wrong ("Could not convert: --dt = 1e-5x", "The following argument was not
+// expected: --frob"); spec errors also say what is allowed. So does this: the option the
+// message names, with what it takes, or the options the verb has, and its --help.
+std::string parse_error_advice(const CLI::App& app, const std::string& program, int argc,
+                               char** argv, const CLI::ParseError& error) {
+  const std::string verb = argc >= 2 ? argv[1] : "";
+  const bool known_verb = std::find(kCommands.begin(), kCommands.end(), verb) != kCommands.end();
+  const CLI::App* command = known_verb ? app.get_subcommand(verb) : &app;
+  const std::string help =
+      known_verb ? fmt::format("{} {} --help", program, verb) : fmt::format("{} --help", program);
+  const std::string what = error.what();
+  // The option the message names: the longest name found as a whole word ("--shard" is not
+  // "--shards").
+  const CLI::Option* named = nullptr;
+  std::size_t named_length = 0;
+  std::vector<std::string> names;
+  for (const CLI::Option* option : command->get_options()) {
+    const std::string name = option->get_name();
+    if (name == "--help" || name.empty()) continue;
+    names.push_back(name);
+    for (std::size_t at = what.find(name); at != std::string::npos; at = what.find(name, at + 1)) {
+      const std::size_t end = at + name.size();
+      const bool word = (at == 0 || what[at - 1] == ' ') &&
+                        (end == what.size() || what[end] == ' ' || what[end] == ':' ||
+                         what[end] == '=' || what[end] == ',');
+      if (word && name.size() > named_length) {
+        named = option;
+        named_length = name.size();
+      }
+    }
+  }
+  const bool unexpected = dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr;
+  std::string advice = what;
+  if (named && !unexpected) {
+    advice +=
+        fmt::format("\n  {} takes {}", named->get_name(), value_phrase(named->get_type_name()));
+    if (!named->get_description().empty()) advice += ": " + named->get_description();
+  } else if (known_verb) {
+    advice += fmt::format("\n  {} takes: {}", verb, fmt::join(names, ", "));
+  }
+  return advice + fmt::format("\n  see {}", help);
+}
+
 }  // namespace
 
 int run_main(int argc, char** argv) {
@@ -361,7 +421,8 @@ int run_main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& version) {
     return app.exit(version);
   } catch (const CLI::ParseError& error) {
-    app.exit(error);
+    fmt::print(stderr, "{}: error: {}\n", program,
+               parse_error_advice(app, program, argc, argv, error));
     return kExitBadInput;
   }
 
@@ -540,7 +601,13 @@ int run_main(int argc, char** argv) {
       // that holds scene.toml, whatever --out says.
       options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
       options.variant = quick ? "quick" : "full";
-      check_output_dir(options.out_dir, sweep_out.empty() ? "output folder" : "--out");
+      const std::string out_option = sweep_out.empty() ? "output folder" : "--out";
+      check_output_dir(options.out_dir, out_option);
+      const auto out_file = [&](const char* name) {
+        return (std::filesystem::path(options.out_dir) / name).string();
+      };
+      if (markdown_only || timing_only) check_output_file(out_file("table.md"), out_option);
+      if (timing_only) check_output_file(out_file("summary.csv"), out_option);
       if (markdown_only) {
         rewrite_scene_markdown(scene, options);
         return 0;
@@ -610,6 +677,13 @@ int run_main(int argc, char** argv) {
       options.scene_name = fs::absolute(scene_file).parent_path().filename().string();
       options.sbatch_path = (fs::path(scene_file).parent_path() / "sweep.sbatch").string();
       check_output_dir(merge_dir, "scene_dir");
+      const SceneUnits units = scene_units(scene);
+      std::vector<std::string> merged = {"table.md", "hosts.csv"};
+      for (const auto& table : shard_tables(units.runs, units.orders, units.stability)) {
+        merged.push_back(table + ".csv");
+      }
+      for (const auto& name : merged)
+        check_output_file((fs::path(merge_dir) / name).string(), "scene_dir");
       try {
         merge_shards(scene, options);
       } catch (const MergeRefused& refused) {

@@ -7,10 +7,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include "harness/order.hpp"
 #include "harness/record.hpp"
+#include "harness/reference.hpp"
+#include "harness/run.hpp"
 #include "harness/toml_reader.hpp"
 
 namespace geomint {
@@ -54,6 +57,23 @@ void check_label(const std::string& label, const std::string& where) {
         "{}: label '{}' is not allowed: use 1 to 64 letters, digits, '_', '-' or '.', no '..' "
         "and no path separator (labels name folders inside the output folder)",
         where, label));
+  }
+}
+
+// The reference files the runs and order studies will read (harness/run.cpp), loaded now: a
+// malformed one is bad input of the scene, not an error row in every run that meets it.
+void validate_references(const std::vector<std::string>& problems, const std::string& where,
+                         std::set<std::string>& checked) {
+  for (const auto& spec : problems) {
+    const auto problem = make_problem(spec);
+    if (problem->has(kExact)) continue;
+    const std::string path = reference_path(RunConfig{}.reference_dir, problem->spec());
+    if (!checked.insert(path).second || !std::filesystem::exists(path)) continue;
+    try {
+      load_reference(path, *problem);
+    } catch (const InputError& error) {
+      throw InputError(fmt::format("{}: {}", where, error.what()));
+    }
   }
 }
 
@@ -121,7 +141,7 @@ Scene load_scene(const std::string& path, bool quick) {
     throw InputError(
         fmt::format("{}: no [[runs]], [[orders]] or [[stability]] block: nothing to run", path));
   }
-  std::set<std::string> labels;
+  std::set<std::string> labels, references;
   for (size_t i = 0; i < run_tables.size(); ++i) {
     TomlBlock reader(*run_tables[i], fmt::format("{}: [[runs]] #{}", path, i + 1));
     RunBlock block;
@@ -153,6 +173,7 @@ Scene load_scene(const std::string& path, bool quick) {
       const char* prefix = candidate == &block ? "" : "quick_";
       bool all_adaptive = false;
       validate_specs(candidate->problems, candidate->methods, where, &all_adaptive);
+      validate_references(candidate->problems, where, references);
       if (candidate->dts.empty() && !all_adaptive) {
         throw InputError(
             fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
@@ -191,6 +212,7 @@ Scene load_scene(const std::string& path, bool quick) {
     check_diverge_factor(block.diverge_factor, where);
     bool all_adaptive = false;
     validate_specs(block.problems, block.methods, where, &all_adaptive);
+    validate_references(block.problems, where, references);
     check_positive(block.dt0, where, "dt0");
     check_positive(block.t_end, where, "t_end");
     // The finest level of either configuration must respect the step limit.

@@ -5,8 +5,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -145,14 +147,6 @@ std::string scene_content_hash(const std::string& scene_path, bool quick) {
     hash *= 1099511628211ull;
   }
   return fmt::format("fnv1a64:{:016x}", hash);
-}
-
-std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability) {
-  std::vector<std::string> tables;
-  if (runs) tables.push_back("summary");
-  if (orders) tables.insert(tables.end(), {"order", "order_points"});
-  if (stability) tables.push_back("stability");
-  return tables;
 }
 
 std::string merged_sweep_command(const std::string& shard_command) {
@@ -395,6 +389,66 @@ void merge_shards(const Scene& scene, const MergeOptions& options) {
                     to_csv(hosts, {"shard", "host", "cpu", "date"}, {}));
 }
 
+namespace {
+
+// A word the generated scripts may leave bare: bash and sbatch give none of these characters a
+// meaning, so plain paths keep reading as they always did.
+bool plain_word(const std::string& text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::strchr("_./:=,+@%-", c);
+  });
+}
+
+// One bash word that is exactly `text`: a folder named `x$(touch PWNED)` must stay a name.
+std::string shell_quoted(const std::string& text) {
+  if (plain_word(text)) return text;
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// `text`, refused when it cannot stay on one line: an #SBATCH line ends at a newline, which no
+// quoting carries, and a newline in a comment line would start a line of code.
+const std::string& one_line(const std::string& text, const std::string& what) {
+  for (char c : text) {
+    if (std::iscntrl(static_cast<unsigned char>(c))) {
+      throw InputError(
+          fmt::format("slurm: {} '{}' holds a control character (a newline, tab, ...), which a "
+                      "line of a Slurm script cannot carry; rename it",
+                      what, text));
+    }
+  }
+  return text;
+}
+
+// A value of an `#SBATCH --key=value` line. sbatch, not bash, reads these lines: it groups by
+// quotes, takes a backslash as an escape even inside quotes and starts a comment at a bare `#`.
+std::string sbatch_quoted(const std::string& text, const std::string& what) {
+  if (plain_word(one_line(text, what))) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// A file name pattern of --output: Slurm expands `%` sequences, `%%` is a literal `%`, and a
+// backslash anywhere turns the expansion off (the %A_%a of the log names with it).
+std::string sbatch_output_path(const std::string& path) {
+  if (path.find('\\') != std::string::npos) {
+    throw InputError(fmt::format(
+        "slurm: the log folder '{}' holds a backslash, which Slurm reads in --output as \"no "
+        "file name patterns\"; rename the folder",
+        path));
+  }
+  std::string out;
+  for (char c : path) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
 std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
   const fs::path folder = fs::absolute(options.scene_path).parent_path();
   const std::string scene_name = folder.filename().string();
@@ -402,20 +456,32 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
   const std::string cwd = fs::current_path().string();
   const std::string quick = options.quick ? " --quick" : "";
   const fs::path logs = out_dir / "slurm-logs";
-  fs::create_directories(logs);  // Slurm does not create the folder of --output
+  // Every path and value reaches the scripts through these, refused before any file is written.
+  // The comment lines carry the paths too: a newline there would start a line of code.
+  const std::string scene_comment = shell_quoted(one_line(options.scene_path, "the scene path"));
+  const std::string sweep_comment = shell_quoted((folder / "sweep.sbatch").string());
+  const std::string logs_value = sbatch_output_path(logs.string());
+  one_line(cwd, "the working folder");
+  const std::string partition =
+      options.partition.empty() ? "" : sbatch_quoted(options.partition, "--partition");
+  const std::string time_limit =
+      options.time_limit.empty() ? "" : sbatch_quoted(options.time_limit, "--time");
   const auto header = [&](const std::string& what, const std::string& job) {
     std::string text = fmt::format(
         "#!/bin/bash\n# {} job of {} (written by `geomint slurm`; README \"Running on a "
-        "cluster\").\n# {}\n#SBATCH --job-name=geomint-{}-{}\n#SBATCH --output={}/{}-{}.out\n",
-        job, options.scene_path, what, job, scene_name, logs.string(), job,
-        job == "sweep" ? "%A_%a" : "%j");
-    if (!options.partition.empty())
-      text += fmt::format("#SBATCH --partition={}\n", options.partition);
-    if (!options.time_limit.empty()) text += fmt::format("#SBATCH --time={}\n", options.time_limit);
+        "cluster\").\n# {}\n#SBATCH --job-name={}\n#SBATCH --output={}\n",
+        job, scene_comment, what,
+        sbatch_quoted(fmt::format("geomint-{}-{}", job, scene_name), "the scene folder"),
+        sbatch_quoted(fmt::format("{}/{}-{}.out", logs_value, job, job == "sweep" ? "%A_%a" : "%j"),
+                      "the log folder"));
+    if (!partition.empty()) text += fmt::format("#SBATCH --partition={}\n", partition);
+    if (!time_limit.empty()) text += fmt::format("#SBATCH --time={}\n", time_limit);
     return text;
   };
-  const std::string body_start = fmt::format("set -euo pipefail\ncd {}\n", cwd);
-  const std::string geomint = options.geomint_path;
+  fs::create_directories(logs);  // Slurm does not create the folder of --output
+  const std::string body_start = fmt::format("set -euo pipefail\ncd {}\n", shell_quoted(cwd));
+  const std::string geomint = shell_quoted(options.geomint_path);
+  const std::string scene = shell_quoted(options.scene_path);
   const std::string array = options.max_parallel > 0
                                 ? fmt::format("0-{}%{}", options.shards - 1, options.max_parallel)
                                 : fmt::format("0-{}", options.shards - 1);
@@ -423,22 +489,23 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
       header(fmt::format("Accuracy runs in {} shards: array task i runs the units k with k mod {} "
                          "== i.\n# A complete shard on disk is skipped, so requeued tasks are "
                          "safe; resubmit single shards with\n#   sbatch --array=3,7 {}",
-                         options.shards, options.shards, (folder / "sweep.sbatch").string()),
+                         options.shards, options.shards, sweep_comment),
              "sweep") +
       fmt::format(
           "#SBATCH --array={}\n#SBATCH --requeue\n#SBATCH --ntasks=1\n"
           "#SBATCH --cpus-per-task={}\n",
           array, options.jobs) +
       body_start +
-      fmt::format("exec {} sweep {}{} --shard-from-env --shards {} --no-timing{}\n", geomint,
-                  options.scene_path, quick, options.shards,
+      fmt::format("exec {} sweep {}{} --shard-from-env --shards {} --no-timing{}\n", geomint, scene,
+                  quick, options.shards,
                   options.jobs > 1 ? fmt::format(" --jobs {}", options.jobs) : "");
-  const std::string merge = header(
-                                "Merge of the shards into the scene's tables (submit with "
-                                "--dependency=afterok:<sweep job>)",
-                                "merge") +
-                            "#SBATCH --ntasks=1\n" + body_start +
-                            fmt::format("exec {} merge {}\n", geomint, out_dir.string());
+  const std::string merge =
+      header(
+          "Merge of the shards into the scene's tables (submit with "
+          "--dependency=afterok:<sweep job>)",
+          "merge") +
+      "#SBATCH --ntasks=1\n" + body_start +
+      fmt::format("exec {} merge {}\n", geomint, shell_quoted(out_dir.string()));
   const std::string timing =
       header(
           "Timing passes, one at a time on one whole node, pinned (submit with "
@@ -446,7 +513,7 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
           "timing") +
       "#SBATCH --exclusive\n#SBATCH --nodes=1\n#SBATCH --ntasks=1\n" + body_start +
       fmt::format("exec srun --cpu-bind=cores --ntasks=1 {} sweep {}{} --timing-only\n", geomint,
-                  options.scene_path, quick);
+                  scene, quick);
   std::vector<std::string> paths;
   for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
            {"sweep.sbatch", sweep}, {"merge.sbatch", merge}, {"timing.sbatch", timing}}) {
@@ -457,14 +524,9 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
 }
 
 std::string submit_sbatch(const std::string& script, const std::string& after) {
-  const auto quoted = [](const std::string& text) {
-    std::string out = "'";
-    for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-  };
   const std::string command = fmt::format(
       "sbatch --parsable{} {} 2>&1",
-      after.empty() ? "" : fmt::format(" --dependency=afterok:{}", after), quoted(script));
+      after.empty() ? "" : fmt::format(" --dependency=afterok:{}", after), shell_quoted(script));
   FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) throw InputError(fmt::format("cannot run '{}'", command));
   std::string output;

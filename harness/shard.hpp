@@ -28,9 +28,6 @@ ShardId shard_from_env(int count);
 // merge must come from the same scene text. InputError when the file cannot be read.
 std::string scene_content_hash(const std::string& scene_path, bool quick);
 
-// The tables a shard of a scene with these unit counts writes (summary; order and order_points;
-// stability), whether or not the shard holds a unit of them, so completeness is file presence.
-std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability);
 
 // The command of the single-machine sweep a merge reproduces: the shard command without
 // --shard, --shard-from-env and --shards, with --no-timing (a shard is never timed).

@@ -40,4 +40,12 @@ void write_shard_table(const std::string& out_dir, const std::string& table, Sha
   write_file_atomic(shard_file(out_dir, table, id), to_csv(rows, columns, lines));
 }
 
+std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability) {
+  std::vector<std::string> tables;
+  if (runs) tables.push_back("summary");
+  if (orders) tables.insert(tables.end(), {"order", "order_points"});
+  if (stability) tables.push_back("stability");
+  return tables;
+}
+
 }  // namespace geomint

@@ -29,6 +29,10 @@ std::string shard_file(const std::string& out_dir, const std::string& table, Sha
 // The column that carries a row's unit index k in the canonical expansion order.
 inline const char* const kCanonicalIndexColumn = "canonical_index";
 
+// The tables a shard of a scene with these unit counts writes (summary; order and order_points;
+// stability), whether or not the shard holds a unit of them, so completeness is file presence.
+std::vector<std::string> shard_tables(size_t runs, size_t orders, size_t stability);
+
 // Writes one shard table atomically: `lines` plus host, scene hash and `shard: i/N`, then the
 // rows with their canonical index first.
 void write_shard_table(const std::string& out_dir, const std::string& table, ShardId id,

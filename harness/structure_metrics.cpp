@@ -129,6 +129,14 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 }
 
 std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem) {
+  // Checked before any dense 2n x 2n matrix is allocated: past the limit the allocation fails
+  // (std::bad_alloc) or the O(n^3) solves take hours.
+  if (problem.dof() > kMaxDenseTangentDof) {
+    return fmt::format(
+        "{} degrees of freedom is more than the {} the dense linearised step and eigensolver "
+        "take",
+        problem.dof(), kMaxDenseTangentDof);
+  }
   if (method.info().flags & kAdaptive) return "adaptive method: no fixed one-step map";
   if (problem.has(kFirstOrderOnly)) return "first-order problem: no canonical (q, p) pair";
   if (problem.has(kForce)) return "forced problem: the step is not a Hamiltonian map";

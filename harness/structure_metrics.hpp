@@ -29,9 +29,15 @@ double symplecticity_defect(const std::string& method_spec, const Problem& probl
 // The same defect of a given 2n×2n DΦ.
 double symplecticity_defect(const Eigen::MatrixXd& tangent);
 
+// The largest problem whose linearised step (a dense 2n x 2n matrix) and normal modes (a dense
+// eigensolver) are computed: at the limit `geomint modes` takes 0.3 GB and about 100 s (a
+// spring_chain on the 2-core development VM); far above it the allocation fails.
+inline constexpr int kMaxDenseTangentDof = 2000;
+
 // Why the defect does not apply to `method` on `problem`, or "" when it does: it needs a
 // fixed-step method that implements the linearised step there (unforced, unconstrained problems
-// with a Hessian; not the library and adaptive solvers).
+// with a Hessian; not the library and adaptive solvers) and at most kMaxDenseTangentDof degrees
+// of freedom.
 std::string symplecticity_defect_not_applicable(const Integrator& method, const Problem& problem);
 bool symplecticity_defect_applies(const Integrator& method, const Problem& problem);
 

@@ -363,6 +363,25 @@ void remove_stale_outputs(const Plan& plan, const std::string& out_dir) {
   }
 }
 
+// Every file the sweep will write, checked before its first run: a folder where summary.csv
+// goes, a file named `series`, a name too long are bad input, not an error after the runs.
+void check_sweep_outputs(const Plan& plan, const SweepOptions& options) {
+  const auto tables =
+      shard_tables(plan.jobs.size(), plan.order_jobs.size(), plan.stability_jobs.size());
+  const std::filesystem::path out(options.out_dir);
+  for (const auto& table : tables) {
+    check_output_file(
+        options.shard_count > 0
+            ? shard_file(options.out_dir, table, {options.shard_index, options.shard_count})
+            : (out / (table + ".csv")).string(),
+        "output");
+  }
+  if (options.shard_count == 0) check_output_file((out / "table.md").string(), "output");
+  for (const auto& job : plan.jobs) {
+    if (!job.config.series_path.empty()) check_output_file(job.config.series_path, "output");
+  }
+}
+
 }  // namespace
 
 void remove_stale_temporaries(const Scene& scene, const std::string& out_dir) {
@@ -375,6 +394,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
+  check_sweep_outputs(plan, options);
   remove_stale_outputs(plan, options.out_dir);
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;

@@ -681,6 +681,152 @@ const std::vector<Case>& cases() {
         {"hosts.csv.2147483646.1.tmp", "partial"}},
        {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
        60},
+      // --- issue 23 (paths, Slurm scripts, CLI messages) ---
+      // The same file spelled two ways (the run is in {dir}): a relative name and "./name", or a
+      // path through "..", is still one file.
+      {"SeriesIsOutSpelledWithDotSlash",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 --series ./x.csv "
+       "--out x.csv",
+       2, "--series"},
+      {"SeriesIsOutSpelledThroughParent",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 --series x.csv "
+       "--out sub/../x.csv",
+       2,
+       "--series",
+       {{"sub/", ""}},
+       {"sub"}},
+      // Outputs where no file can be created, found by a probe file before any computing (the
+      // runs would outlast the timeout): /proc and /sys, where access(2) says yes to root.
+      {"OutUnderProc",
+       "run --problem pendulum --method rk4 --dt 1e-7 --t-end 1000 --out /proc/geomint.csv",
+       2,
+       "--out",
+       {},
+       {},
+       10},
+      {"SeriesUnderSys",
+       "run --problem pendulum --method rk4 --dt 1e-7 --t-end 1000 --series /sys/geomint.csv",
+       2,
+       "--series",
+       {},
+       {},
+       10},
+      {"OrderOutUnderProc",
+       "order --problem pendulum --method rk4 --dt 1e-4 --levels 3 --t-end 1000 --out "
+       "/proc/geomint.csv",
+       2,
+       "--out",
+       {},
+       {},
+       10},
+      // Names longer than the file system takes: the file's own (with room for its temporary),
+      // and a folder to be created.
+      {"OutNameTooLong",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 --out {dir}/" +
+           std::string(250, 'a') + ".csv",
+       2, "bytes long"},
+      {"OutFolderNameTooLong",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 --out {dir}/" +
+           std::string(300, 'a') + "/x.csv",
+       2, "bytes long"},
+      // A 100 kB path of nested folders: refused at once (the output check was quadratic in it).
+      {"OutPathOf100kB",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 --out {dir}/" +
+           [] {
+             std::string path;
+             for (int i = 0; i < 50000; ++i) path += "a/";
+             return path;
+           }() +
+           "x.csv",
+       2,
+       "bytes long",
+       {},
+       {},
+       10},
+      // A sweep's tables and series are checked before its first (long) run.
+      {"SweepSummaryIsADirectory",
+       "sweep {dir}/scene.toml",
+       2,
+       "summary.csv",
+       {{"summary.csv/", ""},
+        {"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
+       {"summary.csv", "scene.toml"},
+       10},
+      {"SweepTableMdIsADirectory",
+       "sweep {dir}/scene.toml",
+       2,
+       "table.md",
+       {{"table.md/", ""},
+        {"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
+       {"table.md", "scene.toml"},
+       10},
+      {"SweepSeriesIsAFile",
+       "sweep {dir}/scene.toml",
+       2,
+       "series",
+       {{"series", "x"},
+        {"scene.toml",
+         scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\nseries_every = 1\n")}},
+       {"series", "scene.toml"},
+       10},
+      {"SweepShardIsADirectory",
+       "sweep {dir}/scene.toml --shard 0/2",
+       2,
+       "summary.0-of-2.csv",
+       {{"shards/summary.0-of-2.csv/", ""},
+        {"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
+       {"shards", "shards/summary.0-of-2.csv", "scene.toml"},
+       10},
+      {"MarkdownOnlyTableMdIsADirectory",
+       "sweep {dir}/scene.toml --markdown-only",
+       2,
+       "table.md",
+       {{"table.md/", ""},
+        {"summary.csv",
+         "# command: geomint sweep scene.toml\nlabel,problem,method,status\n"
+         "a,pendulum,rk4,ok\n"},
+        {"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"table.md", "summary.csv", "scene.toml"}},
+      // A malformed reference file (results/references/ of the working folder, here {dir}) is
+      // bad input of the scene, found when it loads, for runs and order studies alike.
+      {"SweepRunMeetsMalformedReference",
+       "sweep {dir}/scene.toml",
+       2,
+       "not a valid reference",
+       {{"results/references/", ""},
+        {"results/references/henon_heiles_energy_0.08333333333333333_p1_0.1_q1_0_q2_0.1.csv",
+         "junk\n"},
+        {"scene.toml", scene("[[runs]]\nlabel = 'a'\nproblems = ['henon_heiles']\n"
+                             "methods = ['rk4']\ndt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n")}},
+       {"results", "results/references",
+        "results/references/henon_heiles_energy_0.08333333333333333_p1_0.1_q1_0_q2_0.1.csv",
+        "scene.toml"}},
+      {"SweepOrderMeetsMalformedReference",
+       "sweep {dir}/scene.toml",
+       2,
+       "not a valid reference",
+       {{"results/references/", ""},
+        {"results/references/henon_heiles_energy_0.08333333333333333_p1_0.1_q1_0_q2_0.1.csv",
+         "# reference_problem: henon_heiles:energy=0.08333333333333333,p1=0.1,q1=0,q2=0.1\n"
+         "# estimated_error_max: 1e-14\nt,q_0,q_1,p_0,p_1\n0,0,0.1,x,0\n"},
+        {"scene.toml", scene("[[orders]]\nlabel = 'o'\nproblems = ['henon_heiles']\n"
+                             "methods = ['rk4']\ndt0 = 0.1\nlevels = 3\nt_end = 1.0\n")}},
+       {"results", "results/references",
+        "results/references/henon_heiles_energy_0.08333333333333333_p1_0.1_q1_0_q2_0.1.csv",
+        "scene.toml"}},
+      // A dense eigensolver on a million degrees of freedom: refused by size, not std::bad_alloc.
+      {"ModesTooLargeForDenseEigensolver",
+       "modes --problem spring_chain:n=1000000 --method stormer_verlet --dt 0.1", 2,
+       "more than the 2000"},
+      // Parse errors say what the option takes, or which options the verb has, and its --help.
+      {"CliNotANumberSaysWhatTheOptionTakes",
+       "run --problem pendulum --method rk4 --dt 1e-5x --t-end 1", 2, "--dt takes a number"},
+      {"CliRangeSaysTheRange", "sweep {dir}/scene.toml --jobs 0", 2,
+       "--jobs takes an integer in [1 - 256]"},
+      {"CliUnknownOptionListsTheVerbsOptions", "run --problem pendulum --method rk4 --frob 1", 2,
+       "run takes: --problem, --method"},
+      {"CliExtraArgumentPointsToTheVerbsHelp", "sweep {dir}/a.toml {dir}/b.toml", 2,
+       "see geomint sweep --help"},
   };
   return all;
 }
@@ -692,9 +838,12 @@ std::string binary() {
   return other && *other ? other : GEOMINT_BINARY;
 }
 
+// Run in the case's folder: a relative output path, and results/references/, are the case's
+// own, and a relative output that escapes the checks is caught as a stray file.
 std::string fmt_command(const Case& c, const fs::path& dir) {
-  return "timeout -k 5 " + std::to_string(c.timeout_s) + " " + binary() + " " +
-         replace_all(c.arguments, "{dir}", dir.string()) + " 2>&1";
+  return "cd " + dir.string() + " && timeout -k 5 " + std::to_string(c.timeout_s) + " " +
+         fs::absolute(binary()).string() + " " + replace_all(c.arguments, "{dir}", dir.string()) +
+         " 2>&1";
 }
 
 class BadInput : public testing::TestWithParam<Case> {};

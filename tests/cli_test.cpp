@@ -7,7 +7,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -430,6 +432,158 @@ TEST(Cli, ShardMergeAndSlurmScripts) {
   const std::string timing_script{std::istreambuf_iterator<char>(timing), {}};
   EXPECT_NE(timing_script.find("#SBATCH --exclusive"), std::string::npos) << timing_script;
   EXPECT_NE(timing_script.find("srun --cpu-bind=cores"), std::string::npos) << timing_script;
+  fs::remove_all(folder);
+}
+
+// One word for sh: the tests below name folders with spaces, quotes and `$(...)`.
+std::string sh_word(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The arguments of the `#SBATCH` lines of a script, as sbatch reads them (src/sbatch/opt.c,
+// _get_argument): quotes group, a backslash escapes the next character even inside quotes, a
+// bare '#' starts a comment.
+std::vector<std::string> sbatch_arguments(const std::string& script) {
+  std::vector<std::string> arguments;
+  std::istringstream lines(script);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("#SBATCH", 0) != 0) continue;
+    size_t at = 7;
+    while (at < line.size()) {
+      while (at < line.size() && std::isspace(static_cast<unsigned char>(line[at]))) ++at;
+      if (at == line.size()) break;
+      std::string argument;
+      char quote = 0;
+      bool escape = false;
+      for (; at < line.size() && (quote || !std::isspace(static_cast<unsigned char>(line[at])));
+           ++at) {
+        const char c = line[at];
+        if (escape) {
+          escape = false;
+        } else if (c == '\\') {
+          escape = true;
+          continue;
+        } else if (quote) {
+          if (c == quote) {
+            quote = 0;
+            continue;
+          }
+        } else if (c == '"' || c == '\'') {
+          quote = c;
+          continue;
+        } else if (c == '#') {
+          at = line.size();
+          break;
+        }
+        argument += c;
+      }
+      if (!argument.empty()) arguments.push_back(argument);
+    }
+  }
+  return arguments;
+}
+
+// README "Running on a cluster": the scripts of `geomint slurm` run a scene whose folder name
+// holds a space, a quote, a '%' or a command substitution. Each array task, the merge and the
+// timing job are run with bash as Slurm would (srun a stand-in that runs its command), and must
+// treat the name as a name: the tables appear, and `touch PWNED` never runs. The #SBATCH values,
+// read as sbatch reads them, name the folder too.
+TEST(Cli, SlurmScriptsKeepEveryPathOneWord) {
+  const fs::path root = scratch("slurm_quoting");
+  fs::create_directories(root / "bin");
+  std::ofstream(root / "bin/srun") << "#!/bin/sh\nwhile [ \"${1#--}\" != \"$1\" ]; do shift; "
+                                      "done\nexec \"$@\"\n";
+  fs::permissions(root / "bin/srun", fs::perms::owner_all);
+  for (const std::string& name :
+       std::vector<std::string>{"my results", "x$(touch PWNED)", "it's 100%"}) {
+    SCOPED_TRACE(name);
+    const fs::path folder = root / name;
+    fs::create_directories(folder);
+    std::ofstream(folder / "scene.toml")
+        << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic\"]\n"
+           "methods = [\"stormer_verlet\", \"rk4\"]\ndt = 0.1\nt_end = 1.0\ntiming_repeats = 1\n";
+    const std::string in_root = "cd " + sh_word(root.string()) + " && ";
+    const Outcome slurm =
+        geomint_shell(in_root + GEOMINT_BINARY + " slurm " + sh_word(name + "/scene.toml") +
+                      " --shards 2 --partition 'short queue'");
+    ASSERT_EQ(slurm.exit_code, 0) << slurm.output;
+    for (const char* task : {"0", "1"}) {
+      const Outcome shard = geomint_shell(in_root + "SLURM_ARRAY_TASK_ID=" + task + " bash " +
+                                          sh_word(name + "/sweep.sbatch"));
+      EXPECT_EQ(shard.exit_code, 0) << shard.output;
+    }
+    const std::string on_path = "PATH=" + sh_word((root / "bin").string()) + ":\"$PATH\" ";
+    for (const char* job : {"/merge.sbatch", "/timing.sbatch"}) {
+      const Outcome outcome = geomint_shell(in_root + on_path + "bash " + sh_word(name + job));
+      EXPECT_EQ(outcome.exit_code, 0) << job << "\n" << outcome.output;
+    }
+    EXPECT_TRUE(fs::exists(folder / "summary.csv"));
+    EXPECT_TRUE(fs::exists(folder / "table.md"));
+    std::ifstream timing(folder / "summary.csv");
+    const std::string summary{std::istreambuf_iterator<char>(timing), {}};
+    EXPECT_NE(summary.find("wall_s"), std::string::npos) << summary;
+    std::ifstream sweep(folder / "sweep.sbatch");
+    const std::string script{std::istreambuf_iterator<char>(sweep), {}};
+    const auto arguments = sbatch_arguments(script);
+    std::string percent_doubled;
+    for (char c : (folder / "slurm-logs").string()) {
+      percent_doubled += c == '%' ? std::string("%%") : std::string(1, c);
+    }
+    for (const std::string& expected :
+         {"--job-name=geomint-sweep-" + name, "--output=" + percent_doubled + "/sweep-%A_%a.out",
+          std::string("--partition=short queue")}) {
+      EXPECT_NE(std::find(arguments.begin(), arguments.end(), expected), arguments.end())
+          << expected << " in\n"
+          << script;
+    }
+  }
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    EXPECT_NE(entry.path().filename(), "PWNED") << entry.path();
+  }
+  EXPECT_FALSE(fs::exists("PWNED"));
+  fs::remove_all(root);
+}
+
+// A newline in a folder name would end an #SBATCH line or turn the rest of a comment into code:
+// refused before any script is written.
+TEST(Cli, SlurmRefusesAFolderNameWithANewline) {
+  const fs::path root = scratch("slurm_newline");
+  const fs::path folder = root / "a\ntouch PWNED";
+  fs::create_directories(folder);
+  std::ofstream(folder / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic\"]\n"
+         "methods = [\"rk4\"]\ndt = 0.1\nt_end = 1.0\n";
+  const Outcome slurm = geomint("slurm " + sh_word((folder / "scene.toml").string()));
+  EXPECT_EQ(slurm.exit_code, 2) << slurm.output;
+  EXPECT_NE(slurm.output.find("control character"), std::string::npos) << slurm.output;
+  EXPECT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator{}), 1)
+      << "only scene.toml";
+  fs::remove_all(root);
+}
+
+// --series and --out that name one file through a symbolic link are refused before the run, as
+// the same spelling is (the bad-input registry has "./x.csv" and "sub/../x.csv"; it cannot make
+// links): a link to the folder, and a link to an existing series file.
+TEST(Cli, SeriesAndOutThroughASymbolicLinkAreOneFile) {
+  const fs::path folder = scratch("same_file_link");
+  fs::create_directories(folder);
+  fs::create_directory_symlink(".", folder / "here");
+  std::ofstream(folder / "s.csv") << "old\n";
+  fs::create_symlink("s.csv", folder / "alias.csv");
+  const std::string run =
+      "cd " + sh_word(folder.string()) + " && " + GEOMINT_BINARY +
+      " run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --timing-repeats 0 ";
+  for (const char* outputs :
+       {"--series new.csv --out here/new.csv", "--series s.csv --out alias.csv"}) {
+    const Outcome outcome = geomint_shell(run + outputs);
+    EXPECT_EQ(outcome.exit_code, 2) << outputs << "\n" << outcome.output;
+    EXPECT_NE(outcome.output.find("name the same file"), std::string::npos) << outcome.output;
+  }
+  EXPECT_FALSE(fs::exists(folder / "new.csv"));
+  std::ifstream series(folder / "s.csv");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(series), {}), "old\n");
   fs::remove_all(folder);
 }
 
