@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace geomint {
 
@@ -21,5 +22,16 @@ void check_output_dir(const std::string& path, const std::string& option);
 // True when `a` and `b` name the same file: the same inode when both exist, else the same
 // absolute path after resolving `.`, `..` and symbolic links of the existing part.
 bool same_file_path(const std::string& a, const std::string& b);
+
+// A word bash and sbatch may leave bare: they give none of its characters a meaning, so plain
+// paths and arguments keep reading as they always did.
+bool plain_word(const std::string& text);
+// One bash word that is exactly `text` (single-quoted unless plain_word): a folder named
+// `x$(touch PWNED)` stays a name in every command line geomint writes for a shell.
+std::string shell_quoted(const std::string& text);
+// The words of a command line as bash splits it (blanks, '...', "...", backslash escapes; no
+// expansion): the inverse of joining shell_quoted words with spaces. Throws InputError on an
+// unterminated quote.
+std::vector<std::string> shell_words(const std::string& line);
 
 }  // namespace geomint

@@ -70,9 +70,11 @@ std::string program_name(int argc, char** argv) {
   return name.empty() ? "geomint" : name;
 }
 
+// The `# command:` provenance line: every argument shell-quoted, so the line pastes into a shell
+// as it ran and merge can split it back into words (shell_words).
 std::string joined_command_line(int argc, char** argv) {
   std::string out = "geomint";
-  for (int i = 1; i < argc; ++i) out += std::string(" ") + argv[i];
+  for (int i = 1; i < argc; ++i) out += " " + shell_quoted(argv[i]);
   return out;
 }
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "harness/paths.hpp"
 #include "harness/record.hpp"
 #include "harness/shard_files.hpp"
 #include "harness/stability.hpp"
@@ -76,12 +77,12 @@ std::string resubmission(const std::set<int>& shards, const MergeOptions& option
   std::vector<std::string> indices;
   for (int i : shards) indices.push_back(std::to_string(i));
   std::string text = fmt::format("resubmit only these shards:\n  sbatch --array={} {}\n",
-                                 fmt::join(indices, ","), options.sbatch_path);
+                                 fmt::join(indices, ","), shell_quoted(options.sbatch_path));
   if (!sweep_command.empty()) {
     text += fmt::format("  (without Slurm: for i in {}; do {} --shard $i/{}; done)\n",
                         fmt::join(indices, " "), sweep_command, count);
   }
-  return text + fmt::format("then merge again: geomint merge {}", options.out_dir);
+  return text + fmt::format("then merge again: geomint merge {}", shell_quoted(options.out_dir));
 }
 
 }  // namespace
@@ -150,17 +151,23 @@ std::string scene_content_hash(const std::string& scene_path, bool quick) {
 }
 
 std::string merged_sweep_command(const std::string& shard_command) {
-  std::istringstream words(shard_command);
+  std::vector<std::string> words;
+  try {
+    words = shell_words(shard_command);
+  } catch (const InputError&) {
+    return shard_command;  // a provenance line, not input: shown as it was written
+  }
   std::vector<std::string> kept;
   bool no_timing = false;
-  for (std::string word; words >> word;) {
+  for (size_t i = 0; i < words.size(); ++i) {
+    const std::string& word = words[i];
     if (word == "--shard" || word == "--shards") {
-      words >> word;  // its value
+      ++i;  // its value
     } else if (word.rfind("--shard=", 0) == 0 || word.rfind("--shards=", 0) == 0 ||
                word == "--shard-from-env") {
     } else {
       no_timing = no_timing || word == "--no-timing";
-      kept.push_back(word);
+      kept.push_back(shell_quoted(word));
     }
   }
   if (!no_timing) kept.push_back("--no-timing");
@@ -390,22 +397,6 @@ void merge_shards(const Scene& scene, const MergeOptions& options) {
 }
 
 namespace {
-
-// A word the generated scripts may leave bare: bash and sbatch give none of these characters a
-// meaning, so plain paths keep reading as they always did.
-bool plain_word(const std::string& text) {
-  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || std::strchr("_./:=,+@%-", c);
-  });
-}
-
-// One bash word that is exactly `text`: a folder named `x$(touch PWNED)` must stay a name.
-std::string shell_quoted(const std::string& text) {
-  if (plain_word(text)) return text;
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 // `text`, refused when it cannot stay on one line: an #SBATCH line ends at a newline, which no
 // quoting carries, and a newline in a comment line would start a line of code.

@@ -28,7 +28,6 @@ ShardId shard_from_env(int count);
 // merge must come from the same scene text. InputError when the file cannot be read.
 std::string scene_content_hash(const std::string& scene_path, bool quick);
 
-
 // The command of the single-machine sweep a merge reproduces: the shard command without
 // --shard, --shard-from-env and --shards, with --no-timing (a shard is never timed).
 std::string merged_sweep_command(const std::string& shard_command);

@@ -10,11 +10,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 
+#include "harness/paths.hpp"
 #include "harness/sweep.hpp"
 #include "problems/spec.hpp"
 
@@ -291,6 +293,33 @@ TEST(Shard, MergedCommandIsTheSingleMachineSweepWithoutTiming) {
             "geomint sweep s.toml --quick --no-timing");
   EXPECT_EQ(merged_sweep_command("geomint sweep s.toml --shard=1/2 --jobs 4"),
             "geomint sweep s.toml --jobs 4 --no-timing");
+  // A quoted scene path stays one word, quoted again, through the split and the join.
+  EXPECT_EQ(merged_sweep_command("geomint sweep 'x$(touch PWNED)/my s.toml' --shard 0/2"),
+            "geomint sweep 'x$(touch PWNED)/my s.toml' --no-timing");
+}
+
+// Every word survives shell_quoted, a join with spaces and shell_words, and bash reads the
+// joined line back as the same words: the property the provenance line and the resubmission
+// advice rely on.
+TEST(Shell, QuotedWordsSplitBackAndBashAgrees) {
+  const std::vector<std::string> words = {"plain", "my results", "x$(touch PWNED)", "it's", "a\\b",
+                                          "\"q\"", "`id`",       "semi;colon",      "*"};
+  std::string line;
+  for (const auto& word : words) line += (line.empty() ? "" : " ") + shell_quoted(word);
+  EXPECT_EQ(shell_words(line), words);
+  EXPECT_EQ(shell_words("a \"b c\" 'd e' f\\ g"),
+            (std::vector<std::string>{"a", "b c", "d e", "f g"}));
+  EXPECT_THROW(shell_words("a 'b"), InputError);
+  const std::string script = "printf '%s\\n' " + line;
+  FILE* pipe = ::popen(("bash -c " + shell_quoted(script)).c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[256];
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  ASSERT_EQ(::pclose(pipe), 0);
+  std::string expected;
+  for (const auto& word : words) expected += word + "\n";
+  EXPECT_EQ(output, expected);
 }
 
 }  // namespace
