@@ -703,6 +703,11 @@ def main() -> int:
                 break
         log(f"mutation: [{index + 1}/{len(selected)}] {mutant.id}: {mutant.description}")
         record = Record(mutant)
+        if args.gates_only and not mutant.scenes:
+            # Nothing a gate could see and no test to run: not worth a rebuild.
+            record.notes.append("no scene (tests only); not built with --gates-only")
+            records.append(record)
+            continue
         originals = {}
         try:
             for edit in mutant.edits:
