@@ -34,6 +34,9 @@ figure is a property of the list and the gates file together, and a gates file t
 reach must not pass `make mutation`. A subset run prints the figure over the mutants it ran, says
 that it is a subset, and only warns (a subset picked to study missed mutants is below target by
 construction, and a budgeted CI run covers a different sample on every commit).
+--gates-only (MUTATION_GATES_ONLY=1) measures the figure alone: it builds only geomint, runs no
+test, skips the mutants without scenes (not gate-visible by declaration) and does not fail on
+survivors, only on the figure of a whole-list run.
 
 Python 3.11 standard library only (tomllib).
 """
