@@ -178,13 +178,13 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     if (run.ok) {
       const State reference = reference_at(run.final_state.t);
       if (reference.q.allFinite() && reference.p.allFinite()) {
-        state_scale = std::max(
-            state_scale, std::sqrt(reference.q.squaredNorm() + reference.p.squaredNorm()));
+        state_scale =
+            std::max(state_scale, std::sqrt(reference.q.squaredNorm() + reference.p.squaredNorm()));
       }
       if (study.multiplier_applies) {
         multiplier_scale =
-            std::max(multiplier_scale, problem->exact_multipliers(run.final_state.t)
-                                           ->lpNorm<Eigen::Infinity>());
+            std::max(multiplier_scale,
+                     problem->exact_multipliers(run.final_state.t)->lpNorm<Eigen::Infinity>());
       }
       const double q_squared = (run.final_state.q - reference.q).squaredNorm();
       const double p_squared = (run.final_state.p - reference.p).squaredNorm();

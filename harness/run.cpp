@@ -214,8 +214,8 @@ void validate_run_config(const RunConfig& config, bool adaptive) {
                                  config.t_end / config.dt, kMaxFixedSteps));
   }
   if (config.max_steps < 1 || static_cast<double>(config.max_steps) > kMaxFixedSteps) {
-    throw InputError(fmt::format("--max-steps must be in 1..{:g} (got {})", kMaxFixedSteps,
-                                 config.max_steps));
+    throw InputError(
+        fmt::format("--max-steps must be in 1..{:g} (got {})", kMaxFixedSteps, config.max_steps));
   }
   if (config.series_every < 1) {
     throw InputError(fmt::format("--every must be >= 1 (got {})", config.series_every));

@@ -35,7 +35,7 @@ struct RunConfig {
   int timing_repeats = 3;     // separate timed runs without observers (0..kMaxTimingRepeats)
   double diverge_factor = kDefaultDivergeFactor;  // see kDefaultDivergeFactor; 0/inf = off
   long max_steps = kDefaultMaxSteps;  // fixed-step runs: grid steps allowed (1..kMaxFixedSteps)
-  std::string command_line;                       // for the series provenance
+  std::string command_line;           // for the series provenance
   // Problems without an exact solution: error_final/error_max against the reference file
   // <reference_dir>/<problem>.csv when it exists and has a row at t_end (harness/reference.hpp);
   // the row's column `reference` names the file.

@@ -441,11 +441,13 @@ class Cvode final : public SundialsIntegrator {
 // Jacobian is IDA's dense difference quotient.
 class Ida final : public SundialsIntegrator {
  public:
-  Ida(const AdaptiveSettings& settings, int max_order, int index, int max_nonlin_iters)
+  Ida(const AdaptiveSettings& settings, int max_order, int index, int max_nonlin_iters,
+      double nonlin_conv_coef)
       : SundialsIntegrator(settings, "ida"),
         max_order_(max_order),
         index_(index),
-        max_nonlin_iters_(max_nonlin_iters) {}
+        max_nonlin_iters_(max_nonlin_iters),
+        nonlin_conv_coef_(nonlin_conv_coef) {}
 
   MethodInfo info() const override {
     if (index_ == 0) {
@@ -490,7 +492,8 @@ class Ida final : public SundialsIntegrator {
         !check_setup(IDASetUserData(ida, this), "IDASetUserData") ||
         !check_setup(IDASStolerances(ida, settings_.rtol, settings_.atol), "IDASStolerances") ||
         !check_setup(IDASetMaxOrd(ida, max_order_), "IDASetMaxOrd") ||
-        !check_setup(IDASetMaxNonlinIters(ida, max_nonlin_iters_), "IDASetMaxNonlinIters")) {
+        !check_setup(IDASetMaxNonlinIters(ida, max_nonlin_iters_), "IDASetMaxNonlinIters") ||
+        !check_setup(IDASetNonlinConvCoef(ida, nonlin_conv_coef_), "IDASetNonlinConvCoef")) {
       return;
     }
     if (index_ != 0 && !exclude_from_error_test(ida)) return;
@@ -640,6 +643,7 @@ class Ida final : public SundialsIntegrator {
   int max_order_;
   int index_;  // 0: the ODE residual; 2 or 3: the constrained DAE of that index
   int max_nonlin_iters_;
+  double nonlin_conv_coef_;
   int constraint_count_ = 0;
   bool analytic_jacobian_ = false;
   Vec q_, p_, force_, applied_, rate_, g_, g_time_, a_time_;
@@ -865,8 +869,13 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
   // Plain `ida` keeps its canonical spec (and the names of its committed runs).
   params.omit_default_from_canonical("index");
   const long max_nonlin_iters = read_max_nonlin_iters(params, 4);
+  const double nonlin_conv_coef = params.real(
+      "nonlin_conv_coef", 0.33,
+      "Newton convergence test coefficient relative to the local error test (IDA default 0.33)",
+      [](double v) { return v > 0 && v <= 1; }, "in (0, 1]");
+  params.omit_default_from_canonical("nonlin_conv_coef");
   return std::make_unique<Ida>(settings, max_order, index == "ode" ? 0 : std::stoi(index),
-                               static_cast<int>(max_nonlin_iters));
+                               static_cast<int>(max_nonlin_iters), nonlin_conv_coef);
 }
 
 std::unique_ptr<Integrator> make_arkode_erk(Params& params) {

@@ -11,7 +11,6 @@
 
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -73,9 +72,7 @@ class TurnsNan final : public Problem {
   void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
     base_->constraint_hessian(q, lambda, K);
   }
-  std::vector<std::string> multiplier_names() const override {
-    return base_->multiplier_names();
-  }
+  std::vector<std::string> multiplier_names() const override { return base_->multiplier_names(); }
 
  private:
   // NaN below the threshold, and NaN in, NaN out.
@@ -88,16 +85,18 @@ class TurnsNan final : public Problem {
 };
 
 std::unique_ptr<Problem> make_turns_nan(Params& params) {
-  const std::string kind = params.choice("kind", "gradient", {"gradient", "force", "constrained"},
-                                         "what turns NaN");
+  const std::string kind =
+      params.choice("kind", "gradient", {"gradient", "force", "constrained"}, "what turns NaN");
   if (kind == "constrained") {
     return std::make_unique<TurnsNan>(make_problem("cartesian_pendulum"), false);
   }
   return std::make_unique<TurnsNan>(make_problem("harmonic"), kind == "force");
 }
 
-const ProblemRegistrar kRegistrar({"turns_nan", "test problem: NaN after a few steps",
-                                   &make_turns_nan, {"kind=force", "kind=constrained"}});
+const ProblemRegistrar kRegistrar({"turns_nan",
+                                   "test problem: NaN after a few steps",
+                                   &make_turns_nan,
+                                   {"kind=force", "kind=constrained"}});
 
 constexpr double kDt = 0.1;
 constexpr double kTEnd = 4.0;
@@ -163,8 +162,8 @@ TEST_P(EveryMethodFails, TheRowCarriesTheFailureOfStepAndAdvance) {
   std::vector<std::string> not_applicable;
   for (const std::string kind : {"gradient", "force", "constrained"}) {
     const std::string problem_spec = "turns_nan:kind=" + kind;
-    const Applicability applies = applicable(*make_integrator(method_spec),
-                                             *make_problem(problem_spec));
+    const Applicability applies =
+        applicable(*make_integrator(method_spec), *make_problem(problem_spec));
     if (!applies.ok) {
       not_applicable.push_back(kind + ": " + applies.reason);
       continue;
@@ -181,8 +180,6 @@ TEST_P(EveryMethodFails, TheRowCarriesTheFailureOfStepAndAdvance) {
     EXPECT_FALSE(result.ok);
     EXPECT_EQ(result.record.status, expected.reason) << result.record.message.value_or("");
     EXPECT_EQ(result.record.steps, expected.good_steps);
-    std::printf("%s on %s: %s after %ld steps\n", method_spec.c_str(), problem_spec.c_str(),
-                result.record.status.c_str(), result.record.steps);
   }
   if (not_applicable.size() == 3) {
     std::string reasons;
