@@ -230,12 +230,6 @@ const std::map<std::string, std::string> kNoIterationLimit = {
     {"odeint_rosenbrock4", "linearly implicit (Rosenbrock): one linear solve per stage"},
     {"gsl_msbdf", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
     {"gsl_rk4imp", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
-    {"composition",
-     "runs its base method (a name at its defaults), whose limit is tested as that "
-     "method's"},
-    {"penalty",
-     "runs its base method (a name at its defaults), whose limit is tested as that "
-     "method's"},
 };
 
 // Configurations whose step equations one iteration solves exactly, so a limit of one binds
