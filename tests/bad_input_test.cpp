@@ -563,6 +563,16 @@ const std::vector<Case>& cases() {
        "max_steps",
        {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\nmax_steps = 0\n")}},
        {"scene.toml"}},
+      // Iteration limits of the implicit solvers (tests/methods_test.cpp, EveryImplicitMethod).
+      {"CompositionMaxIterOnExplicitBase",
+       "run --problem pendulum --method composition:max_iter=1 --dt 0.1 --t-end 1", 2, "explicit"},
+      {"CvodeMaxNonlinItersZero",
+       "run --problem pendulum --method cvode_bdf:max_nonlin_iters=0 --t-end 1", 2,
+       "max_nonlin_iters"},
+      {"CompositionAtItsIterationLimitIsARow",
+       "run --problem pendulum:theta0=2.5 --method composition:base=implicit_midpoint,max_iter=1 "
+       "--dt 0.2 --t-end 2 --timing-repeats 0",
+       1, "newton_max_iter"},
       // Errors of 10^3-10^4 on an orbit of size 1 once fitted "order 0.999".
       {"OrderFromErrorsAboveTheSolutionIsNoFit",
        "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,
