@@ -43,14 +43,16 @@ double multiplier_error(const Problem& problem, const RunResult& run, OrderStudy
 }  // namespace
 
 OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& errors,
-                   double plateau_floor) {
+                   double plateau_floor, double error_ceiling) {
   OrderFit fit;
   fit.order = std::numeric_limits<double>::quiet_NaN();
   std::vector<int> points;
-  int failed = 0, plateau = 0;
+  int failed = 0, plateau = 0, too_large = 0;
   for (int i = 0; i < static_cast<int>(dts.size()); ++i) {
     if (!std::isfinite(errors[i]) || errors[i] <= 0) {
       ++failed;
+    } else if (errors[i] > error_ceiling) {
+      ++too_large;
     } else if (errors[i] < plateau_floor) {
       ++plateau;
     } else {
@@ -90,6 +92,10 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
   }
   std::vector<std::string> notes;
   if (failed) notes.push_back(fmt::format("{} failed", failed));
+  if (too_large) {
+    notes.push_back(fmt::format("{} with error above {:.3g}, not small against the solution",
+                                too_large, error_ceiling));
+  }
   if (plateau) notes.push_back(fmt::format("{} on round-off plateau", plateau));
   if (preasymptotic) notes.push_back(fmt::format("{} pre-asymptotic", preasymptotic));
   if (points.size() < 3) {
@@ -162,10 +168,24 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     if (row < 0) return {t, Vec::Constant(problem->dof(), nan), Vec::Constant(problem->dof(), nan)};
     return {t, reference_file->q[row], reference_file->p[row]};
   };
+  // The solution's own scale, against which an error must be small to be asymptotic: the
+  // larger of ‖(q, p)‖ at the start and at t_end (a decaying solution keeps its initial scale).
+  const State initial = problem->initial_state();
+  double state_scale = std::sqrt(initial.q.squaredNorm() + initial.p.squaredNorm());
+  double multiplier_scale = 0;
   for (const auto& run : study.runs) {
     double error = nan, error_q = nan, error_p = nan, error_multiplier = nan;
     if (run.ok) {
       const State reference = reference_at(run.final_state.t);
+      if (reference.q.allFinite() && reference.p.allFinite()) {
+        state_scale =
+            std::max(state_scale, std::sqrt(reference.q.squaredNorm() + reference.p.squaredNorm()));
+      }
+      if (study.multiplier_applies) {
+        multiplier_scale =
+            std::max(multiplier_scale,
+                     problem->exact_multipliers(run.final_state.t)->lpNorm<Eigen::Infinity>());
+      }
       const double q_squared = (run.final_state.q - reference.q).squaredNorm();
       const double p_squared = (run.final_state.p - reference.p).squaredNorm();
       error_q = std::sqrt(q_squared);
@@ -182,10 +202,15 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     // The finest level is the reference, so it has no error of its own.
     errors.back() = errors_q.back() = errors_p.back() = nan;
   }
-  study.fit_q = fit_order(dts, errors_q);
-  study.fit_p = fit_order(dts, errors_p);
-  if (study.multiplier_applies) study.fit_multiplier = fit_order(dts, errors_multiplier);
-  study.fit = fit_order(dts, errors);
+  constexpr double kPlateau = 1e-13;
+  const double ceiling = kAsymptoticErrorFraction * state_scale;
+  study.fit_q = fit_order(dts, errors_q, kPlateau, ceiling);
+  study.fit_p = fit_order(dts, errors_p, kPlateau, ceiling);
+  if (study.multiplier_applies) {
+    study.fit_multiplier =
+        fit_order(dts, errors_multiplier, kPlateau, kAsymptoticErrorFraction * multiplier_scale);
+  }
+  study.fit = fit_order(dts, errors, kPlateau, ceiling);
   const auto method = make_integrator(method_spec);
   OrderRecord& record = study.record;
   record.problem = study.runs.front().record.problem;

@@ -171,6 +171,14 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   }
   const StepGrid grid{t0, config.dt, config.t_end,
                       std::max(1L, static_cast<long>(std::ceil(config.t_end / config.dt - 1e-9)))};
+  if (grid.n > config.max_steps) {
+    outcome.status = StepStatus::failure(
+        "max_steps",
+        fmt::format("t_end/dt = {} steps exceed the step budget of a fixed-step run ({} steps); "
+                    "raise it with --max-steps N (scene key max_steps, at most {:g})",
+                    grid.n, config.max_steps, kMaxFixedSteps));
+    return outcome;
+  }
   // The timing pass passes no visitor: explicit methods then run their whole grid in one
   // statically typed loop (Integrator::advance).
   auto check_and_visit = [&](const State& s, long k) {
@@ -204,6 +212,10 @@ void validate_run_config(const RunConfig& config, bool adaptive) {
   if (!adaptive && config.t_end / config.dt > kMaxFixedSteps) {
     throw InputError(fmt::format("--t-end/--dt = {:g} steps is more than the allowed {:g}",
                                  config.t_end / config.dt, kMaxFixedSteps));
+  }
+  if (config.max_steps < 1 || static_cast<double>(config.max_steps) > kMaxFixedSteps) {
+    throw InputError(
+        fmt::format("--max-steps must be in 1..{:g} (got {})", kMaxFixedSteps, config.max_steps));
   }
   if (config.series_every < 1) {
     throw InputError(fmt::format("--every must be >= 1 (got {})", config.series_every));

@@ -20,6 +20,11 @@ constexpr double kDefaultDivergeFactor = 1e8;
 // Caps on counts that would otherwise let one option request unbounded work.
 constexpr int kMaxTimingRepeats = 100;
 constexpr double kMaxFixedSteps = 1e10;  // t_end/dt of one fixed-step run
+// The step budget of a fixed-step run (`--max-steps`, scene key `max_steps`), as the library
+// wrappers have theirs: a run whose grid has more steps ends at once as the failure row
+// `max_steps`, instead of computing for hours without output. 1e8 is ten times the largest
+// committed run (long_run, 1e7 steps); the budget may be raised up to kMaxFixedSteps.
+constexpr long kDefaultMaxSteps = 100'000'000;
 
 struct RunConfig {
   double dt = 0.0;            // fixed step (> 0); adaptive methods ignore it
@@ -29,7 +34,8 @@ struct RunConfig {
   bool series_state = false;  // force q, p columns for problems with > 64 dof
   int timing_repeats = 3;     // separate timed runs without observers (0..kMaxTimingRepeats)
   double diverge_factor = kDefaultDivergeFactor;  // see kDefaultDivergeFactor; 0/inf = off
-  std::string command_line;                       // for the series provenance
+  long max_steps = kDefaultMaxSteps;  // fixed-step runs: grid steps allowed (1..kMaxFixedSteps)
+  std::string command_line;           // for the series provenance
   // Problems without an exact solution: error_final/error_max against the reference file
   // <reference_dir>/<problem>.csv when it exists and has a row at t_end (harness/reference.hpp);
   // the row's column `reference` names the file.
@@ -61,7 +67,8 @@ double time_run(const std::string& problem_spec, const std::string& method_spec,
                 const RunConfig& config, int repeats);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
-// --timing-repeats and --diverge-factor (InputError naming the offending option).
+// --timing-repeats, --diverge-factor and --max-steps (InputError naming the offending option).
+// A grid longer than max_steps is no input error but a failure row (run_one).
 void validate_run_config(const RunConfig& config, bool adaptive);
 
 // Checks the run's output paths before anything is computed (InputError naming the option):

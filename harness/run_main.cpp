@@ -301,6 +301,11 @@ int run_main(int argc, char** argv) {
   run->add_option("--timing-repeats", timing_repeats,
                   fmt::format("timing pass repeats (0 = none, at most {})", kMaxTimingRepeats));
   run->add_option("--diverge-factor", diverge_factor, diverge_help);
+  long max_steps = kDefaultMaxSteps;
+  run->add_option("--max-steps", max_steps,
+                  fmt::format("step budget of a fixed-step run: more grid steps end the run as "
+                              "the failure row max_steps (default {:g}, at most {:g})",
+                              static_cast<double>(kDefaultMaxSteps), kMaxFixedSteps));
   std::vector<std::string> extra_metrics;
   run->add_option("--metric", extra_metrics,
                   "also compute an optional metric (repeatable): symplecticity_defect, "
@@ -459,6 +464,7 @@ int run_main(int argc, char** argv) {
       config.series_state = series_state;
       config.timing_repeats = static_cast<int>(timing_repeats);
       config.diverge_factor = diverge_factor;
+      config.max_steps = max_steps;
       config.extra_metrics = extra_metrics;
       config.command_line = command_line;
       // Outputs are checked before anything is computed.

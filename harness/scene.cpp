@@ -157,6 +157,8 @@ Scene load_scene(const std::string& path, bool quick) {
     block.timing_repeats =
         static_cast<int>(reader.integer("timing_repeats", false, 3, 0, kMaxTimingRepeats));
     block.diverge_factor = reader.number("diverge_factor", false, kDefaultDivergeFactor);
+    block.max_steps =
+        reader.integer("max_steps", false, kDefaultMaxSteps, 1, static_cast<long>(kMaxFixedSteps));
     const auto quick_dts = reader.numbers("quick_dt", false);
     double quick_t_end = 0;
     const bool has_quick_t_end = quick_number(reader, "quick_t_end", where, &quick_t_end);

@@ -20,6 +20,7 @@ struct RunBlock {
   bool series_state = false;
   int timing_repeats = 3;                         // 0 = no timing pass
   double diverge_factor = kDefaultDivergeFactor;  // RunConfig::diverge_factor; 0 or inf = off
+  long max_steps = kDefaultMaxSteps;              // RunConfig::max_steps
 };
 
 struct OrderBlock {

@@ -219,6 +219,7 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
           job.config.t_end = block.t_end;
           job.config.timing_repeats = 0;
           job.config.diverge_factor = block.diverge_factor;
+          job.config.max_steps = block.max_steps;
           job.config.extra_metrics = requested_metrics;
           job.config.command_line = options.command_line;
           if (block.series_every > 0) {

@@ -146,11 +146,12 @@ TEST(Advance, ExplicitLoopsDoNotAllocate) {
       const auto method = make_integrator(method_spec);
       State state = problem->initial_state();
       method->reset(*problem, state, kGrid.dt);
-      method->advance(*problem, state, kGrid, StepVisitor());
+      ASSERT_TRUE(method->advance(*problem, state, kGrid, StepVisitor()).status.ok);
       const StepGrid next{state.t, kGrid.dt, 1.0, 100};
       const long before = allocation_count.load();
-      method->advance(*problem, state, next, StepVisitor());
+      const AdvanceOutcome outcome = method->advance(*problem, state, next, StepVisitor());
       EXPECT_EQ(allocation_count.load() - before, 0);
+      EXPECT_TRUE(outcome.status.ok) << outcome.status.message;
     }
   }
 }

@@ -52,7 +52,9 @@ class ExplicitStepper : public Integrator {
   }
   AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
                          StepVisitor visit) final {
-    return run_grid(state, grid, visit, [&](double h) { derived().advance_by(problem, state, h); });
+    // The body's own return type reaches run_grid, so a body that can fail ends the run there.
+    return run_grid(state, grid, visit,
+                    [&](double h) { return derived().advance_by(problem, state, h); });
   }
 
  private:

@@ -41,8 +41,11 @@ struct MethodInfo {
   std::string reference;  // where the scheme is defined
 };
 
-// Result of one step; a failed step leaves the state unspecified and ends the run.
-struct StepStatus {
+// Result of one step; a failed step leaves the state unspecified and ends the run. [[nodiscard]]:
+// a caller that drops a status turns a failed run into an `ok` row (a step loop that ignored its
+// body's status once reported position Verlet's unconverged force kick as success), so dropping
+// one is a compiler warning; a caller that really means it says so with a cast to void.
+struct [[nodiscard]] StepStatus {
   bool ok = true;
   std::string reason;   // short CSV code: "nan", "newton_max_iter", "cvode_flag_-4", ...
   std::string message;  // human-readable detail
@@ -106,7 +109,7 @@ class StepVisitor {
 
 // What Integrator::advance did: `steps` steps passed the integrator and the visitor; `status` is
 // the integrator's failure in step steps + 1 (ok when every step ran or the visitor stopped).
-struct AdvanceOutcome {
+struct [[nodiscard]] AdvanceOutcome {
   StepStatus status;
   long steps = 0;
 };

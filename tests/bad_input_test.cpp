@@ -827,6 +827,78 @@ const std::vector<Case>& cases() {
        "run takes: --problem, --method"},
       {"CliExtraArgumentPointsToTheVerbsHelp", "sweep {dir}/a.toml {dir}/b.toml", 2,
        "see geomint sweep --help"},
+      // --- issue 23 (failure rows, budgets, order fit) ---
+      // The force kick's fixed point diverges (h·c/m = 8): the advance() path, which the run
+      // takes, once dropped the status and reported `ok` after 100 force evaluations per step.
+      {"PositionVerletForceKickFailureIsARow",
+       "run --problem damped_oscillator:zeta=4 --method position_verlet --dt 0.5 --t-end 5 "
+       "--timing-repeats 0",
+       1, "force_kick_max_iter"},
+      {"StormerVerletForceKickFailureIsARow",
+       "run --problem damped_oscillator:zeta=4 --method stormer_verlet --dt 0.5 --t-end 5 "
+       "--timing-repeats 0",
+       1, "force_kick_max_iter"},
+      // 10^10 Verlet steps (an hour, then three timing repeats) end at once as a budget row
+      // that says how to raise the budget.
+      {"FixedStepHugeHorizonEnds",
+       "run --problem pendulum --method stormer_verlet --dt 0.1 --t-end 1e9",
+       1,
+       "--max-steps",
+       {},
+       {},
+       10},
+      {"FixedStepHugeHorizonIsAMaxStepsRow",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1e9",
+       1,
+       ",max_steps,",
+       {},
+       {},
+       10},
+      {"FixedStepBudgetFromTheCommandLine",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --max-steps 9", 1, "max_steps"},
+      {"FixedStepBudgetJustEnough",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --max-steps 10 "
+       "--timing-repeats 0",
+       0, ",ok,"},
+      {"MaxStepsZero", "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --max-steps 0", 2,
+       "--max-steps"},
+      {"MaxStepsAboveCap",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --max-steps 100000000000", 2,
+       "--max-steps"},
+      {"SceneHugeHorizonEnds",
+       "sweep {dir}/scene.toml",
+       0,
+       "1 failed run",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1e9\ntiming_repeats = 0\n")}},
+       {"scene.toml", "summary.csv", "table.md"},
+       10},
+      {"SceneMaxStepsEnds",
+       "sweep {dir}/scene.toml",
+       0,
+       "1 failed run",
+       {{"scene.toml",
+         scene(kRunBlock + "dt = 0.1\nt_end = 1.0\nmax_steps = 5\ntiming_repeats = 0\n")}},
+       {"scene.toml", "summary.csv", "table.md"}},
+      {"SceneMaxStepsZero",
+       "sweep {dir}/scene.toml",
+       2,
+       "max_steps",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\nmax_steps = 0\n")}},
+       {"scene.toml"}},
+      // Iteration limits of the implicit solvers (tests/methods_test.cpp, EveryImplicitMethod).
+      {"CompositionMaxIterOnExplicitBase",
+       "run --problem pendulum --method composition:max_iter=1 --dt 0.1 --t-end 1", 2, "explicit"},
+      {"CvodeMaxNonlinItersZero",
+       "run --problem pendulum --method cvode_bdf:max_nonlin_iters=0 --t-end 1", 2,
+       "max_nonlin_iters"},
+      {"CompositionAtItsIterationLimitIsARow",
+       "run --problem pendulum:theta0=2.5 --method composition:base=implicit_midpoint,max_iter=1 "
+       "--dt 0.2 --t-end 2 --timing-repeats 0",
+       1, "newton_max_iter"},
+      // Errors of 10^3-10^4 on an orbit of size 1 once fitted "order 0.999".
+      {"OrderFromErrorsAboveTheSolutionIsNoFit",
+       "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,
+       "not small against the solution"},
   };
   return all;
 }

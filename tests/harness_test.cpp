@@ -83,6 +83,25 @@ TEST(OrderFit, NeedsThreePoints) {
   EXPECT_NE(fit.note.find("need 3"), std::string::npos);
 }
 
+// Errors that have saturated at the size of the solution follow a clean power law of their own
+// (Kepler at e = 0.999: 1.1e4, 5.6e3, 2.8e3, 1.4e3 gave "order 0.999"): above the ceiling they are
+// not asymptotic, and with fewer than three points left there is no fit.
+TEST(OrderFit, ErrorsAboveTheSolutionScaleAreNotAsymptotic) {
+  const std::vector<double> dts = {0.01, 0.005, 0.0025, 0.00125};
+  const std::vector<double> errors = {11179.0, 5589.3, 2795.1, 1399.3};
+  EXPECT_NEAR(fit_order(dts, errors).order, 1.0, 0.01);
+  const OrderFit fit = fit_order(dts, errors, 1e-13, 4.47);
+  EXPECT_TRUE(std::isnan(fit.order));
+  EXPECT_NE(fit.note.find("4 with error above 4.47"), std::string::npos) << fit.note;
+  // Below the ceiling the points stay: the first two are dropped, the rest fit.
+  const std::vector<double> mixed = {5.0, 2.0, 1e-2, 2.5e-3, 6.25e-4, 1.5625e-4};
+  const std::vector<double> ladder = {0.8, 0.4, 0.2, 0.1, 0.05, 0.025};
+  const OrderFit kept = fit_order(ladder, mixed, 1e-13, 1.0);
+  ASSERT_TRUE(std::isfinite(kept.order)) << kept.note;
+  EXPECT_NEAR(kept.order, 2.0, 1e-9);
+  EXPECT_EQ(kept.used.front(), 2);
+}
+
 TEST(Drift, LeastSquaresSlope) {
   EXPECT_NEAR(least_squares_slope({1, 2, 3, 4}, {2, 4, 6, 8}), 2.0, 1e-14);
   EXPECT_NEAR(least_squares_slope({1, 2, 3, 4}, {5, 5, 5, 5}), 0.0, 1e-14);

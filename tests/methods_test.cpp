@@ -4,7 +4,10 @@
 // Negative controls make sure the checks can fail.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
+#include <map>
+#include <string>
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
@@ -214,6 +217,83 @@ TEST_P(EveryMethod, ScalingMassesAndPotentialTogetherKeepsTheMotion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, EveryMethod, testing::ValuesIn(fixed_step_methods()), test_name);
+
+// Every implicit method, its solver stopped at its iteration limit: the step must end the run as
+// a failure row that names the non-convergence, never be accepted unconverged (an implicit RK
+// step that took its last unconverged iterate passed every order and flag check above, whose
+// solves converge). Each family's own limit, the first of these options the method accepts.
+// SUNDIALS retries a failed solve with a smaller step, which one iteration then solves: its
+// convergence test is made unreachable as well, so every retry fails.
+const char* const kIterationLimits[] = {"max_iter=1", "max_nonlin_iters=1,nonlin_conv_coef=1e-300"};
+// Implicit methods with no iteration to limit, and why.
+const std::map<std::string, std::string> kNoIterationLimit = {
+    {"odeint_rosenbrock4", "linearly implicit (Rosenbrock): one linear solve per stage"},
+    {"gsl_msbdf", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
+    {"gsl_rk4imp", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
+};
+
+// Configurations whose step equations one iteration solves exactly, so a limit of one binds
+// nothing.
+const std::map<std::string, std::string> kSolvedInOneIteration = {
+    {"lobatto3ab:s=2", "Stormer-Verlet: its stage equations are linear in the unknowns"},
+};
+
+std::vector<std::string> implicit_methods() {
+  std::vector<std::string> out;
+  for (const auto& spec : integrator_test_specs()) {
+    if (make_integrator(spec)->info().flags & kImplicit) out.push_back(spec);
+  }
+  return out;
+}
+
+class EveryImplicitMethod : public testing::TestWithParam<std::string> {};
+
+TEST_P(EveryImplicitMethod, SolverAtItsIterationLimitIsAFailureRow) {
+  const std::string& spec = GetParam();
+  const std::string name = make_integrator(spec)->info().name;
+  if (const auto exact = kSolvedInOneIteration.find(spec); exact != kSolvedInOneIteration.end()) {
+    GTEST_SKIP() << exact->second;
+  }
+  std::string limited;
+  for (const char* limit : kIterationLimits) {
+    const std::string candidate = spec + (spec.find(':') == std::string::npos ? ":" : ",") + limit;
+    try {
+      make_integrator(candidate);
+    } catch (const InputError&) {
+      continue;
+    }
+    limited = candidate;
+    break;
+  }
+  if (limited.empty()) {
+    const auto why = kNoIterationLimit.find(name);
+    ASSERT_NE(why, kNoIterationLimit.end())
+        << spec << " is implicit but takes none of the iteration limits this test knows";
+    GTEST_SKIP() << why->second;
+  }
+  // A nonlinear problem and a step no single iteration solves to tolerance.
+  std::string problem = "pendulum:theta0=2.5";
+  if (!applicable(*make_integrator(limited), *make_problem(problem)).ok) {
+    problem = "cartesian_pendulum:theta0=2.5";
+  }
+  const Applicability applies = applicable(*make_integrator(limited), *make_problem(problem));
+  ASSERT_TRUE(applies.ok) << applies.reason;
+  RunConfig config;
+  config.dt = 0.2;
+  config.t_end = 2.0;
+  config.timing_repeats = 0;
+  const RunResult result = run_one(problem, limited, config);
+  EXPECT_FALSE(result.ok) << limited << " on " << problem << " was accepted";
+  std::string text = result.record.status + " " + result.record.message.value_or("");
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  EXPECT_TRUE(text.find("max_iter") != std::string::npos ||
+              text.find("converge") != std::string::npos ||
+              text.find("conv_fail") != std::string::npos)
+      << limited << ": the row does not name non-convergence: " << text;
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, EveryImplicitMethod, testing::ValuesIn(implicit_methods()),
+                         test_name);
 
 }  // namespace
 }  // namespace geomint
