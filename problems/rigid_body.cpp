@@ -42,7 +42,7 @@ class RigidBody final : public Problem {
     for (int k = 0; k < 3; ++k)
       mass.segment<3>(3 * k).setConstant(half_trace - parameters.moments[k]);
     set_mass(mass);
-    set_capabilities(kHessian | kAngularMomentum | kConstraints);
+    set_capabilities(kHessian | kAngularMomentum | kConstraints | kCasimir);
     // About 600 steps per radian of rotation at the initial rate, 100 radians.
     const double rate = parameters.omega.norm();
     const double unit = rate > 0 ? 1 / rate : 1.0;
@@ -73,6 +73,12 @@ class RigidBody final : public Problem {
     Eigen::Vector3d total = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) total += column(q, k).cross(column(p, k));
     return total;
+  }
+
+  // |Π|² = |QJΩ|² on the manifold: kept by the motion and by any method that keeps the spatial
+  // angular momentum and QᵀQ = I.
+  double casimir(const Vec& q, const Vec& p) const override {
+    return rigid_body_body_momentum(q, p).squaredNorm();
   }
 
   int constraint_count() const override { return 6; }

@@ -35,6 +35,8 @@ TEST(RigidBody, TriangleInequalityIsAnInputErrorNamingIt) {
   // Equality is a flat body with a zero mass d_k: refused as well.
   EXPECT_NE(message_of("rigid_body:I1=3,I2=1,I3=2").find("I1 = 3 must be < I2 + I3"),
             std::string::npos);
+  EXPECT_NE(message_of("rigid_body_euler:I1=1,I2=5,I3=3").find("I2 = 5 must be < I3 + I1 = 4"),
+            std::string::npos);
 }
 
 TEST(RigidBody, ZeroAttitudeAxisIsAnInputError) {
@@ -159,6 +161,40 @@ TEST(FreeBodyMotion, SeparatrixAndSymmetricBodiesHaveNoEllipticSolution) {
   const FreeBodyMotion steady({1, 2, 3}, {0, 0, 2});
   ASSERT_TRUE(steady.exact());
   EXPECT_EQ(steady.at(7.3), Eigen::Vector3d(0, 0, 2));
+}
+
+// rigid_body_euler is Euler's equations for the same body: y = Π = JΩ, the exact solution and the
+// period are FreeBodyMotion's, the Casimir is |Π|², and the period observable (Π of the axis the
+// orbit does not circulate about) crosses 0 upwards once per period, for orbits about either
+// extreme axis.
+TEST(RigidBodyEuler, IsEulersEquationsWithTheEllipticSolution) {
+  for (const std::string& parameters :
+       {std::string("I1=3,I2=1.5,I3=2.2,omega1=0.2,omega2=1.1,omega3=0.4"),
+        std::string("omega1=1.5,omega2=0.2,omega3=0.1")}) {
+    SCOPED_TRACE(parameters);
+    const auto euler = make_problem("rigid_body_euler:" + parameters);
+    const auto body = make_problem("rigid_body:" + parameters);
+    const State start = body->initial_state();
+    const Eigen::Vector3d pi0 = rigid_body_body_momentum(start.q, start.p);
+    EXPECT_LE((euler->initial_state().q - pi0).norm(), 1e-15 * pi0.norm());
+    ASSERT_TRUE(euler->has(kExact) && euler->has(kPeriod) && euler->has(kCasimir));
+    EXPECT_DOUBLE_EQ(body->casimir(start.q, start.p), pi0.squaredNorm());
+    const double T = euler->period();
+    Vec rate;
+    euler->rhs(0, euler->initial_state().q, rate);
+    // J from the masses: I_k = (d1 + d2 + d3) − d_k.
+    const Eigen::Vector3d d(body->mass()[0], body->mass()[3], body->mass()[6]);
+    const Eigen::Vector3d J = Eigen::Vector3d::Constant(d.sum()) - d;
+    EXPECT_LE((Eigen::Vector3d(rate) - pi0.cross(pi0.cwiseQuotient(J))).norm(), 1e-15);
+    int upward = 0;
+    double previous = euler->period_observable(euler->exact(0).q, Vec());
+    for (int i = 1; i <= 4000; ++i) {
+      const double now = euler->period_observable(euler->exact(3 * T * i / 4000.0).q, Vec());
+      upward += previous < 0 && now >= 0;
+      previous = now;
+    }
+    EXPECT_EQ(upward, 3);
+  }
 }
 
 }  // namespace
