@@ -82,6 +82,26 @@ class MomentumObserver : public Observer {
   double err_max_ = 0;
 };
 
+// casimir_err_max = max_k |C(q_k, p_k) − C₀| / |C₀| (absolute when C₀ = 0) on problems with a
+// Casimir (|Π|² of a rigid body): relative, since |Π|² carries the square of the momentum's units.
+// Kept to round-off by a Lie–Poisson integrator, drifting under a general-purpose ODE solver.
+class CasimirObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State& state, double) override {
+    initial_ = problem.casimir(state.q, state.p);
+  }
+  void observe(const Problem& problem, const State& state) override {
+    const double scale = initial_ != 0 ? std::abs(initial_) : 1.0;
+    err_max_ = std::max(err_max_, std::abs(problem.casimir(state.q, state.p) - initial_) / scale);
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    metrics["casimir_err_max"] = err_max_;
+  }
+
+ private:
+  double initial_ = 0, err_max_ = 0;
+};
+
 // constraint_err_max = max_k ‖g(q_k)‖∞ and constraint_vel_err_max = max_k ‖G(q_k) M⁻¹p_k‖∞ on
 // problems with holonomic constraints (docs/METHOD.md §3). Absolute, in the units of g (a length
 // for the rod problems: the rod-length error) and of dg/dt: g = 0 is the reference, so there is
@@ -345,6 +365,7 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
     observers.push_back(
         std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
   }
+  if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
   if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());

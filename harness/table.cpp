@@ -107,6 +107,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "energy_growth_exponent",
                                                    "momentum_err_max",
                                                    "angular_momentum_err_max",
+                                                   "casimir_err_max",
                                                    "constraint_err_max",
                                                    "constraint_vel_err_max",
                                                    "symplecticity_defect",

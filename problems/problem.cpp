@@ -109,6 +109,7 @@ std::vector<std::string> capability_names(unsigned capabilities) {
       {kTimeDependentConstraints, "time_dependent_constraints"},
       {kFirstOrderOnly, "first_order_only"},
       {kEndReference, "end_reference"},
+      {kCasimir, "casimir"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -124,6 +125,7 @@ namespace {
 }  // namespace
 
 void Problem::hessian(const Vec&, SparseMatrix&) const { missing(*this, "hessian"); }
+double Problem::casimir(const Vec&, const Vec&) const { missing(*this, "casimir"); }
 void Problem::force(const Vec&, const Vec&, double, Vec&) const { missing(*this, "force"); }
 void Problem::force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix&) const {
   missing(*this, "force Jacobian");

@@ -43,6 +43,9 @@ enum Capability : unsigned {
   // (energy() is NaN). Only methods with the flag kFirstOrderCapable run it (applicable()).
   kFirstOrderOnly = 1u << 10,
   kEndReference = 1u << 11,  // end_reference(): a tabulated state at one time (IVP Test Set)
+  // casimir(q, p): a Casimir of the problem's Poisson structure that the motion keeps whatever
+  // the Hamiltonian (|Π|² of a free rigid body), for the casimir_err_max metric.
+  kCasimir = 1u << 12,
 };
 
 // Capability names for `geomint list` and error messages.
@@ -90,6 +93,8 @@ class Problem {
   // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when
   // has(kAngularMomentum).
   virtual Vec angular_momentum(const Vec& q, const Vec& p) const;
+  // The Casimir (|Π|² of the rigid bodies, problems/rigid_body.hpp). Only when has(kCasimir).
+  virtual double casimir(const Vec& q, const Vec& p) const;
   // Period of the exact motion. Only when has(kPeriod).
   virtual double period() const;
   // The scalar whose upward zero crossings the period_measured metric times

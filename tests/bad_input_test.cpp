@@ -81,6 +81,9 @@ const std::vector<Case>& cases() {
        2, "theta0"},
       {"OutOfRangeParameter", "run --problem kepler:e=1.5 --method rk4 --dt 0.1 --t-end 1", 2,
        "e=1.5"},
+      {"RigidBodyTriangleInequality",
+       "run --problem rigid_body:I1=1,I2=1.2,I3=2.5 --method rattle --dt 0.1 --t-end 1", 2,
+       "I3 = 2.5 must be < I1 + I2 = 2.2 (triangle inequality"},
       // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
