@@ -483,6 +483,13 @@ const std::map<std::string, std::vector<std::string>>& exact_branches() {
       {"stiff_spring", {"ratio=1,stretch=0.3"}},
       {"cartesian_pendulum", {"theta0=3.0,length=1.5", "theta0=0.2,v0=-2.5,length=0.8,gravity=2"}},
       {"spherical_pendulum", {"theta0=1.3,length=0.6,gravity=9.81"}},
+      // I = (1, 2, 2.5): 2E·I2 − |Π|² = ω1² − 1.25ω3², so ω3 = 0.1/√1.25 ≈ 0.08944 is the
+      // separatrix at ω1 = 0.1.
+      {"rigid_body_euler",
+       {"I1=1,I2=2,I3=2.5,omega1=0.1,omega2=1,omega3=0.089",     // just inside: about axis 1
+        "I1=1,I2=2,I3=2.5,omega1=0.1,omega2=1,omega3=0.0899",    // just outside: about axis 3
+        "I1=1,I2=2,I3=2.5,omega1=1,omega2=0.2,omega3=-0.1",      // far from it, about axis 1
+        "I1=2.5,I2=2,I3=1,omega1=0.1,omega2=-0.5,omega3=0.9"}},  // moments in falling order
   };
   return branches;
 }
