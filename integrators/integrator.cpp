@@ -279,4 +279,21 @@ void Integrator::eval_total_force(const Problem& problem, const Vec& q, const Ve
   }
 }
 
+std::string with_base_max_iter(Params& params, const std::string& base_spec,
+                               const std::string& method) {
+  const long max_iter = params.integer(
+      "max_iter", 0, "Newton iterations per solve of an implicit base (0: the base's own limit)", 0,
+      10000);
+  params.omit_default_from_canonical("max_iter");
+  if (max_iter == 0) return base_spec;
+  if (!(make_integrator(base_spec)->info().flags & kImplicit)) {
+    throw InputError(
+        fmt::format("{}: max_iter limits an implicit base's solves; base '{}' is "
+                    "explicit",
+                    method, base_spec));
+  }
+  return base_spec + (base_spec.find(':') == std::string::npos ? ":" : ",") +
+         fmt::format("max_iter={}", max_iter);
+}
+
 }  // namespace geomint

@@ -253,6 +253,13 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
 // Registry (integrators/registry.def). Throws InputError for unknown names/keys/values.
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
 
+// `max_iter` of an implicit base method (its Newton iterations per solve), read from the wrapping
+// method's `params` and appended to `base_spec` (a name at its defaults); 0 leaves the base's own
+// limit and keeps the canonical spec as it was. An explicit base has no iteration to limit: an
+// InputError naming `method`. Shared by the wrappers that run a base method (composition, penalty).
+std::string with_base_max_iter(Params& params, const std::string& base_spec,
+                               const std::string& method);
+
 struct IntegratorEntry {
   std::string name;
   std::string summary;
