@@ -41,11 +41,14 @@ namespace fs = std::filesystem;
 // (harness/table.cpp), at its longest: a name is only writable when that one fits too.
 constexpr std::size_t kTemporarySuffix = 24;
 
-// The start of a path for a message: a 100 kB path is not printed whole.
+// A path for a message: a 100 kB path is not printed whole, but its start and its end (the
+// file name the message is about) are, so a deep working folder (a CI runner's TMPDIR) does not
+// cut the name off.
 std::string shown_path(const std::string& path) {
-  constexpr std::size_t kShown = 100;
-  if (path.size() <= kShown) return path;
-  return fmt::format("{}... ({} bytes)", path.substr(0, kShown), path.size());
+  constexpr std::size_t kHead = 120, kTail = 120;
+  if (path.size() <= kHead + kTail) return path;
+  return fmt::format("{}...{} ({} bytes)", path.substr(0, kHead), path.substr(path.size() - kTail),
+                     path.size());
 }
 
 // Creates and removes a file in `folder`: the one test that answers "can a file be written

@@ -322,5 +322,29 @@ TEST(Shell, QuotedWordsSplitBackAndBashAgrees) {
   EXPECT_EQ(output, expected);
 }
 
+// A message about an output keeps the file's name however deep its folder: CI runners put
+// TMPDIR 100+ bytes deep, where a message cut after its first 100 bytes lost the name (a CI
+// failure of the bad-input case SweepShardIsADirectory). A 100 kB path is still not printed whole.
+TEST(Paths, MessageNamesTheFileUnderADeepFolder) {
+  const fs::path deep = fs::temp_directory_path() / ("geomint_deep_" + std::to_string(::getpid())) /
+                        std::string(150, 'd') / "shards";
+  fs::create_directories(deep / "summary.0-of-1.csv");
+  try {
+    check_output_file((deep / "summary.0-of-1.csv").string(), "output");
+    ADD_FAILURE() << "a folder was accepted as an output file";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("shards/summary.0-of-1.csv"), std::string::npos) << message;
+    EXPECT_NE(message.find("is a directory"), std::string::npos) << message;
+  }
+  try {
+    check_output_file(std::string(100000, 'x') + "/summary.csv", "output");
+    ADD_FAILURE() << "a 100 kB path was accepted";
+  } catch (const InputError& error) {
+    EXPECT_LT(std::string(error.what()).size(), 1000u);
+  }
+  fs::remove_all(deep.parent_path().parent_path());
+}
+
 }  // namespace
 }  // namespace geomint
