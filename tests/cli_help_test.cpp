@@ -71,7 +71,8 @@ TEST(CliHelp, EveryHelpTextEqualsItsGoldenFile) {
   const std::string top = read_text(golden / "geomint.txt");
   const std::string listed = top.substr(top.find("Subcommands:"));
   int verbs = 0;
-  for (std::istringstream lines(listed); std::string line; std::getline(lines, line)) {
+  std::istringstream lines(listed);
+  for (std::string line; std::getline(lines, line);) {
     if (line.rfind("  ", 0) != 0) continue;
     const std::string verb = line.substr(2, line.find(' ', 2) - 2);
     EXPECT_TRUE(fs::exists(golden / (verb + ".txt"))) << "no golden help for verb " << verb;
