@@ -108,7 +108,8 @@ class SeriesWriter {
   std::vector<double> extras_;
 };
 
-struct LoopOutcome {
+// [[nodiscard]] as StepStatus: the metric pass and the timing pass both read the status.
+struct [[nodiscard]] LoopOutcome {
   StepStatus status;
   long steps = 0;
   double t_reached = 0;  // time of the last step point that passed the checks
@@ -235,8 +236,12 @@ void check_run_outputs(const RunConfig& config) {
   if (!config.series_path.empty()) check_output_file(config.series_path, "--series");
 }
 
-double time_run(const std::string& problem_spec, const std::string& method_spec,
-                const RunConfig& config, int repeats) {
+std::string TimingOutcome::failure_message() const {
+  return fmt::format("timing pass failed: {}: {}", status.reason, status.message);
+}
+
+TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
+                       const RunConfig& config, int repeats) {
   const auto problem = make_problem(problem_spec);
   std::vector<double> seconds;
   for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
@@ -245,12 +250,14 @@ double time_run(const std::string& problem_spec, const std::string& method_spec,
     State state = problem->initial_state();
     const auto start = std::chrono::steady_clock::now();
     integrator->reset(*problem, state, config.dt);
-    integrate(*problem, *integrator, state, config, adaptive, false, [](const State&, bool) {});
+    LoopOutcome outcome =
+        integrate(*problem, *integrator, state, config, adaptive, false, [](const State&, bool) {});
+    if (!outcome.status.ok) return {std::move(outcome.status), 0};
     seconds.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   std::nth_element(seconds.begin(), seconds.begin() + seconds.size() / 2, seconds.end());
-  return seconds[seconds.size() / 2];
+  return {StepStatus::success(), seconds[seconds.size() / 2]};
 }
 
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
@@ -322,7 +329,12 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
-    record.wall_s = time_run(problem_spec, method_spec, config, config.timing_repeats);
+    const TimingOutcome timing = time_run(problem_spec, method_spec, config, config.timing_repeats);
+    if (timing.status.ok) {
+      record.wall_s = timing.seconds;
+    } else {
+      record.message = timing.failure_message();
+    }
   }
   return result;
 }

@@ -62,9 +62,16 @@ struct RunResult {
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
                   const RunConfig& config);
 
-// Timing pass alone: median wall time of `repeats` runs without observers or per-step checks.
-double time_run(const std::string& problem_spec, const std::string& method_spec,
-                const RunConfig& config, int repeats);
+// Timing pass alone: median wall time of `repeats` runs without observers or per-step checks,
+// or the status of the first pass that failed (a method whose runs differ; it gets no time).
+struct [[nodiscard]] TimingOutcome {
+  StepStatus status;
+  double seconds = 0;
+  // "timing pass failed: reason: message", the row's message when the status failed.
+  std::string failure_message() const;
+};
+TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
+                       const RunConfig& config, int repeats);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
 // --timing-repeats, --diverge-factor and --max-steps (InputError naming the offending option).

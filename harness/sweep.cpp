@@ -472,7 +472,13 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (!timing || job.timing_repeats == 0) continue;
     if (job.ok) {
       try {
-        job.record.wall_s = time_run(job.problem, job.method, job.config, job.timing_repeats);
+        const TimingOutcome timed =
+            time_run(job.problem, job.method, job.config, job.timing_repeats);
+        if (timed.status.ok) {
+          job.record.wall_s = timed.seconds;
+        } else {
+          job.record.message = timed.failure_message();
+        }
       } catch (const std::exception& error) {
         job.record.message = fmt::format("timing pass failed: {}", error.what());
       }
@@ -587,7 +593,13 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     if (status != row.end() && status->second == "ok") {
       RunRecord timing;
       try {
-        timing.wall_s = time_run(job.problem, job.method, job.config, job.timing_repeats);
+        const TimingOutcome timed =
+            time_run(job.problem, job.method, job.config, job.timing_repeats);
+        if (timed.status.ok) {
+          timing.wall_s = timed.seconds;
+        } else {
+          timing.message = timed.failure_message();
+        }
       } catch (const std::exception& error) {
         timing.message = fmt::format("timing pass failed: {}", error.what());
       }

@@ -11,8 +11,10 @@
 #include <array>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -301,6 +303,75 @@ TEST(Cli, GateExitsZeroOnPassOneOnFailTwoOnBadInput) {
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("min"), std::string::npos) << bad.output;
   EXPECT_EQ(geomint("gate " + failing.string() + " /nonexistent.csv").exit_code, 2);
+}
+
+// `geomint gate --format junit|json` (docs/CLI.md "gate"): the same verdicts and exit codes as the
+// text format. Two scenes, a passing gate in one and a failing gate (with '<' and '"' in its name,
+// which the writers must escape) in the other: the JUnit XML parses (xmllint --noout, Debian's
+// libxml2-utils), has one <testsuite> per scene and one <testcase> per gate, and a <failure>
+// exactly for the failing gate; the JSON is one object per gate.
+TEST(Cli, GateFormatsJunitAndJsonCarryTheVerdictsAndTheExitCode) {
+  const std::string root = GEOMINT_SOURCE_DIR;
+  const std::string results =
+      root + "/results/fig1_pendulum/summary.csv " + root + "/results/momentum/summary.csv";
+  const fs::path gates = scratch("format_gates.toml");
+  std::ofstream(gates) << "[[gate]]\nname = \"fig1 runs\"\nscene = \"fig1_pendulum\"\n"
+                          "column = \"status\"\nequals = \"ok\"\n"
+                          "[[gate]]\nname = \"too <strict> \\\"x\\\"\"\nscene = \"momentum\"\n"
+                          "column = \"steps\"\nmax = 0\n";
+  const Outcome text = geomint("gate " + gates.string() + " " + results);
+  EXPECT_EQ(text.exit_code, 1) << text.output;
+  EXPECT_NE(text.output.find("1 of 2 gate(s) passed"), std::string::npos) << text.output;
+
+  const fs::path xml = scratch("gates.xml");
+  const Outcome junit =
+      geomint("gate --format junit " + gates.string() + " " + results + " > " + xml.string());
+  EXPECT_EQ(junit.exit_code, 1) << junit.output;
+  std::ifstream in(xml);
+  const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto count = [&](const std::string& what) {
+    int n = 0;
+    for (auto at = report.find(what); at != std::string::npos; at = report.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("<testsuite "), 2) << report;
+  EXPECT_EQ(count("<testcase "), 2) << report;
+  EXPECT_EQ(count("<failure "), 1) << report;
+  EXPECT_NE(report.find("<testsuite name=\"momentum\" tests=\"1\" failures=\"1\">"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("name=\"too &lt;strict&gt; &quot;x&quot;\""), std::string::npos) << report;
+  if (std::system("command -v xmllint > /dev/null 2>&1") == 0) {
+    const Outcome lint = geomint_shell("xmllint --noout " + xml.string());
+    EXPECT_EQ(lint.exit_code, 0) << lint.output << report;
+  } else {
+    ADD_FAILURE() << "xmllint not found: install libxml2-utils (scripts/install-deps.sh)";
+  }
+
+  const Outcome json = geomint("gate --format json " + gates.string() + " " + results);
+  EXPECT_EQ(json.exit_code, 1) << json.output;
+  EXPECT_EQ(json.output.rfind("[\n  {\"scene\": \"fig1_pendulum\", \"gate\": \"fig1 runs\", "
+                              "\"passed\": true, \"message\": \"",
+                              0),
+            0u)
+      << json.output;
+  EXPECT_NE(json.output.find("{\"scene\": \"momentum\", \"gate\": \"too <strict> \\\"x\\\"\", "
+                             "\"passed\": false"),
+            std::string::npos)
+      << json.output;
+  EXPECT_EQ(json.output.substr(json.output.size() - 4), "}\n]\n") << json.output;
+
+  const fs::path passing = scratch("format_passing.toml");
+  std::ofstream(passing) << "[[gate]]\nname = \"fig1 runs\"\ncolumn = \"status\"\nequals = "
+                            "\"ok\"\n";
+  for (const std::string format : {"text", "junit", "json"}) {
+    EXPECT_EQ(geomint("gate --format " + format + " " + passing.string() + " " + root +
+                      "/results/fig1_pendulum/summary.csv")
+                  .exit_code,
+              0)
+        << format;
+  }
+  fs::remove(xml);
 }
 
 TEST(Readme, MethodAndProblemTablesMatchTheRegistry) {

@@ -98,6 +98,19 @@ const ProblemRegistrar kRegistrar({"turns_nan",
                                    &make_turns_nan,
                                    {"kind=force", "kind=constrained"}});
 
+// The harmonic oscillator, poisoned as turns_nan:kind=gradient in every instance but the first
+// made since the counter was reset: run_one's metric pass succeeds and its timing pass (a second
+// instance, harness/run.cpp time_run) fails.
+int fails_when_timed_instances = 0;
+std::unique_ptr<Problem> make_fails_when_timed(Params&) {
+  if (fails_when_timed_instances++ == 0) return make_problem("harmonic");
+  return std::make_unique<TurnsNan>(make_problem("harmonic"), false);
+}
+const ProblemRegistrar kTimedRegistrar({"fails_when_timed",
+                                        "test problem: NaN in every instance after the first",
+                                        &make_fails_when_timed,
+                                        {}});
+
 constexpr double kDt = 0.1;
 constexpr double kTEnd = 4.0;
 
@@ -186,6 +199,25 @@ TEST_P(EveryMethodFails, TheRowCarriesTheFailureOfStepAndAdvance) {
     for (const auto& reason : not_applicable) reasons += "\n  " + reason;
     GTEST_SKIP() << "no test problem applies:" << reasons;
   }
+}
+
+// A timing pass's failed status is not dropped: the row keeps the metric pass's `ok`, gets no
+// wall_s, and its message says why.
+TEST(TimingPass, AFailedTimingPassLeavesNoWallTimeAndSaysWhy) {
+  make_problem("fails_when_timed");  // the spec check's instance: the counter starts after it
+  fails_when_timed_instances = 0;
+  RunConfig config;
+  config.dt = kDt;
+  config.t_end = kTEnd;
+  config.timing_repeats = 1;
+  config.diverge_factor = 0;
+  const RunResult result = run_one("fails_when_timed", "implicit_euler", config);
+  ASSERT_GE(fails_when_timed_instances, 2) << "the timing pass made no second instance";
+  EXPECT_TRUE(result.ok);
+  EXPECT_EQ(result.record.status, "ok");
+  EXPECT_FALSE(result.record.wall_s.has_value());
+  EXPECT_EQ(result.record.message.value_or("").rfind("timing pass failed: ", 0), 0u)
+      << result.record.message.value_or("");
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, EveryMethodFails, testing::ValuesIn(integrator_test_specs()),

@@ -1,0 +1,184 @@
+// `geomint gate GATES RESULTS...`: result tables checked against the thresholds of a gates file
+// (harness/gate.hpp); exit 1 when a gate fails, 2 when none applies (docs/CLI.md "gate"). The
+// verdicts print as text, as JUnit XML (one <testsuite> per scene, one <testcase> per gate) for
+// CI systems to render, or as a JSON array of {scene, gate, passed, message}.
+#include "harness/gate.hpp"
+
+#include <fmt/format.h>
+
+#include <map>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "problems/spec.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct GateCliOptions {
+  std::string gates_path;
+  std::vector<std::string> results;
+  bool verbose = false;
+  std::string format = "text";
+};
+
+// A gate without a scene checks every scene given.
+std::string scene_of(const Gate& gate) { return gate.scene.empty() ? "*" : gate.scene; }
+
+// The checked rows of a failing gate (every row with --verbose), one per line.
+std::string outcome_message(const GateOutcome& outcome, bool verbose) {
+  std::string message = fmt::format("{} row(s)", outcome.rows_checked);
+  if (!outcome.passed || verbose) {
+    for (const auto& line : outcome.lines) message += "\n" + line;
+  }
+  return message;
+}
+
+std::string xml_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\n':
+        out += "&#10;";
+        break;  // kept in an attribute value
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string json_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+void print_text(const std::vector<const GateOutcome*>& applied, bool verbose) {
+  for (const GateOutcome* outcome : applied) {
+    fmt::print("{} {} ({} row(s))\n", outcome->passed ? "PASS" : "FAIL", outcome->gate->name,
+               outcome->rows_checked);
+    if (!outcome->passed || verbose) {
+      for (const auto& line : outcome->lines) fmt::print("    {}\n", line);
+    }
+  }
+}
+
+void print_junit(const std::vector<const GateOutcome*>& applied, bool verbose) {
+  std::map<std::string, std::vector<const GateOutcome*>> by_scene;
+  for (const GateOutcome* outcome : applied) by_scene[scene_of(*outcome->gate)].push_back(outcome);
+  int failures = 0;
+  for (const GateOutcome* outcome : applied) failures += outcome->passed ? 0 : 1;
+  fmt::print("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+  fmt::print("<testsuites name=\"geomint gate\" tests=\"{}\" failures=\"{}\">\n", applied.size(),
+             failures);
+  for (const auto& [scene, outcomes] : by_scene) {
+    int failed = 0;
+    for (const GateOutcome* outcome : outcomes) failed += outcome->passed ? 0 : 1;
+    fmt::print("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\">\n", xml_escaped(scene),
+               outcomes.size(), failed);
+    for (const GateOutcome* outcome : outcomes) {
+      const std::string name = xml_escaped(outcome->gate->name);
+      const std::string message = xml_escaped(outcome_message(*outcome, verbose));
+      if (outcome->passed) {
+        fmt::print("    <testcase classname=\"{}\" name=\"{}\"/>\n", xml_escaped(scene), name);
+      } else {
+        fmt::print(
+            "    <testcase classname=\"{0}\" name=\"{1}\">\n"
+            "      <failure message=\"{2}\" type=\"gate\">{2}</failure>\n"
+            "    </testcase>\n",
+            xml_escaped(scene), name, message);
+      }
+    }
+    fmt::print("  </testsuite>\n");
+  }
+  fmt::print("</testsuites>\n");
+}
+
+void print_json(const std::vector<const GateOutcome*>& applied, bool verbose) {
+  fmt::print("[");
+  for (std::size_t k = 0; k < applied.size(); ++k) {
+    const GateOutcome& outcome = *applied[k];
+    fmt::print("{}\n  {{\"scene\": \"{}\", \"gate\": \"{}\", \"passed\": {}, \"message\": \"{}\"}}",
+               k == 0 ? "" : ",", json_escaped(scene_of(*outcome.gate)),
+               json_escaped(outcome.gate->name), outcome.passed ? "true" : "false",
+               json_escaped(outcome_message(outcome, verbose)));
+  }
+  fmt::print("{}]\n", applied.empty() ? "" : "\n");
+}
+
+int run_gate(const GateCliOptions& cli, const Context&) {
+  const std::vector<Gate> gates = load_gates(cli.gates_path);
+  const auto outcomes = check_gates(gates, load_result_files(cli.results));
+  std::vector<const GateOutcome*> applied;
+  int failed = 0;
+  for (const auto& outcome : outcomes) {
+    if (!outcome.applicable) continue;
+    applied.push_back(&outcome);
+    failed += outcome.passed ? 0 : 1;
+  }
+  if (applied.empty()) {
+    throw InputError(fmt::format(
+        "gate: none of the {} gate(s) in '{}' applies to the results given (their scenes "
+        "and variants differ); nothing was checked",
+        outcomes.size(), cli.gates_path));
+  }
+  if (cli.format == "junit") {
+    print_junit(applied, cli.verbose);
+  } else if (cli.format == "json") {
+    print_json(applied, cli.verbose);
+  } else {
+    print_text(applied, cli.verbose);
+    fmt::print("{} of {} gate(s) passed ({} not applicable to the scenes given)\n",
+               applied.size() - failed, applied.size(), outcomes.size() - applied.size());
+  }
+  return failed == 0 ? kExitOk : kExitFailed;
+}
+
+}  // namespace
+
+Verb add_gate(CLI::App& app) {
+  auto options = std::make_shared<GateCliOptions>();
+  auto* command = app.add_subcommand(
+      "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
+  command->add_option("gates", options->gates_path, "GATES.toml with [[gate]] blocks")->required();
+  command->add_flag("--verbose", options->verbose,
+                    "print every checked row, not only the failing ones");
+  command
+      ->add_option("results", options->results,
+                   "result CSV files (summary.csv, order.csv, ...) or scene folders "
+                   "(results/<scene>, results/<scene>/quick)")
+      ->required();
+  command
+      ->add_option("--format", options->format,
+                   "text (default), junit (JUnit XML: a testsuite per scene, a testcase per "
+                   "gate) or json (an array of {scene, gate, passed, message})")
+      ->check(CLI::IsMember({"text", "junit", "json"}));
+  return {"gate", command,
+          [options](const Context& context) { return run_gate(*options, context); }};
+}
+
+}  // namespace geomint::cli

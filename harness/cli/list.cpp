@@ -1,0 +1,154 @@
+// `geomint list [methods|problems|all] [--markdown]`: the registries as aligned columns with every
+// parameter's default, or as the README's Markdown tables (docs/CLI.md "list").
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "integrators/integrator.hpp"
+#include "problems/problem.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct ListOptions {
+  std::string what = "all";
+  bool markdown = false;
+};
+
+std::string parameter_list(const Params& params) {
+  std::vector<std::string> parameters;
+  for (const auto& doc : params.docs()) {
+    parameters.push_back(fmt::format("{}={}", doc.key, doc.default_value));
+  }
+  return fmt::format("{}", fmt::join(parameters, ","));
+}
+
+// A Markdown table cell: '|' would end the cell.
+std::string markdown_cell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+// The default configuration's order, then the other orders among the variants the tests cover
+// (integrators/registry.def): "2 (variants: 1)" for hp.
+std::string order_column(const IntegratorEntry& entry, int default_order) {
+  std::vector<int> others;
+  for (const auto& variant : entry.variants) {
+    const int order = make_integrator(entry.name + ":" + variant)->info().order;
+    if (order != default_order && std::find(others.begin(), others.end(), order) == others.end()) {
+      others.push_back(order);
+    }
+  }
+  if (others.empty()) return std::to_string(default_order);
+  std::sort(others.begin(), others.end());
+  return fmt::format("{} (variants: {})", default_order, fmt::join(others, ", "));
+}
+
+// Aligned plain-text columns: each as wide as its widest cell (names and capability lists grow
+// with the registry, so fixed widths let a long one push the rest of its row out of line). The
+// last column is left unpadded.
+void print_aligned(const std::vector<std::vector<std::string>>& rows,
+                   const std::vector<bool>& right_aligned) {
+  std::vector<std::size_t> widths(right_aligned.size(), 0);
+  for (const auto& row : rows) {
+    for (std::size_t column = 0; column < row.size(); ++column) {
+      widths[column] = std::max(widths[column], row[column].size());
+    }
+  }
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t column = 0; column < row.size(); ++column) {
+      const bool last = column + 1 == row.size();
+      if (column > 0) line += column == 2 ? "  " : " ";
+      if (last) {
+        line += row[column];
+      } else if (right_aligned[column]) {
+        line += fmt::format("{:>{}}", row[column], widths[column]);
+      } else {
+        line += fmt::format("{:<{}}", row[column], widths[column]);
+      }
+    }
+    line.erase(line.find_last_not_of(' ') + 1);  // an empty last column leaves no padding
+    fmt::print("{}\n", line);
+  }
+}
+
+// `markdown`: the README's table (README.md, between <!-- methods:begin/end -->), one row per
+// built-in registry entry (register_method() ones are not the README's); otherwise aligned
+// columns with every parameter and its default, registered methods included.
+void print_methods(bool markdown) {
+  std::vector<std::vector<std::string>> rows;
+  if (markdown) {
+    fmt::print("| method | order | flags | what it is |\n|---|---|---|---|\n");
+  } else {
+    rows.push_back({"method", "order", "flags", "parameters (default)"});
+  }
+  for (const auto& entry : integrator_registry()) {
+    if (markdown && !entry.builtin) continue;
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto integrator = entry.factory(params);
+    const MethodInfo info = integrator->info();
+    if (markdown) {
+      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, order_column(entry, info.order),
+                 fmt::format("{}", fmt::join(flag_names(info.flags), ", ")),
+                 markdown_cell(entry.summary));
+    } else {
+      rows.push_back({entry.name, std::to_string(info.order),
+                      fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
+                      parameter_list(params)});
+    }
+  }
+  if (!markdown) print_aligned(rows, {false, true, false, false});
+}
+
+void print_problems(bool markdown) {
+  std::vector<std::vector<std::string>> rows;
+  if (markdown) {
+    fmt::print("| problem | dof | capabilities | what it is |\n|---|---|---|---|\n");
+  } else {
+    rows.push_back({"problem", "dof", "capabilities (defaults)", "parameters (default)"});
+  }
+  for (const auto& entry : problem_registry()) {
+    if (markdown && !entry.builtin) continue;
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto problem = entry.factory(params);
+    const auto capabilities = capability_names(problem->capabilities());
+    if (markdown) {
+      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, problem->dof(),
+                 fmt::format("{}", fmt::join(capabilities, ", ")), markdown_cell(entry.summary));
+    } else {
+      rows.push_back({entry.name, std::to_string(problem->dof()),
+                      fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params)});
+    }
+  }
+  if (!markdown) print_aligned(rows, {false, true, false, false});
+}
+
+int run_list(const ListOptions& options) {
+  if (options.what != "problems") print_methods(options.markdown);
+  if (options.what == "all") fmt::print("\n");
+  if (options.what != "methods") print_problems(options.markdown);
+  return kExitOk;
+}
+
+}  // namespace
+
+Verb add_list(CLI::App& app) {
+  auto options = std::make_shared<ListOptions>();
+  auto* command = app.add_subcommand("list", "List registered methods and/or problems");
+  command->add_option("what", options->what, "methods | problems | all")
+      ->check(CLI::IsMember({"methods", "problems", "all"}));
+  command->add_flag("--markdown", options->markdown,
+                    "print the README's Markdown tables (methods: order, flags, summary; "
+                    "problems: dof, capabilities of the defaults, summary); `make readme-tables` "
+                    "pastes them");
+  return {"list", command, [options](const Context&) { return run_list(*options); }};
+}
+
+}  // namespace geomint::cli

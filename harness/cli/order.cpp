@@ -1,0 +1,79 @@
+// `geomint order`: the convergence order fitted over the ladder dt0·2^-k (harness/order.hpp);
+// prints the order on stdout, the ladder on stderr; exit 1 when no order could be fitted
+// (docs/CLI.md "order").
+#include "harness/order.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "harness/paths.hpp"
+#include "harness/run.hpp"
+#include "harness/table.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct OrderOptions {
+  std::string problem_spec, method_spec, out_path, initial_path;
+  double dt0 = 0, t_end = 0;
+  long levels = 6;
+  double diverge_factor = kDefaultDivergeFactor;
+};
+
+int run_order(OrderOptions options, const Context& context) {
+  add_initial_state(options.problem_spec, options.initial_path);
+  validate_order_study(options.problem_spec, options.method_spec, options.dt0, options.levels,
+                       options.t_end);
+  if (!options.out_path.empty()) check_output_file(options.out_path, "--out");
+  const OrderStudy study =
+      order_study(options.problem_spec, options.method_spec, options.dt0,
+                  static_cast<int>(options.levels), options.t_end, options.diverge_factor);
+  for (const auto& run_result : study.runs) {
+    const Row row = to_row(run_result.record);
+    fmt::print(stderr, "dt={:<12} status={:<8} error_final={}\n", row.at("dt"), row.at("status"),
+               row.count("error_final") ? row.at("error_final") : "-");
+  }
+  if (!options.out_path.empty()) {
+    std::vector<RunRecord> records;
+    for (const auto& run_result : study.runs) records.push_back(run_result.record);
+    write_file_atomic(options.out_path, records_to_csv(records, provenance(context.command_line)));
+  }
+  if (!std::isfinite(study.fit.order)) {
+    fmt::print(stderr, "{}: no order fit: {}\n", context.program, study.fit.note);
+    return kExitFailed;
+  }
+  fmt::print("{:.3f}\n", study.fit.order);
+  fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
+             study.record.declared_order, to_row(study.record).at("points_used"),
+             study.fit.note.empty() ? "" : "; " + study.fit.note);
+  const Row orders = to_row(study.record);
+  const auto shown = [](const std::string& cell) { return cell.empty() ? "no fit" : cell; };
+  fmt::print(stderr, "order_q {}, order_p {}, order_multiplier {}{}\n", shown(orders.at("order_q")),
+             shown(orders.at("order_p")), shown(orders.at("order_multiplier")),
+             study.multiplier_from_state ? " (multiplier from (q, p))" : "");
+  return kExitOk;
+}
+
+}  // namespace
+
+Verb add_order(CLI::App& app) {
+  auto options = std::make_shared<OrderOptions>();
+  auto* command = app.add_subcommand("order", "Fit the convergence order over a dt ladder");
+  command->add_option("--problem", options->problem_spec, "problem spec")->required();
+  command->add_option("--method", options->method_spec, "method spec")->required();
+  command->add_option("--dt", options->dt0, "largest step dt0 (ladder dt0*2^-k)")->required();
+  command->add_option(
+      "--levels", options->levels,
+      fmt::format("number of ladder levels ({}..{})", kMinOrderLevels, kMaxOrderLevels));
+  command->add_option("--t-end", options->t_end, "horizon")->required();
+  command->add_option("--out", options->out_path, "write the ladder runs as CSV");
+  command->add_option("--diverge-factor", options->diverge_factor, diverge_factor_help());
+  command->add_option("--initial", options->initial_path, kInitialStateHelp);
+  return {"order", command,
+          [options](const Context& context) { return run_order(*options, context); }};
+}
+
+}  // namespace geomint::cli

@@ -1,0 +1,108 @@
+// `geomint run`: one problem with one method (harness/run.hpp), its summary as one CSV row and
+// optionally a time series; exit 1 when the run failed (docs/CLI.md "run").
+#include "harness/run.hpp"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "harness/paths.hpp"
+#include "harness/structure_metrics.hpp"
+#include "harness/table.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct RunOptions {
+  std::string problem_spec, method_spec, out_path, series_path, initial_path;
+  double dt = 0, t_end = 0;
+  bool dt_given = false, t_end_given = false;
+  long every = 1;
+  long timing_repeats = 3;
+  double diverge_factor = kDefaultDivergeFactor;
+  bool series_state = false;
+  long max_steps = kDefaultMaxSteps;
+  std::vector<std::string> extra_metrics;
+};
+
+int run_run(RunOptions options, const Context& context) {
+  add_initial_state(options.problem_spec, options.initial_path);
+  const auto problem = make_problem(options.problem_spec);
+  if (options.timing_repeats < 0 || options.timing_repeats > kMaxTimingRepeats) {
+    throw InputError(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
+                                 options.timing_repeats));
+  }
+  RunConfig config;
+  config.dt = options.dt_given ? options.dt : problem->default_dt();
+  config.t_end = options.t_end_given ? options.t_end : problem->default_t_end();
+  config.series_path = options.series_path;
+  config.series_every = options.every;
+  config.series_state = options.series_state;
+  config.timing_repeats = static_cast<int>(options.timing_repeats);
+  config.diverge_factor = options.diverge_factor;
+  config.max_steps = options.max_steps;
+  config.extra_metrics = options.extra_metrics;
+  config.command_line = context.command_line;
+  // Outputs are checked before anything is computed.
+  const std::string& out_path = options.out_path;
+  if (!out_path.empty()) check_output_file(out_path, "--out");
+  if (!options.series_path.empty() && !out_path.empty() &&
+      same_file_path(options.series_path, out_path)) {
+    throw InputError(
+        fmt::format("--series and --out name the same file '{}' (the summary would overwrite "
+                    "the series)",
+                    out_path));
+  }
+  const RunResult result = run_one(options.problem_spec, options.method_spec, config);
+  const std::string csv = records_to_csv({result.record}, provenance(context.command_line));
+  if (out_path.empty()) {
+    std::cout << csv;
+  } else {
+    write_file_atomic(out_path, csv);
+  }
+  if (!result.ok) {
+    fmt::print(stderr, "{}: run failed: {}: {}\n", context.program, result.record.status,
+               result.record.message.value_or(""));
+  }
+  return result.ok ? kExitOk : kExitFailed;
+}
+
+}  // namespace
+
+Verb add_run(CLI::App& app) {
+  auto options = std::make_shared<RunOptions>();
+  auto* command = app.add_subcommand("run", "Run one problem with one method and print a CSV row");
+  command->add_option("--problem", options->problem_spec, "problem spec, e.g. pendulum:theta0=1.5")
+      ->required();
+  command->add_option("--method", options->method_spec, "method spec, e.g. stormer_verlet")
+      ->required();
+  command->add_option("--dt", options->dt, "step size (> 0); default: the problem's");
+  command->add_option("--t-end", options->t_end, "horizon (> 0); default: the problem's");
+  command->add_option("--out", options->out_path, "write the summary CSV here instead of stdout");
+  command->add_option("--series", options->series_path, "write a time series CSV here");
+  command->add_option("--every", options->every,
+                      "series: every N-th step point (the last is always written)");
+  command->add_flag("--state", options->series_state, "series: include q and p even for > 64 dof");
+  command->add_option("--timing-repeats", options->timing_repeats,
+                      fmt::format("timing pass repeats (0 = none, at most {})", kMaxTimingRepeats));
+  command->add_option("--diverge-factor", options->diverge_factor, diverge_factor_help());
+  command->add_option("--max-steps", options->max_steps,
+                      fmt::format("step budget of a fixed-step run: more grid steps end the run "
+                                  "as the failure row max_steps (default {:g}, at most {:g})",
+                                  static_cast<double>(kDefaultMaxSteps), kMaxFixedSteps));
+  command->add_option("--metric", options->extra_metrics,
+                      "also compute an optional metric (repeatable): symplecticity_defect, "
+                      "period_measured (with period_err_rel), energy_growth_exponent, "
+                      "mode_freq_err_max, mode_damping_max");
+  command->add_option("--initial", options->initial_path, kInitialStateHelp);
+  return {"run", command, [options, command](const Context& context) {
+            RunOptions given = *options;
+            given.dt_given = command->count("--dt") > 0;
+            given.t_end_given = command->count("--t-end") > 0;
+            return run_run(given, context);
+          }};
+}
+
+}  // namespace geomint::cli

@@ -1,0 +1,77 @@
+// `geomint slurm SCENE`: sweep.sbatch (an array of shards), merge.sbatch and timing.sbatch next
+// to the scene (harness/shard.hpp), optionally submitted as a dependency chain (docs/CLI.md
+// "slurm").
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "harness/paths.hpp"
+#include "harness/scene.hpp"
+#include "harness/shard.hpp"
+#include "harness/sweep.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct SlurmCliOptions {
+  std::string scene, partition, time;
+  int shards = 0, max_parallel = 0;
+  bool submit = false, quick = false;
+};
+
+int run_slurm(const SlurmCliOptions& cli, const Context& context) {
+  const Scene scene = load_scene(cli.scene, cli.quick);
+  SlurmOptions options;
+  options.scene_path = cli.scene;
+  options.quick = cli.quick;
+  const size_t units = scene_units(scene).total();
+  if (static_cast<size_t>(cli.shards) > units) {
+    throw InputError(fmt::format(
+        "--shards {}: the scene has {} unit(s); use at most that many shards", cli.shards, units));
+  }
+  options.shards = cli.shards ? cli.shards : static_cast<int>(std::clamp<size_t>(units, 1, 1000));
+  options.max_parallel = cli.max_parallel;
+  options.partition = cli.partition;
+  options.time_limit = cli.time;
+  options.geomint_path = std::filesystem::canonical("/proc/self/exe").string();
+  check_output_dir(std::filesystem::absolute(cli.scene).parent_path().string(), "scene folder");
+  const auto scripts = write_slurm_scripts(options);
+  for (const auto& path : scripts) fmt::print("{}\n", path);
+  if (cli.submit) {
+    std::string dependency;
+    for (const auto& path : scripts) {
+      const std::string id = submit_sbatch(path, dependency);
+      fmt::print(stderr, "{}: submitted {} as job {}\n", context.program, path, id);
+      dependency = id;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Verb add_slurm(CLI::App& app) {
+  auto options = std::make_shared<SlurmCliOptions>();
+  auto* command = app.add_subcommand(
+      "slurm",
+      "Write sweep.sbatch, merge.sbatch and timing.sbatch next to the scene (and submit them)");
+  command->add_option("scene", options->scene, "results/<scene>/scene.toml")->required();
+  command->add_option("--shards", options->shards, "array size N (default: min(units, 1000))")
+      ->check(CLI::Range(1, kMaxShards));
+  command->add_option("--max-parallel", options->max_parallel, "at most K array tasks at once")
+      ->check(CLI::Range(1, 1000000));
+  command->add_option("--partition", options->partition, "Slurm partition");
+  command->add_option("--time", options->time,
+                      "time limit of each job (Slurm format, e.g. 1:00:00)");
+  command->add_flag("--quick", options->quick,
+                    "the scene's CI-sized variant (into <folder>/quick)");
+  command->add_flag("--submit", options->submit,
+                    "submit the three scripts with sbatch, chained by --dependency=afterok");
+  return {"slurm", command,
+          [options](const Context& context) { return run_slurm(*options, context); }};
+}
+
+}  // namespace geomint::cli

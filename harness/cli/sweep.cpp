@@ -1,0 +1,132 @@
+// `geomint sweep SCENE`: a scene file's runs, order studies and stability searches into its
+// tables (harness/sweep.hpp), whole, as one shard (i/N) or as its timing passes alone; failed
+// runs are rows, so a finished sweep exits 0 (docs/CLI.md "sweep").
+#include "harness/sweep.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "harness/paths.hpp"
+#include "harness/scene.hpp"
+#include "harness/shard.hpp"
+
+namespace geomint::cli {
+namespace {
+
+struct SweepCliOptions {
+  std::string scene_path, out;
+  int jobs = 1;
+  bool quick = false, markdown_only = false, no_timing = false, timing_only = false;
+  std::string shard_text;
+  bool shard_from_env = false;
+  int shard_count = 0;
+};
+
+int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
+  const Scene scene = load_scene(cli.scene_path, cli.quick);
+  SweepOptions options;
+  options.jobs = cli.jobs;
+  options.command_line = context.command_line;
+  const auto folder = std::filesystem::path(cli.scene_path).parent_path();
+  options.out_dir = !cli.out.empty() ? cli.out
+                    : cli.quick      ? (folder / "quick").string()
+                                     : folder.string();
+  // Gates select tables by scene and variant (harness/gate.hpp): the scene is the folder that
+  // holds scene.toml, whatever --out says.
+  options.scene_name = std::filesystem::absolute(cli.scene_path).parent_path().filename().string();
+  options.variant = cli.quick ? "quick" : "full";
+  const std::string out_option = cli.out.empty() ? "output folder" : "--out";
+  check_output_dir(options.out_dir, out_option);
+  const auto out_file = [&](const char* name) {
+    return (std::filesystem::path(options.out_dir) / name).string();
+  };
+  if (cli.markdown_only || cli.timing_only) check_output_file(out_file("table.md"), out_option);
+  if (cli.timing_only) check_output_file(out_file("summary.csv"), out_option);
+  if (cli.markdown_only) {
+    rewrite_scene_markdown(scene, options);
+    return kExitOk;
+  }
+  const bool sharded = !cli.shard_text.empty() || cli.shard_from_env;
+  if (cli.timing_only) {
+    if (cli.no_timing || sharded) {
+      throw InputError(
+          "--timing-only runs only the timing passes: leave out --no-timing, "
+          "--shard and --shard-from-env");
+    }
+    run_timing_only(scene, options);
+    fmt::print(stderr, "{}: timing passes of '{}' written into {}\n", context.program, scene.title,
+               options.out_dir);
+    return kExitOk;
+  }
+  options.timing = !cli.no_timing;
+  if (sharded) {
+    if (!cli.shard_text.empty() && cli.shard_from_env) {
+      throw InputError("give either --shard i/N or --shard-from-env, not both");
+    }
+    const ShardId id =
+        cli.shard_from_env ? shard_from_env(cli.shard_count) : parse_shard(cli.shard_text);
+    options.shard_index = id.index;
+    options.shard_count = id.count;
+    options.scene_hash = scene_content_hash(cli.scene_path, cli.quick);
+    const SceneUnits units = scene_units(scene);
+    if (static_cast<size_t>(id.count) > units.total()) {
+      // Merge refuses such a set: shards past the last unit would hold nothing.
+      throw InputError(
+          fmt::format("--shard {}/{}: the scene has {} unit(s) (runs, order studies, stability "
+                      "searches); use at most that many shards",
+                      id.index, id.count, units.total()));
+    }
+    const auto tables = shard_tables(units.runs, units.orders, units.stability);
+    if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
+      fmt::print(stderr, "{}: shard {}/{} of '{}' is complete on disk; skipped\n", context.program,
+                 id.index, id.count, scene.title);
+      return kExitOk;
+    }
+    if (shard_fails_on_purpose(id)) {
+      fmt::print(stderr, "{}: GEOMINT_FAIL_SHARD={}: shard {}/{} fails on purpose\n",
+                 context.program, id.index, id.index, id.count);
+      return kExitFailed;
+    }
+  } else if (cli.shard_count) {
+    throw InputError("--shards N goes with --shard-from-env");
+  }
+  const int failed = run_sweep(scene, options);
+  fmt::print(stderr, "{}: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
+             context.program, scene.title, failed, options.out_dir);
+  return kExitOk;
+}
+
+}  // namespace
+
+Verb add_sweep(CLI::App& app) {
+  auto options = std::make_shared<SweepCliOptions>();
+  auto* command = app.add_subcommand("sweep", "Run a scene file and write its tables");
+  command->add_option("scene", options->scene_path, "results/<scene>/scene.toml")->required();
+  command->add_option("--jobs", options->jobs, "parallel accuracy runs")->check(CLI::Range(1, 256));
+  command->add_flag("--quick", options->quick, "apply the scene's quick_* settings (CI-sized)");
+  command->add_flag("--markdown-only", options->markdown_only,
+                    "run nothing: rewrite table.md from the CSVs already in the output folder");
+  command->add_option("--out", options->out,
+                      "output folder (default: the scene's folder; with --quick: <folder>/quick)");
+  command->add_flag("--no-timing", options->no_timing,
+                    "accuracy runs only: no timing passes, no wall_s");
+  command->add_option("--shard", options->shard_text,
+                      "i/N: only the units k (runs, order studies, stability searches in scene "
+                      "order) with k mod N == i, written to <out>/shards/ for `geomint merge`; "
+                      "implies --no-timing; a complete shard on disk is skipped");
+  command->add_flag("--shard-from-env", options->shard_from_env,
+                    "take i/N from SLURM_ARRAY_TASK_ID and --shards, or from "
+                    "OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE");
+  command->add_option("--shards", options->shard_count, "N for --shard-from-env")
+      ->check(CLI::Range(1, kMaxShards));
+  command->add_flag("--timing-only", options->timing_only,
+                    "run only the timing passes, one at a time, into the merged tables of the "
+                    "output folder (after `geomint merge`), with this node's CPU in provenance");
+  return {"sweep", command,
+          [options](const Context& context) { return run_sweep_verb(*options, context); }};
+}
+
+}  // namespace geomint::cli

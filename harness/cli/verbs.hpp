@@ -1,0 +1,20 @@
+// The verbs of the geomint command line, one file each (harness/cli/<verb>.cpp, docs/CLI.md):
+// add_<verb> adds the subcommand with its options to `app` and returns how to run it. Their
+// order here is the order of `geomint --help`.
+#pragma once
+
+#include "harness/cli/common.hpp"
+
+namespace geomint::cli {
+
+Verb add_list(CLI::App& app);
+Verb add_run(CLI::App& app);
+Verb add_order(CLI::App& app);
+Verb add_sweep(CLI::App& app);
+Verb add_merge(CLI::App& app);
+Verb add_slurm(CLI::App& app);
+Verb add_reference(CLI::App& app);
+Verb add_modes(CLI::App& app);
+Verb add_gate(CLI::App& app);
+
+}  // namespace geomint::cli
