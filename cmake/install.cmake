@@ -1,6 +1,6 @@
 # `cmake --install`: headers under include/geomint/ (so "integrators/integrator.hpp" stays the
 # include path), the static libraries, the geomint program and the CMake package geomint
-# (geomintConfig.cmake, version file, targets, FindCHOLMOD.cmake): README "Verify your own
+# (geomintConfig.cmake, version file, targets, FindCHOLMOD.cmake): docs/VERIFY.md "Verify your own
 # integrator", docs/ARCHITECTURE.md "Installed package".
 include(CMakePackageConfigHelpers)
 set(GEOMINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/geomint)

@@ -1,9 +1,9 @@
 // geomint command line (docs/DESIGN.md §4) as geomint::run_main, so a user's executable with
-// registered methods is a full geomint (README "Verify your own integrator"): list, run, order,
-// sweep, merge, slurm, reference, gate (merge and slurm: README "Running on a cluster"). Exit
-// codes: 0 ok, 1 a run or gate failed, 2 bad input (the message names the offending option, key or
-// value; checked before any computing, outputs included), 3 an internal error (a defect, or an
-// I/O failure after the up-front checks, e.g. a full disk).
+// registered methods is a full geomint (docs/VERIFY.md "Verify your own integrator"): list, run,
+// order, sweep, merge, slurm, reference, gate (merge and slurm: docs/CLUSTER.md "Running on a
+// cluster"). Exit codes: 0 ok, 1 a run or gate failed, 2 bad input (the message names the offending
+// option, key or value; checked before any computing, outputs included), 3 an internal error (a
+// defect, or an I/O failure after the up-front checks, e.g. a full disk).
 #include "harness/run_main.hpp"
 
 #include <fmt/format.h>
@@ -140,8 +140,8 @@ void print_aligned(const std::vector<std::vector<std::string>>& rows,
   }
 }
 
-// `markdown`: the README's table (README.md, between <!-- methods:begin/end -->), one row per
-// built-in registry entry (register_method() ones are not the README's); otherwise aligned
+// `markdown`: the catalogue's table (docs/METHODS.md, between <!-- methods:begin/end -->), one row
+// per built-in registry entry (register_method() ones are not the catalogue's); otherwise aligned
 // columns with every parameter and its default, registered methods included.
 void print_methods(bool markdown) {
   std::vector<std::vector<std::string>> rows;
@@ -275,9 +275,11 @@ int run_main(int argc, char** argv) {
   list->add_option("what", list_what, "methods | problems | all")
       ->check(CLI::IsMember({"methods", "problems", "all"}));
   bool list_markdown = false;
-  list->add_flag("--markdown", list_markdown,
-                 "print the README's Markdown tables (methods: order, flags, summary; problems: "
-                 "dof, capabilities of the defaults, summary); `make readme-tables` pastes them");
+  list->add_flag(
+      "--markdown", list_markdown,
+      "print the Markdown tables of docs/METHODS.md and docs/PROBLEMS.md (methods: order, "
+      "flags, summary; problems: dof, capabilities of the defaults, summary); `make "
+      "readme-tables` pastes them");
 
   std::string problem_spec, method_spec, out_path, series_path;
   double dt = 0, t_end = 0;
@@ -399,9 +401,9 @@ int run_main(int argc, char** argv) {
                         "spacing of the written rows (> 0; default: t-end/100; must divide t-end)");
   reference->add_option("--out", out_path, "output file (default: results/references/...)");
 
-  auto* modes = app.add_subcommand(
-      "modes",
-      "Print the normal modes of a method's one-step map on a linear problem (README \"Metrics\")");
+  auto* modes = app.add_subcommand("modes",
+                                   "Print the normal modes of a method's one-step map on a linear "
+                                   "problem (docs/USAGE.md \"Optional structure metrics\")");
   modes->add_option("--problem", problem_spec, "linear problem spec")->required();
   modes->add_option("--method", method_spec, "method spec")->required();
   modes->add_option("--dt", dt, "step (> 0)")->required();
