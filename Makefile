@@ -23,7 +23,7 @@ build: configure
 
 # Fast suites (< 10 minutes on 2 cores; long runs carry the CTest label "slow"), then what a
 # user's CI does: the CI-sized scenes, gated; then geomint installed into a temporary prefix and
-# examples/external_method built and tested against it (README "Verify your own integrator").
+# examples/external_method built and tested against it (docs/VERIFY.md "Verify your own integrator").
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
@@ -32,7 +32,7 @@ test: build
 test-external: build
 	@JOBS=$(JOBS) bash scripts/test-external.sh $(BUILD_DIR)
 
-# Sweeps on a real Slurm (README "Running on a cluster"): as root, installs slurmctld, slurmd and
+# Sweeps on a real Slurm (docs/CLUSTER.md "Running on a cluster"): as root, installs slurmctld, slurmd and
 # munge, starts them on this machine, runs a scene through `geomint slurm --submit` in 8 shards,
 # merges, times, injects a failing shard and resubmits it; stops every daemon it started.
 test-cluster: build
@@ -46,7 +46,7 @@ test-all: build
 	@$(MAKE) --no-print-directory fuzz
 	@$(MAKE) --no-print-directory mutation
 
-# Sanitizer build (README "Sanitizers and fuzzing"): clang, -fsanitize=address,undefined with
+# Sanitizer build (docs/TESTING.md "Sanitizers and fuzzing"): clang, -fsanitize=address,undefined with
 # UB fatal, in its own directory; it also builds the libFuzzer targets of fuzz/. No benchmarks.
 SAN_DIR ?= build-asan
 SAN_CXX ?= clang++
@@ -108,11 +108,11 @@ gate-quick: build
 	@QUICK=1 PLOTS=0 bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
 	@$(BUILD_DIR)/geomint gate $(GATES) $(addsuffix /quick,$(addprefix results/,$(SCENES)))
 
-# Mutation testing (README.md, "Mutation testing"): applies each seeded bug of
+# Mutation testing (docs/TESTING.md, "Mutation testing"): applies each seeded bug of
 # tests/mutation/mutants.toml to a scratch copy of the tracked sources in build-mutation/ (never to
 # the working tree), rebuilds incrementally, runs the affected tests and quick scenes + gates, and
 # fails unless every mutant is killed and, on the whole list, the gates alone kill at least 80% of
-# the gate-visible mutants (README "The gates' own figure"). MUTATION_ONLY=id,id,
+# the gate-visible mutants (docs/TESTING.md "The gates' own figure"). MUTATION_ONLY=id,id,
 # MUTATION_SHARD=i/N or MUTATION_BUDGET_MIN=M (rotating by commit) run a subset; the default is
 # the whole list. MUTATION_GATES_ONLY=1 measures only the gates' figure (no tests, minutes).
 mutation: deps
@@ -122,11 +122,11 @@ mutation: deps
 mutation-check:
 	@/usr/bin/python3 scripts/mutation.py --check
 
-# Rewrites README.md's method and problem tables (between the <!-- methods:begin/end --> and
-# <!-- problems:begin/end --> markers) with `geomint list --markdown`; the test
-# Readme.TablesAreTheOutputOfListMarkdown fails until they agree.
+# Rewrites the method table of docs/METHODS.md and the problem table of docs/PROBLEMS.md (between
+# the <!-- methods:begin/end --> and <!-- problems:begin/end --> markers) with
+# `geomint list --markdown`; the test Readme.TablesAreTheOutputOfListMarkdown fails until they agree.
 readme-tables: build
-	@/usr/bin/python3 scripts/readme_tables.py $(BUILD_DIR)/geomint README.md
+	@/usr/bin/python3 scripts/readme_tables.py $(BUILD_DIR)/geomint docs/METHODS.md docs/PROBLEMS.md
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done

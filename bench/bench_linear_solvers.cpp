@@ -1,8 +1,9 @@
-// Linear solvers of the Newton step (integrators/newton.hpp LinearSolverKind; README "Scale"):
-// numeric factorisation and solve time per solver on the elastic bar's implicit-Euler matrix
-// M + h²∇²V at ~10³, 10⁴, 10⁵ tetrahedra (symbolic analysis once, outside the timing, as in a run),
-// and one implicit step (implicit Euler, HP midpoint) per solver through the method registry.
-// CPU time (the machine is shared): run with --benchmark_filter=... to pick a size or solver.
+// Linear solvers of the Newton step (integrators/newton.hpp LinearSolverKind; docs/METHODS.md
+// "Scale"): numeric factorisation and solve time per solver on the elastic bar's implicit-Euler
+// matrix M + h²∇²V at ~10³, 10⁴, 10⁵ tetrahedra (symbolic analysis once, outside the timing, as in
+// a run), and one implicit step (implicit Euler, HP midpoint) per solver through the method
+// registry. CPU time (the machine is shared): run with --benchmark_filter=... to pick a size or
+// solver.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/CholmodSupport>

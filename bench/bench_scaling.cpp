@@ -1,5 +1,5 @@
-// Per-step cost against problem size (issue 9 item 4; README "Scale"): Störmer–Verlet and the HP
-// midpoint step (Kharevych et al. 2006; hp:alpha=0.5) on spring_chain (10²…10⁶ dof) and on
+// Per-step cost against problem size (issue 9 item 4; docs/METHODS.md "Scale"): Störmer–Verlet and
+// the HP midpoint step (Kharevych et al. 2006; hp:alpha=0.5) on spring_chain (10²…10⁶ dof) and on
 // elastic_bar (10²…2·10⁵ tets, HP per linear solver), with the fitted exponent of cost against dof,
 // the gradient's element throughput and the process's peak RSS. `--csv FILE` runs the reduced
 // sizes that `make reproduce-figures` plots (scripts/scaling.sh) and writes them with provenance.
@@ -27,7 +27,7 @@ using geomint::Problem;
 using geomint::State;
 
 // h as a multiple of the explicit stability limit 2/ω_max: inside it for Störmer–Verlet, far
-// beyond it for the implicit step (the regime it is for; README "Scale" uses 20×).
+// beyond it for the implicit step (the regime it is for; docs/METHODS.md "Scale" uses 20×).
 constexpr double kExplicitStepOverLimit = 0.5;
 constexpr double kImplicitStepOverLimit = 20;
 constexpr long kImplicitRunSteps = 20;

@@ -1,5 +1,5 @@
 # Finds Debian's SuiteSparse CHOLMOD (libsuitesparse-dev) and METIS (libmetis-dev) for the Newton
-# solver's linear_solver=cholmod|ldlt_metis (README "Scale"); installed next to geomintConfig.cmake
+# solver's linear_solver=cholmod|ldlt_metis (docs/METHODS.md "Scale"); installed next to geomintConfig.cmake
 # so an installed geomint finds them again. Defines the imported target CHOLMOD::CHOLMOD.
 include(FindPackageHandleStandardArgs)
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse)

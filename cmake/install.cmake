@@ -1,6 +1,6 @@
 # `cmake --install`: headers under include/geomint/ (so "integrators/integrator.hpp" stays the
 # include path), the static libraries, the geomint program and the CMake package geomint
-# (geomintConfig.cmake, version file, targets, FindCHOLMOD.cmake): README "Verify your own
+# (geomintConfig.cmake, version file, targets, FindCHOLMOD.cmake): docs/VERIFY.md "Verify your own
 # integrator", docs/ARCHITECTURE.md "Installed package".
 include(CMakePackageConfigHelpers)
 set(GEOMINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/geomint)
@@ -28,3 +28,6 @@ write_basic_package_version_file(${CMAKE_BINARY_DIR}/geomintConfigVersion.cmake
 install(FILES ${CMAKE_BINARY_DIR}/geomintConfig.cmake ${CMAKE_BINARY_DIR}/geomintConfigVersion.cmake
               ${CMAKE_SOURCE_DIR}/cmake/FindCHOLMOD.cmake
         DESTINATION ${GEOMINT_CMAKE_DIR})
+# The licence (GPL-3.0-or-later, the build links GSL) and the citation file travel with the package.
+install(FILES ${CMAKE_SOURCE_DIR}/LICENSE ${CMAKE_SOURCE_DIR}/CITATION.cff
+        DESTINATION ${CMAKE_INSTALL_DOCDIR})

@@ -1,5 +1,6 @@
-// Shared helpers of the libFuzzer targets (README "Sanitizers and fuzzing"): a private temporary
-// directory for the file-based readers, removed at exit, so a fuzzer never writes elsewhere.
+// Shared helpers of the libFuzzer targets (docs/TESTING.md "Sanitizers and fuzzing"): a private
+// temporary directory for the file-based readers, removed at exit, so a fuzzer never writes
+// elsewhere.
 #pragma once
 
 #include <cstddef>

@@ -1,6 +1,7 @@
-// The BLAS that CHOLMOD's dense supernodes run on (README "Scale"; docs/DESIGN.md §5 provenance):
-// Debian selects libblas.so.3 through update-alternatives, so the CSV provenance records where
-// that link resolves, and warns when it is the reference BLAS (10× slower factorisations).
+// The BLAS that CHOLMOD's dense supernodes run on (docs/METHODS.md "Scale"; docs/DESIGN.md §5
+// provenance): Debian selects libblas.so.3 through update-alternatives, so the CSV provenance
+// records where that link resolves, and warns when it is the reference BLAS (10× slower
+// factorisations).
 #pragma once
 
 #include <string>

@@ -106,7 +106,8 @@ class CasimirObserver : public Observer {
 // problems with holonomic constraints (docs/METHOD.md §3). Absolute, in the units of g (a length
 // for the rod problems: the rod-length error) and of dg/dt: g = 0 is the reference, so there is
 // no initial value to divide by as for the energy, and the problem's g already fixes the scale
-// (README "Constraints"). The initial state counts: it is consistent to round-off.
+// (docs/METHODS.md "Holonomic constraints"). The initial state counts: it is consistent to
+// round-off.
 class ConstraintObserver : public Observer {
  public:
   void begin(const Problem& problem, const State& state, double) override {

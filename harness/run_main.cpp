@@ -1,5 +1,5 @@
 // geomint command line (docs/CLI.md, docs/DESIGN.md §4) as geomint::run_main, so a user's
-// executable with registered methods is a full geomint (README "Verify your own integrator").
+// executable with registered methods is a full geomint (docs/VERIFY.md "Verify your own integrator").
 // Each verb lives in harness/cli/<verb>.cpp; this file parses and dispatches. Exit codes: 0 ok,
 // 1 a run or gate failed, 2 bad input (checked before any computing, outputs included), 3 an
 // internal error (a defect, or an I/O failure after the up-front checks, e.g. a full disk).

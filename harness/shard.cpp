@@ -1,4 +1,4 @@
-// Shards, merge and Slurm scripts (see shard.hpp; README "Running on a cluster").
+// Shards, merge and Slurm scripts (see shard.hpp; docs/CLUSTER.md "Running on a cluster").
 #include "harness/shard.hpp"
 
 #include <fmt/format.h>
@@ -459,7 +459,7 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
       options.time_limit.empty() ? "" : sbatch_quoted(options.time_limit, "--time");
   const auto header = [&](const std::string& what, const std::string& job) {
     std::string text = fmt::format(
-        "#!/bin/bash\n# {} job of {} (written by `geomint slurm`; README \"Running on a "
+        "#!/bin/bash\n# {} job of {} (written by `geomint slurm`; docs/CLUSTER.md \"Running on a "
         "cluster\").\n# {}\n#SBATCH --job-name={}\n#SBATCH --output={}\n",
         job, scene_comment, what,
         sbatch_quoted(fmt::format("geomint-{}-{}", job, scene_name), "the scene folder"),

@@ -1,5 +1,5 @@
-// Sweeps beyond one machine (README "Running on a cluster", docs/DESIGN.md §3, §5): shard ids
-// from the command line or the environment, the provenance a shard carries, `geomint merge`
+// Sweeps beyond one machine (docs/CLUSTER.md "Running on a cluster", docs/DESIGN.md §3, §5): shard
+// ids from the command line or the environment, the provenance a shard carries, `geomint merge`
 // (tables byte-identical to a single-machine sweep) and the Slurm scripts of `geomint slurm`.
 // Shard ids, file names and the shard writer the sweep uses are in shard_files.hpp.
 #pragma once

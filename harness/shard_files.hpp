@@ -1,5 +1,5 @@
-// One shard of a sharded sweep (README "Running on a cluster", docs/DESIGN.md §5): its id, the
-// names of its files and the table a shard writes. The sweep writes shards through this module
+// One shard of a sharded sweep (docs/CLUSTER.md "Running on a cluster", docs/DESIGN.md §5): its id,
+// the names of its files and the table a shard writes. The sweep writes shards through this module
 // and `geomint merge` (harness/shard.*) reads them, so the dependency runs shard → sweep →
 // shard_files and never back.
 #pragma once

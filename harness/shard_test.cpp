@@ -1,6 +1,6 @@
-// Sharded sweeps and `geomint merge` (harness/shard.hpp, README "Running on a cluster", issue 16):
-// a scene swept in 4 shards and merged writes the bytes of a single-machine sweep (date line
-// aside; after --timing-only, wall_s too), and merge refuses a missing, a foreign and a
+// Sharded sweeps and `geomint merge` (harness/shard.hpp, docs/CLUSTER.md "Running on a cluster",
+// issue 16): a scene swept in 4 shards and merged writes the bytes of a single-machine sweep (date
+// line aside; after --timing-only, wall_s too), and merge refuses a missing, a foreign and a
 // duplicated shard, naming them and the resubmission command.
 #include "harness/shard.hpp"
 

@@ -1,4 +1,5 @@
-// Optional structure metrics (harness/structure_metrics.hpp; README "Metrics").
+// Optional structure metrics (harness/structure_metrics.hpp; docs/USAGE.md "Optional structure
+// metrics").
 #include "harness/structure_metrics.hpp"
 
 #include <fmt/format.h>

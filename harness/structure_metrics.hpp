@@ -1,7 +1,8 @@
-// Optional structure metrics of a run (README "Metrics"; docs/DESIGN.md §3): the symplecticity
-// defect of the one-step map, the period measured from zero crossings and the energy-error growth
-// exponent. They are computed only when asked for (RunConfig::extra_metrics: `run --metric`, or
-// a scene whose table_columns list them), so tables that do not ask keep their columns.
+// Optional structure metrics of a run (docs/USAGE.md "Optional structure metrics"; docs/DESIGN.md
+// §3): the symplecticity defect of the one-step map, the period measured from zero crossings and
+// the energy-error growth exponent. They are computed only when asked for
+// (RunConfig::extra_metrics: `run --metric`, or a scene whose table_columns list them), so tables
+// that do not ask keep their columns.
 #pragma once
 
 #include <memory>
@@ -23,7 +24,7 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 // `state` (max norm: the largest entry), J the canonical 2n×2n form. DΦ is the method's
 // linearised step (Integrator::step_tangent, integrators/tangent.hpp) taken by a fresh integrator
 // from a reset at `state`, never a difference quotient; NaN when the step fails. Its floor (round
-// off, README "Metrics") is measured by tests/structure_metrics_test.cpp.
+// off, docs/USAGE.md "Optional structure metrics") is measured by tests/structure_metrics_test.cpp.
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,
                             const State& state, double h);
 // The same defect of a given 2n×2n DΦ.

@@ -19,7 +19,7 @@ struct SweepOptions {
   std::string variant = "full";  // "full" or "quick"
   bool progress = true;          // progress on stderr when it is a terminal
   bool timing = true;            // false: accuracy runs only (--no-timing)
-  // Sharded sweep (--shard i/N, README "Running on a cluster"): only the units k of the
+  // Sharded sweep (--shard i/N, docs/CLUSTER.md "Running on a cluster"): only the units k of the
   // canonical expansion (runs, then order studies, then stability searches) with k mod N == i,
   // written to <out_dir>/shards/<table>.i-of-N.csv with a canonical_index column; never timed.
   // shard_count 0: an ordinary sweep.

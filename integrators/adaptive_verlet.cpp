@@ -1,6 +1,6 @@
 // Störmer–Verlet with a standard error controller (Hairer, Lubich & Wanner, GNI §VIII.1): the
 // contrast that shows why a symplectic step with state-dependent step sizes loses the bounded
-// energy error of the fixed-step method (docs/METHOD.md §1; README "Adaptive steps against
+// energy error of the fixed-step method (docs/METHOD.md §1; docs/METHODS.md "Adaptive steps against
 // structure").
 #include <fmt/format.h>
 

@@ -237,7 +237,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
       // without losing feasibility is also taken. Near a solution of a stiff step the merit's
       // change falls below the rounding of its large terms, while Newton still cuts ‖F₁‖
       // quadratically: measured on the pinned spinning elastic bar, where the merit test alone
-      // stalled at ‖F₁‖ ~ 1e-7 (README "Holonomic constraints").
+      // stalled at ‖F₁‖ ~ 1e-7 (docs/METHODS.md "Holonomic constraints").
       const bool merit_decreases =
           merit(trial) <= merit_start + options.armijo * step * slope + noise;
       const bool residual_decreases =

@@ -166,9 +166,10 @@ class Integrator {
   // fixed-step method without an override fails the registry test in harness/stability_test.cpp.
   virtual StabilityPrediction predicted_linear_stability() const;
 
-  // The linearised step (README "Metrics"; integrators/tangent.hpp): whether step_tangent()
-  // gives the exact DΦ of this method on `problem`. The default says no; methods that implement
-  // it say yes on unforced, unconstrained problems with a Hessian (tangent_applies()).
+  // The linearised step (docs/USAGE.md "Optional structure metrics"; integrators/tangent.hpp):
+  // whether step_tangent() gives the exact DΦ of this method on `problem`. The default says no;
+  // methods that implement it say yes on unforced, unconstrained problems with a Hessian
+  // (tangent_applies()).
   virtual bool has_step_tangent(const Problem& problem) const;
   // One step exactly as step() from a reset at `state` (a method carrying a variable of its own,
   // HHT's acceleration, starts it consistently as reset() does), and `tangent` = DΦ =
@@ -265,17 +266,17 @@ struct IntegratorEntry {
   std::string summary;
   std::unique_ptr<Integrator> (*factory)(Params&);
   std::vector<std::string> variants;  // extra parameter sets the test suite must also cover
-  // false for register_method() entries, which the README's table leaves out
+  // false for register_method() entries, which docs/METHODS.md's table leaves out
   bool builtin = true;
 };
 // The built-in entries (registry.def) followed by the register_method() ones, in call order.
 const std::vector<IntegratorEntry>& integrator_registry();
 
-// A method defined outside the tree (README "Verify your own integrator", docs/ARCHITECTURE.md):
-// appended to the registry that make_integrator, `geomint list`, the sweeps, applicable() and
-// the registry-driven tests read. Call it before run_main (or through a static MethodRegistrar);
-// not thread-safe. Throws InputError for a name that is not a plain spec name or is already
-// registered (a built-in's name included). `builtin` is set to false.
+// A method defined outside the tree (docs/VERIFY.md "Verify your own integrator",
+// docs/ARCHITECTURE.md): appended to the registry that make_integrator, `geomint list`, the sweeps,
+// applicable() and the registry-driven tests read. Call it before run_main (or through a static
+// MethodRegistrar); not thread-safe. Throws InputError for a name that is not a plain spec name or
+// is already registered (a built-in's name included). `builtin` is set to false.
 void register_method(IntegratorEntry entry);
 struct MethodRegistrar {
   explicit MethodRegistrar(IntegratorEntry entry) { register_method(std::move(entry)); }

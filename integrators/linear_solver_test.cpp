@@ -1,6 +1,7 @@
-// The Newton solver's linear solvers (integrators/newton.hpp LinearSolverKind; README "Scale"):
-// every choice gives the same trajectory to the Newton tolerance, at unit and far-from-unit scales,
-// the SPD safeguard works with each, modified Newton saves factorisations, bad values are named.
+// The Newton solver's linear solvers (integrators/newton.hpp LinearSolverKind; docs/METHODS.md
+// "Scale"): every choice gives the same trajectory to the Newton tolerance, at unit and
+// far-from-unit scales, the SPD safeguard works with each, modified Newton saves factorisations,
+// bad values are named.
 #include <gtest/gtest.h>
 
 #include <cmath>

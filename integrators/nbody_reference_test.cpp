@@ -64,7 +64,7 @@ TEST(Pleiades, TightRunsReproduceTheTestSetReferenceAtTThree) {
   ASSERT_EQ(problem->dof(), 14);
   EXPECT_EQ(problem->default_t_end(), 3.0);
   // Fixed-step methods at h, adaptive ones at their tolerance: the digits each reaches at t = 3
-  // against wall time (README "Problems", Pleiades).
+  // against wall time (docs/PROBLEMS.md "Problems", Pleiades).
   const std::pair<const char*, double> runs[] = {
       {"gsl_rk8pd:rtol=1e-14,atol=1e-14", 1e-3},
       {"gsl_rk8pd:rtol=1e-10,atol=1e-10", 1e-3},

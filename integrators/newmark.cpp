@@ -40,9 +40,10 @@ namespace {
 // edited state) takes the consistent acceleration a₀ = M⁻¹f(q₀, v₀, t₀), the start Chung &
 // Hulbert (1993, §2) and Hilber et al. analyse. Recomputing the consistent a₀ at every step
 // instead would be a different two-term method whose high-frequency damping is not the
-// requested ρ∞ (integrators/structural_alpha_test.cpp measures both, README "Methods").
-// At α_m = α_f (γ = ½: HHT α = 0, generalized-α ρ∞ = 1) a consistent start stays consistent,
-// the scheme is Newmark's trapezoidal rule and kSymmetric is declared.
+// requested ρ∞ (integrators/structural_alpha_test.cpp measures both, docs/METHODS.md
+// "Structural-dynamics schemes"). At α_m = α_f (γ = ½: HHT α = 0, generalized-α ρ∞ = 1) a
+// consistent start stays consistent, the scheme is Newmark's trapezoidal rule and kSymmetric is
+// declared.
 class Newmark final : public Integrator {
  public:
   // α-generalisation of Newmark (α_m = α_f = 0); `second_order` is the caller's γ = ½ − α_m + α_f,

@@ -14,8 +14,8 @@ namespace geomint {
 
 class Params;
 
-// Which solver factorises (or iterates on) a symmetric Newton matrix (README "Scale"; issue 9).
-// Non-symmetric Jacobians always go to SparseLU.
+// Which solver factorises (or iterates on) a symmetric Newton matrix (docs/METHODS.md "Scale";
+// issue 9). Non-symmetric Jacobians always go to SparseLU.
 //  - kLdlt: Eigen SimplicialLDLT, AMD ordering (bit-identical to the results committed before the
 //    choice existed); kLdltMetis: the same with METIS nested-dissection ordering.
 //  - kCholmod: CHOLMOD supernodal LLᵀ (METIS ordering, dense supernodes through the BLAS).
@@ -26,7 +26,8 @@ class Params;
 enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol };
 
 // `auto` picks kLdlt below this many unknowns (every committed result, bit for bit) and kCg from
-// it on. Measured (README "Scale", CPU s of a whole one-step run, 2-core machine under load 5–7):
+// it on. Measured (docs/METHODS.md "Scale", CPU s of a whole one-step run, 2-core machine under
+// load 5–7):
 //   /usr/bin/time -f "%U %S" build/geomint run --problem elastic_bar:nx=26,ny=8,nz=8
 //     --method hp:linear_solver=cg --dt 0.022 --t-end 0.022 --timing-repeats 0
 // (and ldlt, cholmod; nx=65,ny=16,nz=16 with --dt 0.011; bench/bench_linear_solvers.cpp).
@@ -72,9 +73,9 @@ inline constexpr double kSubnormalResidual = 2.2250738585072014e-308;  // DBL_MI
 // so Armijo φ(α) ≤ φ(0) + c₁αφ'(0) is exactly φ'(α) ≤ (2c₁ − 1)φ'(0), and φ' comes from R, whose
 // rounding is that of the gradient's terms, not of the energy's. E may then rise by no more than
 // this fraction of its size (Hager & Zhang's ε = 1e-6), which still rejects a step across a
-// hill of E towards another stationary point. Measured (README "minimize_vs_newton", spinning
-// free elastic bar at t = 2.29): E's rounding ~120ε·objective_scale, above the 16ε the value
-// test allows, while a full Newton step cut ‖R‖ from 1.5e-6 to 7e-14.
+// hill of E towards another stationary point. Measured (results/minimize_vs_newton/README.md
+// "minimize_vs_newton", spinning free elastic bar at t = 2.29): E's rounding ~120ε·objective_scale,
+// above the 16ε the value test allows, while a full Newton step cut ‖R‖ from 1.5e-6 to 7e-14.
 inline constexpr double kApproximateArmijoSlack = 1e-6;
 
 struct NewtonOptions {

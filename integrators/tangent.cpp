@@ -1,4 +1,4 @@
-// Linearised one-step maps (integrators/tangent.hpp; README "Metrics").
+// Linearised one-step maps (integrators/tangent.hpp; docs/USAGE.md "Optional structure metrics").
 #include "integrators/tangent.hpp"
 
 namespace geomint {

@@ -1,6 +1,7 @@
-// The linearised one-step map DΦ = ∂(q⁺, p⁺)/∂(q, p) (Integrator::step_tangent; README "Metrics",
-// symplecticity_defect; GNI §VI.2): tangent vectors propagated through explicit stages with the
-// Hessian ∇²V, and the implicit function theorem on the converged equations of implicit steps.
+// The linearised one-step map DΦ = ∂(q⁺, p⁺)/∂(q, p) (Integrator::step_tangent; docs/USAGE.md
+// "Optional structure metrics", symplecticity_defect; GNI §VI.2): tangent vectors propagated
+// through explicit stages with the Hessian ∇²V, and the implicit function theorem on the converged
+// equations of implicit steps.
 #pragma once
 
 #include <Eigen/Dense>

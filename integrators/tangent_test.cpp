@@ -1,7 +1,7 @@
-// The linearised step Integrator::step_tangent (integrators/tangent.hpp; README "Metrics") against
-// a central difference of step(), for every method that implements it, on small nonlinear
-// problems with unit and non-unit masses. The difference is only a cross-check here; the metric
-// itself never differences.
+// The linearised step Integrator::step_tangent (integrators/tangent.hpp; docs/USAGE.md "Optional
+// structure metrics") against a central difference of step(), for every method that implements it,
+// on small nonlinear problems with unit and non-unit masses. The difference is only a cross-check
+// here; the metric itself never differences.
 #include "integrators/tangent.hpp"
 
 #include <gtest/gtest.h>

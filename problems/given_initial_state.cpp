@@ -1,7 +1,7 @@
 // Any problem started from a state read from a CSV file (the spec key `initial=FILE.csv`, which
-// make_problem handles for every problem, and `geomint run|order --initial FILE.csv`; README
-// "Problems"): the problem is forwarded unchanged except for its initial state and the exact
-// solution and period, which belong to the problem's own start.
+// make_problem handles for every problem, and `geomint run|order --initial FILE.csv`;
+// docs/PROBLEMS.md "Problems"): the problem is forwarded unchanged except for its initial state and
+// the exact solution and period, which belong to the problem's own start.
 #include <fmt/format.h>
 
 #include <cmath>

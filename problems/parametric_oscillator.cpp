@@ -1,8 +1,8 @@
 // Time-dependent Hamiltonian H(q, p, t) = p²/2m + ½ m ω² (1 + ε cos νt) q² (a Mathieu
 // oscillator, the modulated-stiffness case of SUNDIALS' ARKODE SPRKStep damped-harmonic example
 // without the damping). Problem's potential has no t, so the modulation enters as the external
-// force F(q, t) = −m ω² ε cos(νt) q, exact in the Lagrange–d'Alembert view (docs/METHOD.md
-// "Forcing"); the reported energy is the unmodulated part. No closed form: errors come from the
+// force F(q, t) = −m ω² ε cos(νt) q, exact in the Lagrange–d'Alembert view (docs/METHOD.md §2,
+// forcing); the reported energy is the unmodulated part. No closed form: errors come from the
 // long-double reference generator (`geomint reference`, harness/reference_generator.hpp).
 #include <cmath>
 #include <numbers>

@@ -109,7 +109,7 @@ class Problem {
   // itself (the normal-mode metrics, harness/structure_metrics.hpp).
   virtual bool is_linear() const { return false; }
 
-  // Holonomic constraints g(q) = 0 (PAPER.md §3, docs/METHOD.md "Constraints"). Only when
+  // Holonomic constraints g(q) = 0 (PAPER.md §3, docs/METHOD.md §3). Only when
   // has(kConstraints). The motion is M q̈ = −∇V(q) + F − G(q)ᵀλ, G = ∂g/∂q, with m =
   // constraint_count() multipliers λ. Problems whose initial state comes from user parameters
   // get it checked by make_problem (an inconsistent state is an InputError naming the residual).
@@ -221,7 +221,7 @@ struct ProblemEntry {
   std::string summary;
   std::unique_ptr<Problem> (*factory)(Params&);
   std::vector<std::string> variants;  // extra parameter sets for the registry-driven tests
-  // false for register_problem() entries, which the README's table leaves out
+  // false for register_problem() entries, which docs/PROBLEMS.md's table leaves out
   bool builtin = true;
 };
 // The built-in entries (registry.def) followed by the register_problem() ones, in call order.

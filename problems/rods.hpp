@@ -1,6 +1,7 @@
 // Rigid rods as holonomic length constraints g = |x_b − x_a| − L between two nodes (or a node and
-// a fixed pivot), shared by spherical_pendulum and rod_chain (docs/METHOD.md §3, README
-// "Constraints"): the residual, its Jacobian row, curvature term and the Hessian block of λ·g.
+// a fixed pivot), shared by spherical_pendulum and rod_chain (docs/METHOD.md §3, docs/METHODS.md
+// "Holonomic constraints"): the residual, its Jacobian row, curvature term and the Hessian block of
+// λ·g.
 #pragma once
 
 #include <Eigen/SparseCore>

@@ -1,4 +1,4 @@
-# Shared gnuplot settings for geomint figures (README "Figures"): CSV input with `# ` provenance
+# Shared gnuplot settings for geomint figures (docs/SCENES.md "Figures"): CSV input with `# ` provenance
 # lines and a header row, names with underscores printed literally, and one fixed style per method.
 set datafile separator comma
 set datafile columnheaders
@@ -59,6 +59,6 @@ set style line 48 lw 2 lc rgb "#c9a800" pt 9
 # Legends sit above the plot in rows, so they take neither width nor data area.
 key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 spacing 1.1"
 
-# Every figure is written twice: PNG (README) and PDF (reports).
+# Every figure is written twice: PNG (the scenes' README.md) and PDF (reports).
 png_term = "pngcairo noenhanced size 1000,650 font 'DejaVu Sans,11'"
 pdf_term = "pdfcairo noenhanced size 7in,4.5in font 'DejaVu Sans,9'"

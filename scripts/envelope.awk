@@ -1,4 +1,4 @@
-# Per-window maximum of |column - ref| / |ref| (README "Figures"): an envelope that shows energy
+# Per-window maximum of |column - ref| / |ref| (docs/SCENES.md "Figures"): an envelope that shows energy
 # drift without the false beats a sampled oscillation aliases into. Windows are log-spaced,
 # per_decade to a decade, merged with the next until one spans at least min_width (one
 # oscillation period) and holds min_count samples, so no window sees only part of an oscillation.

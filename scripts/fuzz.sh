@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the libFuzzer targets of fuzz/ (README "Sanitizers and fuzzing") for a bounded time each.
+# Runs the libFuzzer targets of fuzz/ (docs/TESTING.md "Sanitizers and fuzzing") for a bounded time each.
 #   scripts/fuzz.sh BUILD_DIR SECONDS [TARGET...]     TARGET: spec scene gates (default: all)
 # Seeds: fuzz/corpus/<target>/ (committed, read only); new inputs go to
 # BUILD_DIR/fuzz/corpus/<target>/, crash/timeout/leak inputs to BUILD_DIR/fuzz/artifacts/<target>/,

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Writes results/README.md: every scene with its title, table and figures.
+# Writes results/README.md: every scene with its title, table, narrative (<scene>/README.md,
+# written by hand) and figures.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 {
@@ -16,6 +17,10 @@ root=$(cd "$(dirname "$0")/.." && pwd)
     echo "## [$scene]($scene/) — $title"
     echo
     echo "Table: [$scene/table.md]($scene/table.md)"
+    if [ -f "$folder/README.md" ]; then
+      echo
+      echo "Narrative and measured numbers: [$scene/README.md]($scene/README.md)"
+    fi
     for png in "$folder"/*.png; do
       [ -f "$png" ] || continue
       echo
@@ -27,7 +32,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
     echo
     echo "## [scaling](scaling/) — cost per step against problem size (scripts/scaling.sh)"
     echo
-    echo "Data: [scaling/scaling.csv](scaling/scaling.csv)"
+    echo "Data: [scaling/scaling.csv](scaling/scaling.csv); narrative and measured numbers:"
+    echo "[scaling/README.md](scaling/README.md)"
     echo
     echo "![scaling](scaling/scaling.png)"
   fi

@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages geomint builds with (docs/DESIGN.md §8). Idempotent: installs only
 # what is missing, waits for the dpkg lock, never pulls recommends. As non-root it prints the
 # exact command to run and exits 1. `install-deps.sh cluster` installs the local single-node Slurm
-# that `make test-cluster` runs (README "Running on a cluster") instead.
+# that `make test-cluster` runs (docs/CLUSTER.md "Running on a cluster") instead.
 set -euo pipefail
 
 PACKAGES=(

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Mutation testing for geomint: `make mutation` (README.md, "Mutation testing").
+"""Mutation testing for geomint: `make mutation` (docs/TESTING.md, "Mutation testing").
 
 Applies each seeded bug of tests/mutation/mutants.toml to a scratch copy of the tracked sources
 (never to the working tree), rebuilds incrementally only the targets the mutant needs, runs the

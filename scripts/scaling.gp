@@ -1,4 +1,4 @@
-# Scaling figure (issue 9 item 4; README "Scale"): CPU seconds per step against dof, log-log, for
+# Scaling figure (issue 9 item 4; docs/METHODS.md "Scale"): CPU seconds per step against dof, log-log, for
 # Stormer-Verlet and the HP midpoint step on spring_chain and on elastic_bar (HP per linear
 # solver), with a slope-1 reference. Run inside results/scaling; reads scaling.csv, written by
 # bench_scaling --csv (scripts/scaling.sh).

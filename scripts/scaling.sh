@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# results/scaling/ (issue 9 item 4; README "Scale"): the reduced sizes of bench/bench_scaling.cpp
+# results/scaling/ (issue 9 item 4; docs/METHODS.md "Scale"): the reduced sizes of bench/bench_scaling.cpp
 # (spring_chain to 10^5 dof, elastic_bar to 10^4 tets; under a minute on 2 cores) into
 # scaling.csv with provenance, then the log-log figure (scripts/scaling.gp). The largest sizes
 # (10^6 dof, 2*10^5 tets) run only under `make bench`. Usage: scaling.sh BUILD_DIR

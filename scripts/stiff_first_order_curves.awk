@@ -1,4 +1,4 @@
-# scd-against-wall-time curves of results/stiff_first_order (README "Stiff first-order
+# scd-against-wall-time curves of results/stiff_first_order (docs/PROBLEMS.md "Stiff first-order
 # references"): from summary.csv, one file curves/<group>_<method>.dat ("wall_s scd" per ok row
 # with an scd, in file order) per label group (vdpol, rober: the label up to its first "_") and
 # method name (the spec up to ":"), and curves/<group>.list naming them.

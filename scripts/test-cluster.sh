@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `make test-cluster` (README "Running on a cluster", issue 16): a real single-node Slurm on this
+# `make test-cluster` (docs/CLUSTER.md "Running on a cluster", issue 16): a real single-node Slurm on this
 # machine runs a committed scene through `geomint slurm --submit` with 8 shards, and the merged,
 # timed tables must equal a single-machine sweep (wall_s and date lines aside); then one shard is
 # made to fail, resubmitted alone from merge's message, and the tables are checked again.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs geomint from an existing build into a temporary prefix, then configures, builds and
 # tests examples/external_method against it with its own CMake configure, as a user would
-# (README "Verify your own integrator"; run by `make test`). Usage: test-external.sh [BUILD_DIR]
+# (docs/VERIFY.md "Verify your own integrator"; run by `make test`). Usage: test-external.sh [BUILD_DIR]
 # Exit code: 0 when the install, the example's build and every one of its tests succeed.
 set -euo pipefail
 build_dir=${1:-build}

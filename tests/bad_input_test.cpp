@@ -1,10 +1,10 @@
-// The bad-input suite (issue 14; docs/DESIGN.md §4, README "Exit codes"): a registry of command
-// lines and scene files, each with the exit code it must give, a word its message must contain and
-// the files it may leave behind (none, for bad input). Every case runs the built `geomint` under
-// `timeout` (the hang guard): a case that runs past its limit fails as a hang, not by stalling
-// the suite. Each case runs in its own scratch folder; after it, the folder must hold exactly the
-// files the case wrote there beforehand plus the ones it expects, and the folder's parent
-// nothing but the folder, so an output that escapes (a label "../../x") is caught too.
+// The bad-input suite (issue 14; docs/DESIGN.md §4, docs/USAGE.md "Exit codes"): a registry of
+// command lines and scene files, each with the exit code it must give, a word its message must
+// contain and the files it may leave behind (none, for bad input). Every case runs the built
+// `geomint` under `timeout` (the hang guard): a case that runs past its limit fails as a hang, not
+// by stalling the suite. Each case runs in its own scratch folder; after it, the folder must hold
+// exactly the files the case wrote there beforehand plus the ones it expects, and the folder's
+// parent nothing but the folder, so an output that escapes (a label "../../x") is caught too.
 //
 // Add a case here for every new option and every new way of rejecting input.
 #include <gtest/gtest.h>
@@ -229,7 +229,8 @@ const std::vector<Case>& cases() {
         {"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
        {"file", "scene.toml"},
        10},
-      // --- sharded sweeps, merge, slurm (README "Running on a cluster"): refused before any
+      // --- sharded sweeps, merge, slurm (docs/CLUSTER.md "Running on a cluster"): refused before
+      // any
       // of the long runs below is computed ---
       {"ShardOutOfRange",
        "sweep {dir}/scene.toml --shard 8/8",

@@ -1,6 +1,6 @@
 // Command-line contract (docs/DESIGN.md §4): good input works, a failed run is a row with exit 1,
-// series are streamed, the README's tables match `geomint list`. Bad input (exit 2, a message
-// naming what was wrong, no output file) is the registry of tests/bad_input_test.cpp.
+// series are streamed, the method and problem tables of docs/ match `geomint list`. Bad input (exit
+// 2, a message naming what was wrong, no output file) is the registry of tests/bad_input_test.cpp.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -88,7 +88,7 @@ fs::path scratch(const std::string& name) {
 // tests/bad_input_test.cpp.
 
 // The installed package's version file and `geomint --version` say the same (CMake's
-// PROJECT_VERSION, README "Verify your own integrator"); exit 0 without a command.
+// PROJECT_VERSION, docs/VERIFY.md "Verify your own integrator"); exit 0 without a command.
 TEST(Cli, VersionPrintsTheProjectVersion) {
   const Outcome outcome = geomint("--version");
   EXPECT_EQ(outcome.exit_code, 0) << outcome.output;
@@ -267,8 +267,15 @@ TEST(Cli, SeriesIsStreamedNotHeldInMemory) {
   fs::remove(short_series);
 }
 
+// The generated tables live in the catalogues: methods in docs/METHODS.md, problems in
+// docs/PROBLEMS.md.
+std::string table_file(const std::string& marker) {
+  return std::string(GEOMINT_SOURCE_DIR) +
+         (marker == "methods" ? "/docs/METHODS.md" : "/docs/PROBLEMS.md");
+}
+
 std::set<std::string> readme_table_names(const std::string& marker) {
-  std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
+  std::ifstream in(table_file(marker));
   std::string line;
   bool inside = false;
   std::set<std::string> names;
@@ -415,9 +422,9 @@ TEST(Cli, ListColumnsStayAlignedForTheLongestEntries) {
   }
 }
 
-// The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of README.md.
+// The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of its catalogue.
 std::string readme_block(const std::string& marker) {
-  std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
+  std::ifstream in(table_file(marker));
   std::string line, block;
   bool inside = false;
   while (std::getline(in, line)) {
@@ -428,9 +435,9 @@ std::string readme_block(const std::string& marker) {
   return block;
 }
 
-// The README's method and problem tables are generated (README "Adding a method or a problem"):
-// they must be `geomint list --markdown` verbatim, so a new or changed registry entry fails
-// here with the rows to paste.
+// The README's method and problem tables are generated (docs/METHODS.md "Adding a method or a
+// problem"): they must be `geomint list --markdown` verbatim, so a new or changed registry entry
+// fails here with the rows to paste.
 TEST(Readme, TablesAreTheOutputOfListMarkdown) {
   for (const std::string what : {"methods", "problems"}) {
     const Outcome listing = geomint("list " + what + " --markdown");
@@ -444,7 +451,7 @@ TEST(Readme, TablesAreTheOutputOfListMarkdown) {
     for (std::string row; std::getline(expected, row);) {
       if (!readme_rows.count(row)) changed += "  " + row + "\n";
     }
-    ADD_FAILURE() << "README.md's " << what << " table is not `geomint list " << what
+    ADD_FAILURE() << table_file(what) << "'s " << what << " table is not `geomint list " << what
                   << " --markdown`. Run `make readme-tables`, or paste between <!-- " << what
                   << ":begin --> and <!-- " << what << ":end -->:\n"
                   << listing.output << "(rows new or changed:\n"
@@ -452,7 +459,7 @@ TEST(Readme, TablesAreTheOutputOfListMarkdown) {
   }
 }
 
-// `geomint --help` documents every exit code main() returns (README "Exit codes").
+// `geomint --help` documents every exit code main() returns (docs/USAGE.md "Exit codes").
 TEST(Cli, HelpListsEveryExitCode) {
   const Outcome help = geomint("--help");
   EXPECT_EQ(help.exit_code, 0) << help.output;
@@ -461,7 +468,7 @@ TEST(Cli, HelpListsEveryExitCode) {
   }
 }
 
-// README "Running on a cluster": the CLI of sharded sweeps. Two shards of a scene's quick
+// docs/CLUSTER.md "Running on a cluster": the CLI of sharded sweeps. Two shards of a scene's quick
 // variant merge (exit 0) into <folder>/quick; without shard 1, merge exits 1 and names the
 // resubmission; `geomint slurm` writes the three scripts next to the scene.
 TEST(Cli, ShardMergeAndSlurmScripts) {
@@ -556,8 +563,8 @@ std::vector<std::string> sbatch_arguments(const std::string& script) {
   return arguments;
 }
 
-// README "Running on a cluster": the scripts of `geomint slurm` run a scene whose folder name
-// holds a space, a quote, a '%' or a command substitution. Each array task, the merge and the
+// docs/CLUSTER.md "Running on a cluster": the scripts of `geomint slurm` run a scene whose folder
+// name holds a space, a quote, a '%' or a command substitution. Each array task, the merge and the
 // timing job are run with bash as Slurm would (srun a stand-in that runs its command), and must
 // treat the name as a name: the tables appear, and `touch PWNED` never runs. The #SBATCH values,
 // read as sbatch reads them, name the folder too.

@@ -1,7 +1,7 @@
 // First-order-only problems (van der Pol, Robertson; capability kFirstOrderOnly, docs/DESIGN.md
 // §2) through the harness: which methods apply and why the others do not, every applicable
 // method on a mildly stiff van der Pol, and tight CVODE runs reproducing the IVP Test Set's
-// reference values at its end times (scd, README "Stiff first-order references").
+// reference values at its end times (scd, docs/PROBLEMS.md "Stiff first-order references").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-# The CTest label `slow` (README "Testing", docs/DESIGN.md §7): tests that take long and repeat
+# The CTest label `slow` (docs/TESTING.md "Testing", docs/DESIGN.md §7): tests that take long and repeat
 # what cheaper tests already guard. `make test` runs `ctest -LE slow`; `make test-all` runs them
 # too. Each entry is a GoogleTest filter pattern, with why it is slow and what still guards the
 # same code in `make test`.

@@ -1,6 +1,7 @@
-// Optional structure metrics (harness/structure_metrics.*; README "Metrics"): the symplecticity
-// defect of the linearised step at round-off for every declared-symplectic method and O(h^{p+1})
-// for non-symplectic ones, the period from zero crossings, the energy growth exponent.
+// Optional structure metrics (harness/structure_metrics.*; docs/USAGE.md "Optional structure
+// metrics"): the symplecticity defect of the linearised step at round-off for every
+// declared-symplectic method and O(h^{p+1}) for non-symplectic ones, the period from zero
+// crossings, the energy growth exponent.
 #include "harness/structure_metrics.hpp"
 
 #include <gtest/gtest.h>
@@ -21,8 +22,8 @@ namespace {
 
 // Round-off: DΦ is the exact linearised step (Integrator::step_tangent), and for an implicit
 // method it is the derivative of its step equations at the converged point, which is symplectic
-// whatever the Newton tolerance left (integrators/tangent.hpp). Measured ≤ 4.4e-16 (README
-// "Metrics"); non-symplectic methods must sit far above it.
+// whatever the Newton tolerance left (integrators/tangent.hpp). Measured ≤ 4.4e-16 (docs/USAGE.md
+// "Optional structure metrics"); non-symplectic methods must sit far above it.
 constexpr double kDefectFloor = 1e-14;
 
 double defect(const std::string& method, const std::string& problem_spec, double h) {
@@ -66,7 +67,8 @@ TEST(SymplecticityDefect, DeclaredSymplecticMethodsSitAtTheFloor) {
 // 0.04 and 6.0 further down (5.97, 5.99, 6.00 from h = 0.04 to 0.005, a power above p + 1,
 // which the difference quotient's floor hid). HHT and generalized-α measure 2.0 = p: their
 // first step starts from the consistent acceleration, and its error is O(h²) (the start-up error
-// that does not accumulate, so their global order stays 2; README "Metrics").
+// that does not accumulate, so their global order stays 2; docs/USAGE.md "Optional structure
+// metrics").
 TEST(SymplecticityDefect, NonSymplecticMethodsAreAboveTheFloorAndScaleWithTheOrder) {
   struct Case {
     std::string spec;
@@ -336,9 +338,9 @@ TEST(OptionalMetrics, EveryOneIsReportedAndHasAColumn) {
   EXPECT_NO_THROW(to_row(record));
 }
 
-// The divergence rule is an option (README "Failure rows"): explicit Euler at h = 0.1 multiplies
-// H by 1.01 per step, so a factor of 10 stops it after ln 11/ln 1.01 ≈ 241 steps, and inf lets it
-// run to t = 300 and report the growth, 1.01³⁰⁰⁰ − 1 = 9.2e12.
+// The divergence rule is an option (docs/USAGE.md "Failure rows"): explicit Euler at h = 0.1
+// multiplies H by 1.01 per step, so a factor of 10 stops it after ln 11/ln 1.01 ≈ 241 steps, and
+// inf lets it run to t = 300 and report the growth, 1.01³⁰⁰⁰ − 1 = 9.2e12.
 TEST(DivergeFactor, LowFactorStopsAndInfinityRunsToTheEnd) {
   RunConfig config;
   config.dt = 0.1;

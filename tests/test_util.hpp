@@ -1,6 +1,6 @@
 // Shared GoogleTest helpers for every suite (docs/DESIGN.md §7, "Tests"). Bad input must be an
-// InputError whose message names the offending input (README "Exit codes": exit 2 with a message
-// naming the option, key or value), checked here once instead of in a copy per test file.
+// InputError whose message names the offending input (docs/USAGE.md "Exit codes": exit 2 with a
+// message naming the option, key or value), checked here once instead of in a copy per test file.
 #pragma once
 
 #include <gtest/gtest.h>

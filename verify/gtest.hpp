@@ -1,6 +1,7 @@
-// GoogleTest adapter of geomint::verify (verify/verify.hpp, README "Verify your own integrator"):
-// GEOMINT_VERIFY_METHOD(Name, "spec") instantiates one test per check of verify::check_names()
-// for a method spec; checks its flags do not call for are skipped, failures print the figures.
+// GoogleTest adapter of geomint::verify (verify/verify.hpp, docs/VERIFY.md "Verify your own
+// integrator"): GEOMINT_VERIFY_METHOD(Name, "spec") instantiates one test per check of
+// verify::check_names() for a method spec; checks its flags do not call for are skipped, failures
+// print the figures.
 #pragma once
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // geomint::verify: the registry-driven property checks of docs/DESIGN.md §7 as plain functions
-// that any test framework can call (README "Verify your own integrator"). Each returns a
+// that any test framework can call (docs/VERIFY.md "Verify your own integrator"). Each returns a
 // CheckResult with the measured figure and the bound it was held to; the in-tree suites
 // (tests/methods_test.cpp, tests/constraints_test.cpp, integrators/variational_test.cpp) use them.
 #pragma once

@@ -1,5 +1,5 @@
-// What the example adds to geomint's registries (README "Verify your own integrator"): call both
-// before geomint::run_main or the verify checks.
+// What the example adds to geomint's registries (docs/VERIFY.md "Verify your own integrator"): call
+// both before geomint::run_main or the verify checks.
 #pragma once
 
 namespace user {

@@ -1,6 +1,7 @@
-// A user's integrators, written outside the geomint tree against its installed headers (README
-// "Verify your own integrator"): a drift–kick–drift position Verlet from scratch (GNI §I.3.1), and
-// a deliberately broken velocity Verlet that reuses the stale force in its second kick.
+// A user's integrators, written outside the geomint tree against its installed headers
+// (docs/VERIFY.md "Verify your own integrator"): a drift–kick–drift position Verlet from scratch
+// (GNI §I.3.1), and a deliberately broken velocity Verlet that reuses the stale force in its second
+// kick.
 #include <memory>
 
 #include "integrators/integrator.hpp"

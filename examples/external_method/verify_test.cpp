@@ -1,6 +1,7 @@
-// The user's methods through geomint::verify (README "Verify your own integrator"): the correct
-// position Verlet passes every check its flags call for; the stale-force Verlet must be flagged
-// by the order and energy checks — those tests expect the check to FAIL and pass when it does.
+// The user's methods through geomint::verify (docs/VERIFY.md "Verify your own integrator"): the
+// correct position Verlet passes every check its flags call for; the stale-force Verlet must be
+// flagged by the order and energy checks — those tests expect the check to FAIL and pass when it
+// does.
 #include <verify/gtest.hpp>
 
 #include "user_extensions.hpp"

@@ -1,6 +1,7 @@
 // Runtime registration of methods and problems from outside the tree (integrators/integrator.hpp
-// register_method, problems/problem.hpp register_problem; README "Verify your own integrator").
-// Its own executable: registering changes the process-wide registries the other suites iterate.
+// register_method, problems/problem.hpp register_problem; docs/VERIFY.md "Verify your own
+// integrator"). Its own executable: registering changes the process-wide registries the other
+// suites iterate.
 #include <gtest/gtest.h>
 
 #include <algorithm>
