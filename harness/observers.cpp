@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "integrators/newton.hpp"
+#include "problems/rigid_body.hpp"
 
 namespace geomint {
 namespace {
@@ -100,6 +101,27 @@ class CasimirObserver : public Observer {
 
  private:
   double initial_ = 0, err_max_ = 0;
+};
+
+// orthogonality_err_max = max_k ‖Q_kᵀQ_k − I‖_F on problems whose state holds an attitude Q
+// (rigid_body, heavy_top): absolute, as QᵀQ − I is dimensionless. It reads the attitude as a
+// matrix, where constraint_err_max reads the six constraint functions (the halved norms among
+// them).
+class OrthogonalityObserver : public Observer {
+ public:
+  void begin(const Problem& problem, const State& state, double) override {
+    observe(problem, state);
+  }
+  void observe(const Problem& problem, const State& state) override {
+    const Eigen::Matrix3d Q = attitude_problem(problem)->attitude(state.q);
+    err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    metrics["orthogonality_err_max"] = err_max_;
+  }
+
+ private:
+  double err_max_ = 0;
 };
 
 // constraint_err_max = max_k ‖g(q_k)‖∞ and constraint_vel_err_max = max_k ‖G(q_k) M⁻¹p_k‖∞ on
@@ -368,6 +390,9 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
   }
   if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
+  if (attitude_problem(problem) != nullptr) {
+    observers.push_back(std::make_unique<OrthogonalityObserver>());
+  }
   if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
   if (problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce)) {

@@ -110,6 +110,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "casimir_err_max",
                                                    "constraint_err_max",
                                                    "constraint_vel_err_max",
+                                                   "orthogonality_err_max",
                                                    "symplecticity_defect",
                                                    "mode_freq_err_max",
                                                    "mode_damping_max",

@@ -7,7 +7,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "integrators/free_rigid_body_methods.hpp"
 #include "integrators/newton.hpp"
+#include "problems/rigid_body.hpp"
 
 namespace geomint {
 
@@ -89,6 +91,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kRheonomic, "rheonomic"},
       {kFirstOrderCapable, "first_order"},
       {kConservativeOnly, "conservative_only"},
+      {static_cast<MethodFlag>(kFreeRigidBodyOnly), "free_rigid_body_only"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -146,6 +149,9 @@ void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatr
 
 Applicability applicable(const Integrator& method, const Problem& problem) {
   const MethodInfo info = method.info();
+  // A free rigid body gives such a method all it reads (moments and the (Q, Π) view), be it the
+  // first-order rigid_body_euler or the constrained rigid_body.
+  if ((info.flags & kFreeRigidBodyOnly) && free_rigid_body(problem) != nullptr) return {};
   if (problem.has(kFirstOrderOnly)) {
     if (info.flags & kFirstOrderCapable) return {};
     return {false,
@@ -153,6 +159,12 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         "problem '{}' is a first-order ODE y' = f(t, y) only; methods "
                         "that apply: {}",
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
+  }
+  if (info.flags & kFreeRigidBodyOnly) {
+    return {false, fmt::format("method '{}' integrates free rigid bodies only (rigid_body, "
+                               "rigid_body_euler, which offer their moments and (Q, Pi)); "
+                               "problem '{}' is none",
+                               method.spec(), problem.name())};
   }
   if ((info.flags & kNeedsHessian) && !problem.has(kHessian)) {
     return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
@@ -188,7 +200,8 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
 std::vector<std::string> constrained_methods() {
   std::vector<std::string> specs;
   for (const auto& spec : integrator_test_specs()) {
-    if (make_integrator(spec)->info().flags & kConstrained) specs.push_back(spec);
+    const unsigned flags = make_integrator(spec)->info().flags;
+    if ((flags & kConstrained) && !(flags & kFreeRigidBodyOnly)) specs.push_back(spec);
   }
   if (specs.empty()) specs.push_back("(none registered yet)");
   return specs;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/free_rigid_body_methods.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "tests/test_util.hpp"
@@ -191,8 +192,11 @@ std::vector<std::string> symplectic_methods() {
   for (const auto& spec : integrator_test_specs()) {
     const unsigned flags = make_integrator(spec)->info().flags;
     // Constrained-only methods cannot run on the unconstrained test problem (applicable());
-    // tests/constraints_test.cpp checks them on the constraint manifold.
-    if ((flags & kSymplectic) && !(flags & (kAdaptive | kConstraintsOnly))) out.push_back(spec);
+    // tests/constraints_test.cpp checks them on the constraint manifold, and
+    // integrators/lie_poisson_test.cpp the free-rigid-body splitting.
+    if ((flags & kSymplectic) && !(flags & (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly))) {
+      out.push_back(spec);
+    }
   }
   // Forcing options do not touch an unforced step, but the spec must still give a symplectic map.
   out.push_back("hp:alpha=0.75,solver=newton");
@@ -229,7 +233,9 @@ std::vector<std::string> variational_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
     const unsigned flags = make_integrator(spec)->info().flags;
-    if ((flags & kVariational) && !(flags & (kAdaptive | kConstraintsOnly))) out.push_back(spec);
+    if ((flags & kVariational) && !(flags & (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly))) {
+      out.push_back(spec);
+    }
   }
   return out;
 }

@@ -33,32 +33,15 @@ constexpr std::array<std::array<int, 2>, 6> kPairs = {
 
 Eigen::Vector3d column(const Vec& x, int k) { return x.segment<3>(3 * k); }
 
-class RigidBody final : public Problem {
+// The free body: V = 0, and the Lie–Poisson structure (FreeRigidBodyStructure) through Q and Π.
+class RigidBody final : public AttitudeProblem, public FreeRigidBodyStructure {
  public:
   RigidBody(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude)
-      : parameters_(parameters), attitude_(attitude) {
-    const double half_trace = 0.5 * parameters.moments.sum();
-    Vec mass(9);
-    for (int k = 0; k < 3; ++k)
-      mass.segment<3>(3 * k).setConstant(half_trace - parameters.moments[k]);
-    set_mass(mass);
-    set_capabilities(kHessian | kAngularMomentum | kConstraints | kCasimir);
-    // About 600 steps per radian of rotation at the initial rate, 100 radians.
-    const double rate = parameters.omega.norm();
-    const double unit = rate > 0 ? 1 / rate : 1.0;
-    set_defaults(0.01 * unit, 100 * unit);
-  }
-
-  // Q̇ = QΩ̂, so column k moves at Q(Ω × e_k) and p_k = d_k Q(Ω × e_k).
-  State initial_state() const override {
-    State state{0.0, Vec(9), Vec(9)};
-    for (int k = 0; k < 3; ++k) {
-      state.q.segment<3>(3 * k) = attitude_.col(k);
-      const Eigen::Vector3d rate = attitude_ * parameters_.omega.cross(Eigen::Vector3d::Unit(k));
-      state.p.segment<3>(3 * k) = mass()[3 * k] * rate;
-    }
-    return state;
-  }
+      : AttitudeProblem(parameters, attitude,
+                        kHessian | kAngularMomentum | kConstraints | kCasimir),
+        flip_axis_(
+            FreeBodyMotion(parameters.moments, parameters.moments.cwiseProduct(parameters.omega))
+                .sign_changing_axis()) {}
 
   double potential(const Vec&) const override { return 0.0; }
   void gradient(const Vec&, Vec& g) const override { g = Vec::Zero(9); }
@@ -68,12 +51,6 @@ class RigidBody final : public Problem {
     H.setZero();
     H.makeCompressed();
   }
-  // Σ_k c_k × p_k = Q J Ω: the spatial angular momentum, kept by the free body.
-  Vec angular_momentum(const Vec& q, const Vec& p) const override {
-    Eigen::Vector3d total = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) total += column(q, k).cross(column(p, k));
-    return total;
-  }
 
   // |Π|² = |QJΩ|² on the manifold: kept by the motion and by any method that keeps the spatial
   // angular momentum and QᵀQ = I.
@@ -81,65 +58,34 @@ class RigidBody final : public Problem {
     return rigid_body_body_momentum(q, p).squaredNorm();
   }
 
-  int constraint_count() const override { return 6; }
-  void constraint(const Vec& q, Vec& g) const override {
-    g.resize(6);
-    for (int r = 0; r < 6; ++r) {
-      const auto [i, j] = kPairs[r];
-      const double dot = column(q, i).dot(column(q, j));
-      g[r] = i == j ? 0.5 * (dot - 1) : dot;
-    }
-  }
-  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int r = 0; r < 6; ++r) {
-      const auto [i, j] = kPairs[r];
-      for (int l = 0; l < 3; ++l) {
-        entries.emplace_back(r, 3 * i + l, q[3 * j + l]);
-        if (i != j) entries.emplace_back(r, 3 * j + l, q[3 * i + l]);
-      }
-    }
-    G.resize(6, 9);
-    G.setFromTriplets(entries.begin(), entries.end());
-    G.makeCompressed();
-  }
-  // vᵀ∇²g_r v: |v_i|² for a norm, 2 v_i·v_j for an inner product.
-  void constraint_curvature(const Vec&, const Vec& v, Vec& c) const override {
-    c.resize(6);
-    for (int r = 0; r < 6; ++r) {
-      const auto [i, j] = kPairs[r];
-      c[r] = (i == j ? 1.0 : 2.0) * column(v, i).dot(column(v, j));
-    }
-  }
-  // Σ λ_r ∇²g_r: λ_r I₃ on block (i, i) for a norm, on blocks (i, j) and (j, i) otherwise.
-  void constraint_hessian(const Vec&, const Vec& lambda, SparseMatrix& K) const override {
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int r = 0; r < 6; ++r) {
-      const auto [i, j] = kPairs[r];
-      for (int l = 0; l < 3; ++l) {
-        entries.emplace_back(3 * i + l, 3 * j + l, lambda[r]);
-        if (i != j) entries.emplace_back(3 * j + l, 3 * i + l, lambda[r]);
-      }
-    }
-    K.resize(9, 9);
-    K.setFromTriplets(entries.begin(), entries.end());
-    K.makeCompressed();
-  }
-  std::vector<std::string> multiplier_names() const override {
-    return {"lambda11", "lambda22", "lambda33", "lambda12", "lambda13", "lambda23"};
+  // The component of Π that changes sign once per period of the elliptic motion (Π₁ in the
+  // tennis-racket flip about the intermediate axis 2), so period_measured times the flip on the
+  // 9-coordinate body as on Euler's equations.
+  double period_observable(const Vec& q, const Vec& p) const override {
+    return rigid_body_body_momentum(q, p)[flip_axis_];
   }
 
-  // The body angular momentum, for series (the tennis-racket flip shows in Pi of the
-  // intermediate axis).
-  std::vector<std::string> series_names() const override { return {"Pi1", "Pi2", "Pi3"}; }
-  void series_values(const Vec& q, const Vec& p, std::vector<double>& values) const override {
-    const Eigen::Vector3d pi = rigid_body_body_momentum(q, p);
-    values.assign(pi.data(), pi.data() + 3);
+  Eigen::Vector3d principal_moments() const override { return parameters().moments; }
+  void read_body(const Vec& q, const Vec& p, Eigen::Matrix3d& attitude,
+                 Eigen::Vector3d& body_momentum) const override {
+    attitude = AttitudeProblem::attitude(q);
+    body_momentum = rigid_body_body_momentum(q, p);
+  }
+  // q = vec(Q) and p_k = d_k Q(Ω × e_k) with Ω = J⁻¹Π: the momentum of the tangent velocity
+  // Q̇ = QΩ̂, as initial_state() builds it.
+  void write_body(const Eigen::Matrix3d& attitude, const Eigen::Vector3d& body_momentum, Vec& q,
+                  Vec& p) const override {
+    const Eigen::Vector3d omega = body_momentum.cwiseQuotient(parameters().moments);
+    q.resize(9);
+    p.resize(9);
+    for (int k = 0; k < 3; ++k) {
+      q.segment<3>(3 * k) = attitude.col(k);
+      p.segment<3>(3 * k) = mass()[3 * k] * (attitude * omega.cross(Eigen::Vector3d::Unit(k)));
+    }
   }
 
  private:
-  RigidBodyParameters parameters_;
-  Eigen::Matrix3d attitude_;
+  int flip_axis_;
 };
 
 // Sign of the permutation (a, b, c) of (0, 1, 2).
@@ -151,6 +97,124 @@ double parity(const std::array<int, 3>& order) {
 }
 
 }  // namespace
+
+AttitudeProblem::AttitudeProblem(const RigidBodyParameters& parameters,
+                                 const Eigen::Matrix3d& attitude, unsigned capabilities)
+    : parameters_(parameters), attitude_(attitude) {
+  const double half_trace = 0.5 * parameters.moments.sum();
+  Vec mass(9);
+  for (int k = 0; k < 3; ++k)
+    mass.segment<3>(3 * k).setConstant(half_trace - parameters.moments[k]);
+  set_mass(mass);
+  set_capabilities(capabilities);
+  // About 600 steps per radian of rotation at the initial rate, 100 radians.
+  const double rate = parameters.omega.norm();
+  const double unit = rate > 0 ? 1 / rate : 1.0;
+  set_defaults(0.01 * unit, 100 * unit);
+}
+
+// Q̇ = QΩ̂, so column k moves at Q(Ω × e_k) and p_k = d_k Q(Ω × e_k).
+State AttitudeProblem::initial_state() const {
+  State state{0.0, Vec(9), Vec(9)};
+  for (int k = 0; k < 3; ++k) {
+    state.q.segment<3>(3 * k) = attitude_.col(k);
+    const Eigen::Vector3d rate = attitude_ * parameters_.omega.cross(Eigen::Vector3d::Unit(k));
+    state.p.segment<3>(3 * k) = mass()[3 * k] * rate;
+  }
+  return state;
+}
+
+Eigen::Matrix3d AttitudeProblem::attitude(const Vec& q) const {
+  Eigen::Matrix3d Q;
+  for (int k = 0; k < 3; ++k) Q.col(k) = column(q, k);
+  return Q;
+}
+
+Vec AttitudeProblem::angular_momentum(const Vec& q, const Vec& p) const {
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) total += column(q, k).cross(column(p, k));
+  return total;
+}
+
+void AttitudeProblem::constraint(const Vec& q, Vec& g) const {
+  g.resize(6);
+  for (int r = 0; r < 6; ++r) {
+    const auto [i, j] = kPairs[r];
+    const double dot = column(q, i).dot(column(q, j));
+    g[r] = i == j ? 0.5 * (dot - 1) : dot;
+  }
+}
+
+void AttitudeProblem::constraint_jacobian(const Vec& q, SparseMatrix& G) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int r = 0; r < 6; ++r) {
+    const auto [i, j] = kPairs[r];
+    for (int l = 0; l < 3; ++l) {
+      entries.emplace_back(r, 3 * i + l, q[3 * j + l]);
+      if (i != j) entries.emplace_back(r, 3 * j + l, q[3 * i + l]);
+    }
+  }
+  G.resize(6, 9);
+  G.setFromTriplets(entries.begin(), entries.end());
+  G.makeCompressed();
+}
+
+// vᵀ∇²g_r v: |v_i|² for a norm, 2 v_i·v_j for an inner product.
+void AttitudeProblem::constraint_curvature(const Vec&, const Vec& v, Vec& c) const {
+  c.resize(6);
+  for (int r = 0; r < 6; ++r) {
+    const auto [i, j] = kPairs[r];
+    c[r] = (i == j ? 1.0 : 2.0) * column(v, i).dot(column(v, j));
+  }
+}
+
+// Σ λ_r ∇²g_r: λ_r I₃ on block (i, i) for a norm, on blocks (i, j) and (j, i) otherwise.
+void AttitudeProblem::constraint_hessian(const Vec&, const Vec& lambda, SparseMatrix& K) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int r = 0; r < 6; ++r) {
+    const auto [i, j] = kPairs[r];
+    for (int l = 0; l < 3; ++l) {
+      entries.emplace_back(3 * i + l, 3 * j + l, lambda[r]);
+      if (i != j) entries.emplace_back(3 * j + l, 3 * i + l, lambda[r]);
+    }
+  }
+  K.resize(9, 9);
+  K.setFromTriplets(entries.begin(), entries.end());
+  K.makeCompressed();
+}
+
+std::vector<std::string> AttitudeProblem::multiplier_names() const {
+  return {"lambda11", "lambda22", "lambda33", "lambda12", "lambda13", "lambda23"};
+}
+
+std::vector<std::string> AttitudeProblem::series_names() const { return {"Pi1", "Pi2", "Pi3"}; }
+void AttitudeProblem::series_values(const Vec& q, const Vec& p, std::vector<double>& values) const {
+  const Eigen::Vector3d pi = rigid_body_body_momentum(q, p);
+  values.assign(pi.data(), pi.data() + 3);
+}
+
+const FreeRigidBodyStructure* free_rigid_body(const Problem& problem) {
+  return dynamic_cast<const FreeRigidBodyStructure*>(&problem);
+}
+
+const AttitudeProblem* attitude_problem(const Problem& problem) {
+  return dynamic_cast<const AttitudeProblem*>(&problem);
+}
+
+Eigen::Matrix3d read_initial_attitude(Params& params, const std::string& problem) {
+  Eigen::Vector3d axis;
+  axis[0] = params.real("axis1", 0.0, "initial attitude: rotation axis, component 1");
+  axis[1] = params.real("axis2", 0.0, "initial attitude: rotation axis, component 2");
+  axis[2] = params.real("axis3", 1.0, "initial attitude: rotation axis, component 3");
+  const double angle = params.real(
+      "angle", 0.0, "initial attitude: rotation angle about the axis (rad; 0: Q = I)",
+      [](double x) { return std::abs(x) <= 1000; }, "|angle| <= 1000");
+  if (!(axis.norm() > 0)) {
+    throw InputError(fmt::format(
+        "problem '{}': the attitude axis (axis1, axis2, axis3) must be nonzero", problem));
+  }
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
 
 RigidBodyParameters read_rigid_body_parameters(Params& params, const std::string& problem) {
   const auto positive = [](double x) { return x > 0; };
@@ -261,19 +325,7 @@ Eigen::Vector3d rigid_body_body_momentum(const Vec& q, const Vec& p) {
 
 std::unique_ptr<Problem> make_rigid_body(Params& params) {
   const RigidBodyParameters P = read_rigid_body_parameters(params, "rigid_body");
-  Eigen::Vector3d axis;
-  axis[0] = params.real("axis1", 0.0, "initial attitude: rotation axis, component 1");
-  axis[1] = params.real("axis2", 0.0, "initial attitude: rotation axis, component 2");
-  axis[2] = params.real("axis3", 1.0, "initial attitude: rotation axis, component 3");
-  const double angle = params.real(
-      "angle", 0.0, "initial attitude: rotation angle about the axis (rad; 0: Q = I)",
-      [](double x) { return std::abs(x) <= 1000; }, "|angle| <= 1000");
-  if (!(axis.norm() > 0)) {
-    throw InputError(
-        "problem 'rigid_body': the attitude axis (axis1, axis2, axis3) must be nonzero");
-  }
-  const Eigen::Matrix3d attitude = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-  return std::make_unique<RigidBody>(P, attitude);
+  return std::make_unique<RigidBody>(P, read_initial_attitude(params, "rigid_body"));
 }
 
 }  // namespace geomint

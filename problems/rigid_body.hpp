@@ -48,6 +48,64 @@ class FreeBodyMotion {
   double period_ = 0;
 };
 
+// A rigid body with a fixed point and the attitude Q as 9 coordinates (its entries, column by
+// column) under the 6 constraints QᵀQ = I, masses d_k = ½(I1 + I2 + I3) − I_k (MECHANICS.md §6):
+// the constraints, the initial state Q̇ = QΩ̂ and the spatial angular momentum Σ_k c_k × p_k shared
+// by rigid_body (V = 0) and heavy_top (gravity); each adds its potential and invariants.
+class AttitudeProblem : public Problem {
+ public:
+  AttitudeProblem(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude,
+                  unsigned capabilities);
+  State initial_state() const override;
+  // Q from its columns.
+  Eigen::Matrix3d attitude(const Vec& q) const;
+  // Σ_k c_k × p_k = Q J Ω, the spatial angular momentum.
+  Vec angular_momentum(const Vec& q, const Vec& p) const override;
+  int constraint_count() const override { return 6; }
+  void constraint(const Vec& q, Vec& g) const override;
+  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override;
+  void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override;
+  void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override;
+  std::vector<std::string> multiplier_names() const override;
+  // The body angular momentum Pi1..3, for series (the tennis-racket flip shows in Π of the
+  // intermediate axis).
+  std::vector<std::string> series_names() const override;
+  void series_values(const Vec& q, const Vec& p, std::vector<double>& values) const override;
+
+ protected:
+  const RigidBodyParameters& parameters() const { return parameters_; }
+
+ private:
+  RigidBodyParameters parameters_;
+  Eigen::Matrix3d attitude_;
+};
+
+// The free rigid body's Lie–Poisson structure, offered by rigid_body and rigid_body_euler: the
+// principal moments J = diag(I1, I2, I3), and the state read as the attitude Q (the identity when
+// the state holds none, as in Euler's equations) and the body angular momentum Π, and written back
+// from them. The Lie–Poisson splitting (integrators/lie_poisson.cpp) reads and writes the state
+// only through it, and applicable() admits it only where free_rigid_body() finds it.
+class FreeRigidBodyStructure {
+ public:
+  virtual ~FreeRigidBodyStructure() = default;
+  virtual Eigen::Vector3d principal_moments() const = 0;
+  virtual void read_body(const Vec& q, const Vec& p, Eigen::Matrix3d& attitude,
+                         Eigen::Vector3d& body_momentum) const = 0;
+  virtual void write_body(const Eigen::Matrix3d& attitude, const Eigen::Vector3d& body_momentum,
+                          Vec& q, Vec& p) const = 0;
+};
+
+// The structure a problem offers, or nullptr (every other problem, and a rigid body started from
+// an `initial=` file, whose given state drops the problem's own pieces).
+const FreeRigidBodyStructure* free_rigid_body(const Problem& problem);
+// The attitude problem (rigid_body, heavy_top) behind `problem`, or nullptr: the
+// orthogonality_err_max metric reads Q through it.
+const AttitudeProblem* attitude_problem(const Problem& problem);
+
+// The initial attitude from the spec keys axis1..3 and angle (identity by default), read the same
+// way by rigid_body and heavy_top.
+Eigen::Matrix3d read_initial_attitude(Params& params, const std::string& problem);
+
 // Body angular momentum Π = Qᵀ Σ_k (Q e_k) × p_k of a rigid_body state q = vec(Q) (column by
 // column), p: on the manifold QᵀQ = I this is J Ω.
 Eigen::Vector3d rigid_body_body_momentum(const Vec& q, const Vec& p);

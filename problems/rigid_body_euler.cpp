@@ -10,11 +10,12 @@
 namespace geomint {
 namespace {
 
-class RigidBodyEuler final : public FirstOrderProblem {
+class RigidBodyEuler final : public FirstOrderProblem, public FreeRigidBodyStructure {
  public:
   RigidBodyEuler(const RigidBodyParameters& parameters, const Eigen::Vector3d& pi0,
                  const FreeBodyMotion& motion)
       : FirstOrderProblem(Vec(pi0), Capabilities(motion)),
+        moments_(parameters.moments),
         inverse_moments_(parameters.moments.cwiseInverse()),
         motion_(motion) {
     const double rate = parameters.omega.norm();
@@ -43,6 +44,18 @@ class RigidBodyEuler final : public FirstOrderProblem {
   }
   double casimir(const Vec& q, const Vec&) const override { return q.squaredNorm(); }
 
+  // The state is Π alone: no attitude to read (the identity) or to write.
+  Eigen::Vector3d principal_moments() const override { return moments_; }
+  void read_body(const Vec& q, const Vec&, Eigen::Matrix3d& attitude,
+                 Eigen::Vector3d& body_momentum) const override {
+    attitude.setIdentity();
+    body_momentum = q;
+  }
+  void write_body(const Eigen::Matrix3d&, const Eigen::Vector3d& body_momentum, Vec& q,
+                  Vec&) const override {
+    q = body_momentum;
+  }
+
  private:
   static unsigned Capabilities(const FreeBodyMotion& motion) {
     if (!motion.exact()) return kCasimir;
@@ -54,6 +67,7 @@ class RigidBodyEuler final : public FirstOrderProblem {
     return m;
   }
 
+  Eigen::Vector3d moments_;
   Eigen::Vector3d inverse_moments_;
   FreeBodyMotion motion_;
 };

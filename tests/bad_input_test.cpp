@@ -84,6 +84,12 @@ const std::vector<Case>& cases() {
       {"RigidBodyTriangleInequality",
        "run --problem rigid_body:I1=1,I2=1.2,I3=2.5 --method rattle --dt 0.1 --t-end 1", 2,
        "I3 = 2.5 must be < I1 + I2 = 2.2 (triangle inequality"},
+      // --- the Lie–Poisson splitting runs on free rigid bodies only (applicable()) ---
+      {"LiePoissonOnKepler", "run --problem kepler --method lie_poisson --dt 0.1 --t-end 1", 2,
+       "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
+      {"LiePoissonOrderThree",
+       "run --problem rigid_body_euler --method lie_poisson:order=3 --dt 0.1 --t-end 1", 2,
+       "order"},
       // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,

@@ -11,17 +11,20 @@
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
+#include "integrators/free_rigid_body_methods.hpp"
 #include "verify/verify.hpp"
 
 namespace geomint {
 namespace {
 
 // Constraints-only methods (rattle, penalty) are checked on constrained problems instead
-// (integrators/constrained_methods_test.cpp): the problems here have no constraints.
+// (integrators/constrained_methods_test.cpp): the problems here have no constraints; the
+// free-rigid-body splitting on the rigid bodies (integrators/lie_poisson_test.cpp).
 std::vector<std::string> fixed_step_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
-    if (!(make_integrator(spec)->info().flags & (kAdaptive | kConstraintsOnly))) {
+    if (!(make_integrator(spec)->info().flags &
+          (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly))) {
       out.push_back(spec);
     }
   }

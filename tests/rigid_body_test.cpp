@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -93,6 +94,89 @@ TEST(RigidBodyRuns, CasimirKeptByRattleAndDriftingUnderOdeSolvers) {
   const RunResult cvode = run(euler, "cvode_bdf", 0.05, 1000);
   ASSERT_TRUE(cvode.ok) << cvode.record.message.value_or("");
   EXPECT_GT(cvode.record.metrics.at("casimir_err_max"), 1e-8);  // measured 1.6e-5
+}
+
+// orthogonality_err_max = max ‖QᵀQ − I‖_F: at round-off for RATTLE (projected onto QᵀQ = I every
+// step) and for the Lie–Poisson splitting (products of rotations), far from it for the penalty
+// contrast, which only pulls Q back by a stiff spring (the check can fail); reported only where
+// the state holds an attitude.
+TEST(RigidBodyRuns, OrthogonalityErrorIsRoundOffForExactMethodsOnly) {
+  for (const std::string method : {"rattle", "lie_poisson", "lie_poisson:order=4"}) {
+    const RunResult result = run(kBody, method, 0.05, 200);
+    ASSERT_TRUE(result.ok) << method << ": " << result.record.message.value_or("");
+    EXPECT_LE(result.record.metrics.at("orthogonality_err_max"), 1e-13) << method;
+  }
+  const RunResult penalty = run(kBody, "penalty:k=1e4", 0.002, 5);
+  ASSERT_TRUE(penalty.ok) << penalty.record.message.value_or("");
+  EXPECT_GT(penalty.record.metrics.at("orthogonality_err_max"), 1e-6);
+  const RunResult euler = run("rigid_body_euler", "lie_poisson", 0.05, 1);
+  ASSERT_TRUE(euler.ok);
+  EXPECT_EQ(euler.record.metrics.count("orthogonality_err_max"), 0u);
+  EXPECT_EQ(run("kepler", "rk4", 0.05, 1).record.metrics.count("orthogonality_err_max"), 0u);
+}
+
+// The splitting through the harness on the 9-coordinate body: the Casimir, the spatial angular
+// momentum and the constraints at round-off, over 4000 steps.
+TEST(RigidBodyRuns, LiePoissonKeepsEveryInvariantOfTheFreeBody) {
+  const auto problem = make_problem(kBody);
+  const State start = problem->initial_state();
+  const double momentum = problem->angular_momentum(start.q, start.p).norm();
+  for (const std::string method : {"lie_poisson", "lie_poisson:order=4"}) {
+    const RunResult result = run(kBody, method, 0.05, 200);
+    ASSERT_TRUE(result.ok) << method;
+    const auto& metrics = result.record.metrics;
+    EXPECT_LE(metrics.at("casimir_err_max"), 1e-13) << method;
+    EXPECT_LE(metrics.at("angular_momentum_err_max"), 1e-13 * momentum) << method;
+    EXPECT_LE(metrics.at("constraint_err_max"), 1e-13) << method;
+    EXPECT_LE(metrics.at("constraint_vel_err_max"), 1e-13 * momentum) << method;
+    // Symplectic, not energy-exact: a bounded error of the splitting's order.
+    EXPECT_GT(metrics.at("energy_err_max"), 1e-10) << method;
+    EXPECT_LT(metrics.at("energy_err_max"), 1e-2) << method;
+  }
+}
+
+// The heavy top at non-unit moments, mass, gravity and centre of mass. Released from rest, the
+// centre of mass falls (the sign of V = m g e₃ᵀQχ); a spinning top under RATTLE keeps the vertical
+// spatial angular momentum to round-off and the energy to O(h²), while the horizontal components
+// change under the gravity torque (so the vertical one is not kept by accident).
+const std::string kTop =
+    "heavy_top:I1=1.7,I2=2.9,I3=3.6,m=2.5,g=3.7,chi1=0.2,chi2=-0.1,chi3=0.6,omega1=0.4,"
+    "omega2=-0.3,omega3=6,axis1=1,axis2=0.5,axis3=0,angle=0.7";
+
+double height_of_centre(const Problem& problem, const Vec& q) {
+  return (attitude_problem(problem)->attitude(q) * Eigen::Vector3d(0.2, -0.1, 0.6))[2];
+}
+
+TEST(HeavyTopRuns, FallsFromRestAndKeepsEnergyAndVerticalMomentum) {
+  const std::string resting =
+      "heavy_top:I1=1.7,I2=2.9,I3=3.6,m=2.5,g=3.7,chi1=0.2,chi2=-0.1,chi3=0.6,omega1=0,omega2=0,"
+      "omega3=0,axis1=1,axis2=0.5,axis3=0,angle=0.7";
+  const auto rest_problem = make_problem(resting);
+  const RunResult fall = run(resting, "rattle", 0.01, 0.3);
+  ASSERT_TRUE(fall.ok);
+  EXPECT_LT(height_of_centre(*rest_problem, fall.final_state.q),
+            height_of_centre(*rest_problem, rest_problem->initial_state().q) - 1e-3);
+
+  const auto top = make_problem(kTop);
+  const State start = top->initial_state();
+  ASSERT_EQ(top->angular_momentum(start.q, start.p).size(), 1);
+  const double vertical = std::abs(top->angular_momentum(start.q, start.p)[0]);
+  for (const std::string method : {"rattle", "hp"}) {
+    const RunResult result = run(kTop, method, 0.005, 10);
+    ASSERT_TRUE(result.ok) << method << ": " << result.record.message.value_or("");
+    const auto& metrics = result.record.metrics;
+    EXPECT_LE(metrics.at("angular_momentum_err_max"), 1e-12 * vertical) << method;
+    EXPECT_LE(metrics.at("energy_err_max"), 1e-3) << method;
+    EXPECT_LE(metrics.at("orthogonality_err_max"), 1e-13) << method;
+    const AttitudeProblem& body = *attitude_problem(*top);
+    const Eigen::Matrix3d Q0 = body.attitude(start.q), Q = body.attitude(result.final_state.q);
+    Eigen::Vector3d spatial0 = Eigen::Vector3d::Zero(), spatial = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      spatial0 += Q0.col(k).cross(Eigen::Vector3d(start.p.segment<3>(3 * k)));
+      spatial += Q.col(k).cross(Eigen::Vector3d(result.final_state.p.segment<3>(3 * k)));
+    }
+    EXPECT_GT((spatial - spatial0).head<2>().norm(), 1e-3 * spatial0.norm()) << method;
+  }
 }
 
 }  // namespace

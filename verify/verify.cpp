@@ -8,6 +8,7 @@
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
+#include "integrators/free_rigid_body_methods.hpp"
 
 namespace geomint::verify {
 namespace {
@@ -210,6 +211,7 @@ CheckResult run_check(const std::string& method, const std::string& name,
                             : not_declared("constraint_kept", method, "constraints-only");
   }
   if (constraints_only) return not_declared(name.c_str(), method, "unconstrained");
+  if (flags & kFreeRigidBodyOnly) return not_declared(name.c_str(), method, "free-rigid-body-only");
   if (name == "declared_order_pendulum" || name == "declared_order_kepler") {
     if (flags & kAdaptive) return not_declared(name.c_str(), method, "fixed-step");
     return declared_order(method,
