@@ -20,6 +20,7 @@
 #include "harness/order.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference_generator.hpp"
+#include "harness/report.hpp"
 #include "harness/run.hpp"
 #include "harness/shard.hpp"
 #include "harness/structure_metrics.hpp"
@@ -38,7 +39,7 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 3;
 
 const std::vector<std::string> kCommands = {"list",  "run",       "order", "sweep", "merge",
-                                            "slurm", "reference", "gate",  "modes"};
+                                            "slurm", "reference", "gate",  "modes", "report"};
 
 // CLI11 says "A subcommand is required" for a missing or unknown verb; say which verbs exist.
 // Returns false (message printed) when argv[1] is not an option and not a command.
@@ -418,6 +419,8 @@ int run_main(int argc, char** argv) {
                    "(results/<scene>, results/<scene>/quick)")
       ->required();
 
+  ReportCommand report(app);  // harness/report.cpp
+
   if (!check_command(program, argc, argv)) return kExitBadInput;
   try {
     app.parse(argc, argv);
@@ -435,6 +438,7 @@ int run_main(int argc, char** argv) {
 
   const std::string command_line = joined_command_line(argc, argv);
   try {
+    if (report.selected()) return report.run(command_line);
     if (*list) {
       if (list_what != "problems") print_methods(list_markdown);
       if (list_what == "all") fmt::print("\n");

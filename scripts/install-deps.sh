@@ -12,6 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev
   clang libclang-rt-14-dev python3
+  tidy chromium
 )
 if [ "${1:-}" = cluster ]; then
   shift
