@@ -42,6 +42,7 @@ pre { background: #f4f4f4; padding: 0.6em; overflow-x: auto; white-space: pre-wr
 table { border-collapse: collapse; font-size: 0.85em; }
 th, td { border: 1px solid #ddd; padding: 0.2em 0.5em; white-space: nowrap; text-align: left; }
 th { background: #eee; position: sticky; top: 0; }
+td.claim { white-space: normal; min-width: 30em; }
 tbody tr:nth-child(even) { background: #fafafa; }
 .pass { color: #176317; } .fail { color: #a51d1d; font-weight: bold; } .none { color: #666; }
 ul.gates { list-style: none; padding-left: 0.5em; }
@@ -288,7 +289,7 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
                           page.failed ? "FAIL" : "PASS", page.passed, page.passed + page.failed);
     }
     html += fmt::format(
-        "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td><strong>{1}</strong><br>{2}</td>"
+        "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td class=\"claim\"><strong>{1}</strong><br>{2}</td>"
         "<td>{3}</td><td>{4}</td></tr>\n",
         html_escape(page.name), html_escape(page.title), html_escape(page.headline), gates,
         page.tables.size());
