@@ -33,7 +33,8 @@ namespace {
 // The site's marker: --out is replaced whole, so only a folder holding it may be replaced.
 constexpr const char* kMarker = ".geomint-report";
 
-constexpr const char* kStyle = R"(body { font-family: sans-serif; margin: 1.5em auto; max-width: 75em;
+constexpr const char* kStyle =
+    R"(body { font-family: sans-serif; margin: 1.5em auto; max-width: 75em;
   padding: 0 1em; line-height: 1.4; color: #222; }
 h1 { font-size: 1.6em; } h2 { font-size: 1.3em; margin-top: 1.6em; } h3 { font-size: 1.1em; }
 code, pre { font-family: monospace; font-size: 0.9em; }
@@ -162,10 +163,10 @@ std::string gate_list(const std::vector<const GateOutcome*>& outcomes) {
   std::string html = "<ul class=\"gates\">\n";
   for (const GateOutcome* outcome : outcomes) {
     const char* verdict = outcome->passed ? "PASS" : "FAIL";
-    html += fmt::format("<li class=\"{}\"><strong>{}</strong> {} ({} row(s): <code>{}</code>)",
-                        outcome->passed ? "pass" : "fail", verdict,
-                        html_escape(outcome->gate->name), outcome->rows_checked,
-                        html_escape(outcome->gate->column));
+    html +=
+        fmt::format("<li class=\"{}\"><strong>{}</strong> {} ({} row(s): <code>{}</code>)",
+                    outcome->passed ? "pass" : "fail", verdict, html_escape(outcome->gate->name),
+                    outcome->rows_checked, html_escape(outcome->gate->column));
     if (!outcome->lines.empty()) {
       std::string lines;
       for (const auto& line : outcome->lines) lines += html_escape(line) + "\n";
@@ -193,9 +194,9 @@ std::string cite_block(const ScenePage& page, const CsvTable& table, const std::
       "@misc{{geomint_{}_{},\n  title  = {{geomint: {} ({}.csv)}},\n"
       "  note   = {{geomint version {}, commit {}, scene {}, table {}.csv}},\n"
       "  year   = {{{}}}\n}}\n",
-      version, sha.empty() ? "unknown" : sha, page.name, stem,
-      table.value("variant", "full"), date, page.name, stem, page.title, stem, version,
-      sha.empty() ? "unknown" : sha, page.name, stem, year);
+      version, sha.empty() ? "unknown" : sha, page.name, stem, table.value("variant", "full"), date,
+      page.name, stem, page.title, stem, version, sha.empty() ? "unknown" : sha, page.name, stem,
+      year);
   return "<details><summary>Cite this table</summary><pre>" + html_escape(text) +
          "</pre></details>\n";
 }
@@ -210,16 +211,17 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
   if (page.passed + page.failed == 0) {
     html += "<span class=\"none\">none</span>";
   } else {
-    html += fmt::format("<span class=\"{}\">{} of {} passed</span>",
-                        page.failed ? "fail" : "pass", page.passed, page.passed + page.failed);
+    html += fmt::format("<span class=\"{}\">{} of {} passed</span>", page.failed ? "fail" : "pass",
+                        page.passed, page.passed + page.failed);
   }
   html += ".</p>\n" + page.narrative_html;
   if (!page.images.empty()) {
     html += "<h2>Figures</h2>\n";
     for (const auto& image : page.images) {
-      html += fmt::format("<figure><img src=\"{0}\" alt=\"{0}\"><figcaption>{0}</figcaption>"
-                          "</figure>\n",
-                          html_escape(image));
+      html += fmt::format(
+          "<figure><img src=\"{0}\" alt=\"{0}\"><figcaption>{0}</figcaption>"
+          "</figure>\n",
+          html_escape(image));
     }
   }
   if (page.tables.empty()) {
@@ -237,9 +239,8 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
     }
     html += gate_list(checks);
     html += csv_table_html(table, file_name);
-    html += fmt::format(
-        "<p>{} rows; full precision in <a href=\"{}\">{}</a>.</p>\n", table.rows.size(),
-        html_escape(file_name), html_escape(file_name));
+    html += fmt::format("<p>{} rows; full precision in <a href=\"{}\">{}</a>.</p>\n",
+                        table.rows.size(), html_escape(file_name), html_escape(file_name));
     html += cite_block(page, table, stem) + "</section>\n";
   }
   std::vector<const GateOutcome*> other;  // gates over every table of the scene
@@ -250,11 +251,12 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
   if (!page.tables.empty()) {
     const CsvTable& first = page.tables.front();
     html += "<h2>Provenance</h2>\n" + provenance_block(first);
-    html += "<h2>Reproduce</h2>\n<pre>" +
-            html_escape(options.quick
-                            ? fmt::format("make gate-quick SCENES={0}\nmake report-quick", page.name)
-                            : fmt::format("make reproduce-figures SCENES={0}", page.name)) +
-            "</pre>\n";
+    html +=
+        "<h2>Reproduce</h2>\n<pre>" +
+        html_escape(options.quick
+                        ? fmt::format("make gate-quick SCENES={0}\nmake report-quick", page.name)
+                        : fmt::format("make reproduce-figures SCENES={0}", page.name)) +
+        "</pre>\n";
     const std::string command = first.value("command");
     if (!command.empty()) {
       html += "<p>The tables' own command:</p>\n<pre>" + html_escape(command) + "</pre>\n";
@@ -280,8 +282,9 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
       }(),
       options.quick ? "CI-sized --quick runs" : "published runs", html_escape(options.gates_path),
       failed ? "fail" : "pass", passed, passed + failed);
-  html += "<div class=\"scroll\"><table>\n<thead><tr><th>Scene</th><th>Claim</th><th>Gates</th>"
-          "<th>Tables</th></tr></thead>\n<tbody>\n";
+  html +=
+      "<div class=\"scroll\"><table>\n<thead><tr><th>Scene</th><th>Claim</th><th>Gates</th>"
+      "<th>Tables</th></tr></thead>\n<tbody>\n";
   for (const auto& page : pages) {
     std::string gates = "<span class=\"none\">none</span>";
     if (page.passed + page.failed > 0) {
@@ -289,16 +292,18 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
                           page.failed ? "FAIL" : "PASS", page.passed, page.passed + page.failed);
     }
     html += fmt::format(
-        "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td class=\"claim\"><strong>{1}</strong><br>{2}</td>"
+        "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td "
+        "class=\"claim\"><strong>{1}</strong><br>{2}</td>"
         "<td>{3}</td><td>{4}</td></tr>\n",
         html_escape(page.name), html_escape(page.title), html_escape(page.headline), gates,
         page.tables.size());
   }
   html += "</tbody>\n</table></div>\n";
-  html += "<h2>Reproduce</h2>\n<pre>" +
-          html_escape(options.quick ? "make gate-quick && make report-quick"
-                                    : "make reproduce-figures   # sweeps, figures, then this site") +
-          "</pre>\n";
+  html +=
+      "<h2>Reproduce</h2>\n<pre>" +
+      html_escape(options.quick ? "make gate-quick && make report-quick"
+                                : "make reproduce-figures   # sweeps, figures, then this site") +
+      "</pre>\n";
   return html + "</main>\n" + footer(options, generator);
 }
 
@@ -387,12 +392,23 @@ std::string html_escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -448,8 +464,8 @@ std::string markdown_to_html(const std::string& markdown,
     }
     const bool bullet = starts_with(line, "- ") || starts_with(line, "* ");
     const size_t digits = line.find_first_not_of("0123456789");
-    const bool numbered = digits > 0 && digits != std::string::npos &&
-                          line.compare(digits, 2, ". ") == 0;
+    const bool numbered =
+        digits > 0 && digits != std::string::npos && line.compare(digits, 2, ". ") == 0;
     if (bullet || numbered) {
       const std::string tag = bullet ? "ul" : "ol";
       if (!paragraph.empty() || (!items.empty() && tag != list_tag)) flush();
@@ -470,17 +486,17 @@ std::string markdown_to_html(const std::string& markdown,
 
 std::string csv_table_html(const CsvTable& table, const std::string& file_name) {
   const std::vector<Row> rows = rows_with_short_specs(table.rows);
-  std::string html = fmt::format(
-      "<div class=\"scroll\"><table data-csv=\"{}\" data-rows=\"{}\">\n<thead><tr>",
-      html_escape(file_name), rows.size());
+  std::string html =
+      fmt::format("<div class=\"scroll\"><table data-csv=\"{}\" data-rows=\"{}\">\n<thead><tr>",
+                  html_escape(file_name), rows.size());
   for (const auto& column : table.columns) html += "<th>" + html_escape(column) + "</th>";
   html += "</tr></thead>\n<tbody>\n";
   for (const Row& row : rows) {
     html += "<tr>";
     for (const auto& column : table.columns) {
       const auto found = row.find(column);
-      html += "<td>" + (found == row.end() ? "" : html_escape(shorten_number(found->second))) +
-              "</td>";
+      html +=
+          "<td>" + (found == row.end() ? "" : html_escape(shorten_number(found->second))) + "</td>";
     }
     html += "</tr>\n";
   }
@@ -522,9 +538,9 @@ ReportSummary write_report(const ReportOptions& given) {
   }
   std::sort(folders.begin(), folders.end());
   if (folders.empty()) {
-    throw InputError(fmt::format(
-        "report: --results '{}' holds no scene (no <scene>/scene.toml folder in it)",
-        options.results_dir));
+    throw InputError(
+        fmt::format("report: --results '{}' holds no scene (no <scene>/scene.toml folder in it)",
+                    options.results_dir));
   }
   std::vector<ScenePage> pages;
   for (const auto& folder : folders) pages.push_back(load_scene_page(folder, options, gates, out));
@@ -533,8 +549,8 @@ ReportSummary write_report(const ReportOptions& given) {
       options.generator.empty() ? fmt::format("geomint {} ({})", build_version(), build_git_sha())
                                 : options.generator;
   // Written beside --out and renamed onto it: a failure leaves the previous site as it was.
-  const fs::path partial = out.parent_path() / fmt::format(".{}.partial-{}",
-                                                           out.filename().string(), ::getpid());
+  const fs::path partial =
+      out.parent_path() / fmt::format(".{}.partial-{}", out.filename().string(), ::getpid());
   fs::remove_all(partial);
   ReportSummary summary;
   try {

@@ -19,9 +19,9 @@ struct ReportOptions {
   std::string results_dir = "results";  // holds <scene>/scene.toml folders
   std::string gates_path;               // "" = <results_dir>/gates.toml (absent: no gates)
   std::string out_dir = "site";
-  bool quick = false;         // the CI-sized tables of results/<scene>/quick/
-  std::string generator;      // footer "made by"; "" = this build's version and SHA
-  std::string command_line;   // the `geomint report ...` command, shown as how to rebuild
+  bool quick = false;        // the CI-sized tables of results/<scene>/quick/
+  std::string generator;     // footer "made by"; "" = this build's version and SHA
+  std::string command_line;  // the `geomint report ...` command, shown as how to rebuild
 };
 
 struct ReportSummary {

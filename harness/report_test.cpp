@@ -61,9 +61,10 @@ TEST_F(ReportTest, PagesMatchTheGoldenFiles) {
   const std::string results_from_page =
       fs::relative(kFixture / "results", dir_ / "site" / "tiny").generic_string();
   const bool update = std::getenv("GEOMINT_UPDATE_GOLDEN") != nullptr;
-  for (const auto& [page, golden] : {std::pair<std::string, std::string>{"index.html", "index.html"},
-                                     {"tiny/index.html", "tiny.html"},
-                                     {"bare/index.html", "bare.html"}}) {
+  for (const auto& [page, golden] :
+       {std::pair<std::string, std::string>{"index.html", "index.html"},
+        {"tiny/index.html", "tiny.html"},
+        {"bare/index.html", "bare.html"}}) {
     const std::string written =
         replace_all(replace_all(read_text(dir_ / "site" / page), results_from_page, "@RESULTS@"),
                     kFixture.string(), "@FIXTURE@");
