@@ -7,6 +7,7 @@ SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-quick gates gate-quick bench \
         format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables \
+        report report-quick \
         test-cluster test-external
 
 all: build
@@ -27,6 +28,7 @@ build: configure
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
+	@$(MAKE) --no-print-directory report-quick SITE=$(BUILD_DIR)/site-quick
 	@$(MAKE) --no-print-directory test-external
 
 test-external: build
@@ -91,6 +93,17 @@ fuzz: sanitize-build
 reproduce-figures: build
 	@bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
 	@bash scripts/scaling.sh $(BUILD_DIR)
+	@$(MAKE) --no-print-directory report
+
+# The results site (docs/REPORT.md): site/index.html and one page per scene, from the committed
+# tables and results/gates.toml; opens from file://. report-quick: the CI-sized tables of
+# results/<scene>/quick/ (after gate-quick; `make test` writes it to $(BUILD_DIR)/site-quick).
+SITE ?= site
+report: build
+	@$(BUILD_DIR)/geomint report --results results --gates $(GATES) --out $(SITE)
+
+report-quick: build
+	@$(BUILD_DIR)/geomint report --quick --results results --gates $(GATES) --out $(SITE)
 
 # CI-sized variant: quick_* settings, output under results/<scene>/quick/ (not committed).
 reproduce-quick: build

@@ -37,7 +37,8 @@ int run_main(int argc, char** argv) {
   // The order of `geomint --help`.
   const std::vector<Verb> verbs = {add_list(app),      add_run(app),   add_order(app),
                                    add_sweep(app),     add_merge(app), add_slurm(app),
-                                   add_reference(app), add_modes(app), add_gate(app)};
+                                   add_reference(app), add_modes(app), add_gate(app),
+                                   add_report(app)};
   std::vector<std::string> commands;
   for (const Verb& verb : verbs) commands.push_back(verb.name);
 

@@ -642,6 +642,10 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
   write_file_atomic((out / "table.md").string(), scene_markdown(scene, tables, timed_command));
 }
 
+std::vector<Row> rows_with_short_specs(std::vector<Row> rows) {
+  return with_short_specs(std::move(rows));
+}
+
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                            const std::string& command_line) {
   std::string markdown = fmt::format("# {}\n\n", scene.title);

@@ -60,6 +60,10 @@ struct SceneTables {
 // order_points.csv's columns: the record columns with the ladder level moved after the label.
 std::vector<std::string> order_points_columns(std::vector<std::string> record_columns);
 
+// Rows with their method and problem specs as table.md shows them (only the options that differ
+// from the defaults); `geomint report` shows its tables the same way.
+std::vector<Row> rows_with_short_specs(std::vector<Row> rows);
+
 // table.md: the scene's title and description, then a Markdown table per non-empty table.
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                            const std::string& command_line);

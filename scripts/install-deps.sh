@@ -12,7 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev
   clang libclang-rt-14-dev python3
-  libxml2-utils
+  libxml2-utils tidy chromium
 )
 if [ "${1:-}" = cluster ]; then
   shift

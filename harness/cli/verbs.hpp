@@ -16,5 +16,6 @@ Verb add_slurm(CLI::App& app);
 Verb add_reference(CLI::App& app);
 Verb add_modes(CLI::App& app);
 Verb add_gate(CLI::App& app);
+Verb add_report(CLI::App& app);
 
 }  // namespace geomint::cli

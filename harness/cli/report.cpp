@@ -1,0 +1,35 @@
+// `geomint report`: the static results site (harness/report.hpp, docs/REPORT.md): every scene's
+// tables, figures and gate verdicts, written into a folder it replaces whole.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "harness/cli/verbs.hpp"
+#include "harness/report.hpp"
+
+namespace geomint::cli {
+
+Verb add_report(CLI::App& app) {
+  auto options = std::make_shared<ReportOptions>();
+  auto* command = app.add_subcommand(
+      "report", "Write the results site (HTML: every scene's tables, figures, gate verdicts)");
+  command->add_option("--results", options->results_dir,
+                      "folder of <scene>/scene.toml scenes (default: results)");
+  command->add_option("--gates", options->gates_path,
+                      "gates file checked on each scene (default: <results>/gates.toml)");
+  command->add_option("--out", options->out_dir, "site folder, replaced whole (default: site)");
+  command->add_flag("--quick", options->quick,
+                    "the CI-sized tables of <scene>/quick/ (make gate-quick writes them)");
+  return {"report", command, [options](const Context& context) {
+            options->command_line = context.command_line;
+            const ReportSummary summary = write_report(*options);
+            // 0 once written: the gate verdicts are in the pages (`geomint gate` is what fails).
+            fmt::print(stderr, "report: {} scenes, {} tables, gates {} passed, {} failed; open {}\n",
+                       summary.scenes, summary.tables, summary.gates_passed, summary.gates_failed,
+                       (std::filesystem::path(options->out_dir) / "index.html").string());
+            return kExitOk;
+          }};
+}
+
+}  // namespace geomint::cli

@@ -1,0 +1,135 @@
+// Tests of the results site writer (harness/report.hpp, docs/REPORT.md): golden pages built from
+// the fixture scenes of tests/report/results/, escaping, the Markdown subset, gate verdicts and
+// the replace-only-our-own-site rule. GEOMINT_UPDATE_GOLDEN=1 rewrites the golden files.
+#include "harness/report.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "problems/spec.hpp"
+
+namespace geomint {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kFixture = fs::path(GEOMINT_SOURCE_DIR) / "tests" / "report";
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+class ReportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("geomint_report_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  ReportSummary write_fixture_site() {
+    ReportOptions options;
+    options.results_dir = (kFixture / "results").string();
+    options.out_dir = (dir_ / "site").string();
+    options.generator = "geomint (fixture)";
+    options.command_line = "geomint report --results tests/report/results";
+    return write_report(options);
+  }
+  fs::path dir_;
+};
+
+// The pages, byte for byte. The README's link out of the scene points back into the source tree
+// from wherever the site is, and the index names the gates file as given: the machine-dependent
+// texts, shown as @RESULTS@ and @FIXTURE@.
+TEST_F(ReportTest, PagesMatchTheGoldenFiles) {
+  write_fixture_site();
+  const std::string results_from_page =
+      fs::relative(kFixture / "results", dir_ / "site" / "tiny").generic_string();
+  const bool update = std::getenv("GEOMINT_UPDATE_GOLDEN") != nullptr;
+  for (const auto& [page, golden] :
+       {std::pair<std::string, std::string>{"index.html", "index.html"},
+        {"tiny/index.html", "tiny.html"},
+        {"bare/index.html", "bare.html"}}) {
+    const std::string written =
+        replace_all(replace_all(read_text(dir_ / "site" / page), results_from_page, "@RESULTS@"),
+                    kFixture.string(), "@FIXTURE@");
+    const fs::path golden_path = kFixture / "golden" / golden;
+    if (update) {
+      std::ofstream(golden_path, std::ios::binary) << written;
+      continue;
+    }
+    EXPECT_EQ(written, read_text(golden_path))
+        << page << " differs from " << golden_path
+        << " (GEOMINT_UPDATE_GOLDEN=1 rewrites it after a deliberate change)";
+  }
+}
+
+TEST_F(ReportTest, CopiesTablesAndFiguresNextToThePages) {
+  const ReportSummary summary = write_fixture_site();
+  EXPECT_EQ(summary.scenes, 2);
+  EXPECT_EQ(summary.tables, 2);
+  EXPECT_EQ(summary.gates_passed, 2);  // energy bound and "every row ok"
+  EXPECT_EQ(summary.gates_failed, 1);  // implicit Euler's order, failing on purpose
+  for (const char* file : {"style.css", "tiny/summary.csv", "tiny/order.csv", "tiny/energy.png"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "site" / file)) << file;
+  }
+  EXPECT_EQ(read_text(dir_ / "site" / "tiny" / "order.csv"),
+            read_text(kFixture / "results" / "tiny" / "order.csv"));
+}
+
+TEST_F(ReportTest, TablesHaveOneHtmlRowPerCsvRow) {
+  CsvTable table = parse_csv_table("a,b\n1,x\n2,\n3,\"<y>\"\n", "t.csv");
+  const std::string html = csv_table_html(table, "t.csv");
+  size_t body_rows = 0;
+  for (size_t at = html.find("<tr>"); at != std::string::npos; at = html.find("<tr>", at + 1)) {
+    ++body_rows;
+  }
+  EXPECT_EQ(body_rows, 1 + table.rows.size());  // the header row, then one per CSV row
+  EXPECT_NE(html.find("data-rows=\"3\""), std::string::npos);
+  EXPECT_NE(html.find("<td>&lt;y&gt;</td>"), std::string::npos);
+  EXPECT_NE(html.find("<td>2</td><td></td>"), std::string::npos);  // an empty cell stays a cell
+}
+
+TEST(ReportHtml, EscapesEveryMarkupCharacter) {
+  EXPECT_EQ(html_escape("<a href=\"x\">'&'</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;");
+}
+
+TEST(ReportHtml, RendersTheMarkdownSubset) {
+  EXPECT_EQ(markdown_to_html("# T\n\npara `a<b>` and [l](u.csv)\n\n- x\n- y\n"),
+            "<h2>T</h2>\n<p>para <code>a&lt;b&gt;</code> and <a href=\"u.csv\">l</a></p>\n"
+            "<ul>\n<li>x</li>\n<li>y</li>\n</ul>\n");
+  EXPECT_EQ(markdown_to_html("```\n<x>\n```\n"), "<pre><code>&lt;x&gt;\n</code></pre>\n");
+  EXPECT_EQ(markdown_to_html("2. b\n10. c\n"), "<ol>\n<li>b</li>\n<li>c</li>\n</ol>\n");
+}
+
+// --out is replaced whole: a folder the verb did not write is refused and left as it was.
+TEST_F(ReportTest, RefusesToReplaceAFolderItDidNotWrite) {
+  fs::create_directories(dir_ / "site");
+  std::ofstream(dir_ / "site" / "notes.txt") << "mine";
+  EXPECT_THROW(write_fixture_site(), InputError);
+  EXPECT_EQ(read_text(dir_ / "site" / "notes.txt"), "mine");
+  fs::remove(dir_ / "site" / "notes.txt");
+  write_fixture_site();
+  write_fixture_site();  // its own site, replaced
+  EXPECT_TRUE(fs::exists(dir_ / "site" / "tiny" / "index.html"));
+  EXPECT_FALSE(fs::exists(dir_ / "site" / "notes.txt"));
+}
+
+}  // namespace
+}  // namespace geomint
