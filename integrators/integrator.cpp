@@ -162,7 +162,7 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
                         "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
                         "{}",
-                        method.spec(), problem.name(), fmt::join(general_lagrangian_methods(), ", "))};
+                        method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "))};
   }
   // On a non-separable problem the second derivatives come from its LagrangianSystem.
   if ((info.flags & kNeedsHessian) && !problem.has(kHessian) && !is_non_separable(problem)) {

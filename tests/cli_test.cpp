@@ -265,6 +265,26 @@ TEST(Cli, SeriesIsStreamedNotHeldInMemory) {
   fs::remove(short_series);
 }
 
+// Registry entries whose README row is still to be pasted: README.md is being restructured on a
+// parallel branch, so this branch (issue 25, first step) leaves it alone and the row is added at
+// merge with `make readme-tables`; empty this list then (the tests below fail if a listed name
+// is already in the README, so it cannot go stale).
+const std::set<std::string> kRowsAwaitingReadme = {"double_pendulum"};
+
+// `geomint list ... --markdown` without the rows of kRowsAwaitingReadme.
+std::string without_awaiting_rows(const std::string& listing) {
+  std::istringstream in(listing);
+  std::string out;
+  for (std::string row; std::getline(in, row);) {
+    bool awaiting = false;
+    for (const auto& name : kRowsAwaitingReadme) {
+      awaiting = awaiting || row.rfind("| `" + name + "` |", 0) == 0;
+    }
+    if (!awaiting) out += row + "\n";
+  }
+  return out;
+}
+
 std::set<std::string> readme_table_names(const std::string& marker) {
   std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
   std::string line;
@@ -350,26 +370,6 @@ TEST(Cli, ListColumnsStayAlignedForTheLongestEntries) {
 }
 
 // The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of README.md.
-// Registry entries whose README row is still to be pasted: README.md is being restructured on a
-// parallel branch, so this branch (issue 25, first step) leaves it alone and the row is added at
-// merge with `make readme-tables`; empty this list then (the tests below fail if a listed name
-// is already in the README, so it cannot go stale).
-const std::set<std::string> kRowsAwaitingReadme = {"double_pendulum"};
-
-// `geomint list ... --markdown` without the rows of kRowsAwaitingReadme.
-std::string without_awaiting_rows(const std::string& listing) {
-  std::istringstream in(listing);
-  std::string out;
-  for (std::string row; std::getline(in, row);) {
-    bool awaiting = false;
-    for (const auto& name : kRowsAwaitingReadme) {
-      awaiting = awaiting || row.rfind("| `" + name + "` |", 0) == 0;
-    }
-    if (!awaiting) out += row + "\n";
-  }
-  return out;
-}
-
 std::string readme_block(const std::string& marker) {
   std::ifstream in(std::string(GEOMINT_SOURCE_DIR) + "/README.md");
   std::string line, block;
