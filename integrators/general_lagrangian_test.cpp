@@ -32,7 +32,8 @@ State run(Integrator& method, const Problem& problem, State state, double h, lon
 double fitted_order(const std::vector<double>& steps, const std::vector<double>& errors) {
   double mx = 0, my = 0;
   const double n = static_cast<double>(steps.size());
-  for (size_t i = 0; i < steps.size(); ++i) mx += std::log(steps[i]) / n, my += std::log(errors[i]) / n;
+  for (size_t i = 0; i < steps.size(); ++i)
+    mx += std::log(steps[i]) / n, my += std::log(errors[i]) / n;
   double sxy = 0, sxx = 0;
   for (size_t i = 0; i < steps.size(); ++i) {
     sxy += (std::log(steps[i]) - mx) * (std::log(errors[i]) - my);
@@ -65,9 +66,8 @@ TEST(GeneralStep, AgreesWithTheSeparablePathToRoundOff) {
     std::string method;
     double alpha;  // NaN: implicit midpoint on (q, p)
   };
-  const std::vector<Pair> pairs = {{"del", 0.5},
-                                   {"del:rule=alpha,alpha=0.25", 0.25},
-                                   {"implicit_midpoint", std::nan("")}};
+  const std::vector<Pair> pairs = {
+      {"del", 0.5}, {"del:rule=alpha,alpha=0.25", 0.25}, {"implicit_midpoint", std::nan("")}};
   int compared = 0;
   for (const auto& spec : separable_specs()) {
     const auto problem = make_problem(spec);

@@ -87,8 +87,7 @@ StepStatus general_del_step(const LagrangianSystem& system, State& state, double
 }
 
 StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State& state, double h,
-                                          const GeneralNewtonSettings& newton,
-                                          Counters& counters) {
+                                          const GeneralNewtonSettings& newton, Counters& counters) {
   const long n = state.q.size();
   Vec z0(2 * n);
   z0 << state.q, state.p;

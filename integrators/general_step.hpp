@@ -36,7 +36,6 @@ StepStatus general_del_step(const LagrangianSystem& system, State& state, double
 // The implicit midpoint rule on the Hamiltonian view, z = (q, p), z₁ = z₀ + h f((z₀ + z₁)/2),
 // f = (v(q, p), L_q(q, v(q, p))) (symplectic for any H).
 StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State& state, double h,
-                                          const GeneralNewtonSettings& newton,
-                                          Counters& counters);
+                                          const GeneralNewtonSettings& newton, Counters& counters);
 
 }  // namespace geomint

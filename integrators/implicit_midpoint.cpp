@@ -32,10 +32,10 @@ class ImplicitMidpoint final : public Integrator {
   }
 
   MethodInfo info() const override {
-    return {"implicit_midpoint", 2,
-            kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian |
-                kGeneralLagrangian,
-            "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
+    return {
+        "implicit_midpoint", 2,
+        kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian | kGeneralLagrangian,
+        "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
   }
 
   StabilityPrediction predicted_linear_stability() const override {

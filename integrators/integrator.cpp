@@ -1,14 +1,13 @@
 // Integrator base-class helpers (counted evaluations) and the method registry.
 #include "integrators/integrator.hpp"
 
-#include "integrators/general_step.hpp"
-
 #include <fmt/format.h>
 
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
 
 namespace geomint {
@@ -157,12 +156,13 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
   }
   if (is_non_separable(problem) && !(info.flags & kGeneralLagrangian)) {
-    return {false,
-            fmt::format("method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "
-                        "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
-                        "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
-                        "{}",
-                        method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "))};
+    return {
+        false,
+        fmt::format("method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "
+                    "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
+                    "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
+                    "{}",
+                    method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "))};
   }
   // On a non-separable problem the second derivatives come from its LagrangianSystem.
   if ((info.flags & kNeedsHessian) && !problem.has(kHessian) && !is_non_separable(problem)) {

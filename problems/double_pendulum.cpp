@@ -13,7 +13,12 @@ namespace {
 class DoublePendulum final : public Problem, public LagrangianSystem {
  public:
   DoublePendulum(double m1, double m2, double l1, double l2, double g, Vec theta, Vec omega)
-      : m1_(m1), m2_(m2), l1_(l1), l2_(l2), g_(g), theta_(std::move(theta)),
+      : m1_(m1),
+        m2_(m2),
+        l1_(l1),
+        l2_(l2),
+        g_(g),
+        theta_(std::move(theta)),
         omega_(std::move(omega)) {
     set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is M(θ) (is_non_separable)
     // The faster small-amplitude mode of the equal pendulum is √(g/l)·√(2 + √2) ≈ 1.85 √(g/l).
@@ -80,10 +85,10 @@ std::unique_ptr<Problem> make_double_pendulum(Params& params) {
                          "|theta1| <= 1000");
   theta[1] = params.real("theta2", -0.2, "lower rod angle from the downward vertical (rad)", angle,
                          "|theta2| <= 1000");
-  omega[0] = params.real("omega1", 0.0, "initial rate of theta1 (rad per time)", rate,
-                         "|omega1| <= 1e6");
-  omega[1] = params.real("omega2", 0.0, "initial rate of theta2 (rad per time)", rate,
-                         "|omega2| <= 1e6");
+  omega[0] =
+      params.real("omega1", 0.0, "initial rate of theta1 (rad per time)", rate, "|omega1| <= 1e6");
+  omega[1] =
+      params.real("omega2", 0.0, "initial rate of theta2 (rad per time)", rate, "|omega2| <= 1e6");
   return std::make_unique<DoublePendulum>(m1, m2, l1, l2, g, theta, omega);
 }
 

@@ -1,6 +1,8 @@
 // Registry-driven checks of the general Lagrangian kind (problems/lagrangian.hpp): every
 // primitive and assembled derivative against central finite differences, the Legendre identities,
 // energy along an accurate trajectory, and polar Kepler against Cartesian Kepler.
+#include "problems/lagrangian.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -10,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -51,17 +52,17 @@ Eigen::MatrixXd difference_jacobian(const std::function<Vec(const Vec&)>& f, con
 void expect_close(const Eigen::MatrixXd& analytic, const Eigen::MatrixXd& numeric,
                   const std::string& what) {
   const double scale = std::max({inf_norm(analytic), inf_norm(numeric), 1e-300});
-  EXPECT_LE(inf_norm(analytic - numeric), 1e-7 * scale)
-      << what << "\nanalytic\n"
-      << analytic << "\nfinite differences\n"
-      << numeric;
+  EXPECT_LE(inf_norm(analytic - numeric), 1e-7 * scale) << what << "\nanalytic\n"
+                                                        << analytic << "\nfinite differences\n"
+                                                        << numeric;
 }
 
 class GeneralProblem : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     problem_ = make_problem(GetParam());
-    ASSERT_NE(general_lagrangian(*problem_), nullptr) << "is_non_separable needs the LagrangianSystem";
+    ASSERT_NE(general_lagrangian(*problem_), nullptr)
+        << "is_non_separable needs the LagrangianSystem";
   }
   const LagrangianSystem& system() const { return *general_lagrangian(*problem_); }
   // States the checks probe: the start and two nearby ones, each with a velocity that makes

@@ -1,12 +1,12 @@
 // Problem base-class defaults, the first-order view for ODE solvers, and the problem registry.
 #include "problems/problem.hpp"
 
-#include "problems/lagrangian.hpp"
-
 #include <fmt/format.h>
 
 #include <Eigen/Cholesky>
 #include <limits>
+
+#include "problems/lagrangian.hpp"
 
 namespace geomint {
 

@@ -91,7 +91,8 @@ const std::vector<Case>& cases() {
       {"ConstrainedMethodOnUnconstrainedProblem",
        "run --problem pendulum --method rattle --dt 0.1 --t-end 1", 2,
        "problem 'pendulum' has none"},
-      // --- the general Lagrangian kind (is_non_separable, issue 25): separable-only methods refused ---
+      // --- the general Lagrangian kind (is_non_separable, issue 25): separable-only methods
+      // refused ---
       {"VerletOnNonSeparableProblem",
        "run --problem double_pendulum --method stormer_verlet --dt 0.01 --t-end 1", 2,
        "theta2=-0.2' is non-separable"},
