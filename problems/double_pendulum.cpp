@@ -1,6 +1,7 @@
 // The planar double pendulum in absolute angles from the downward vertical (as rod_chain):
 // T = ½(m₁+m₂)l₁²θ̇₁² + ½m₂l₂²θ̇₂² + m₂l₁l₂θ̇₁θ̇₂cos(θ₁−θ₂), V = −(m₁+m₂)gl₁cos θ₁ − m₂gl₂cos θ₂
 // (../shared/MECHANICS.md §5): a position-dependent mass M(θ), canonical p = M(θ)θ̇.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -21,12 +22,24 @@ class DoublePendulum final : public Problem, public LagrangianSystem {
         theta_(std::move(theta)),
         omega_(std::move(omega)) {
     set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is M(θ) (is_non_separable)
+    set_capabilities(kOmegaMax);
     // The faster small-amplitude mode of the equal pendulum is √(g/l)·√(2 + √2) ≈ 1.85 √(g/l).
     set_defaults(0.01 * std::sqrt(std::min(l1, l2) / g), 10.0);
   }
 
   State initial_state() const override {
     return {0.0, theta_, static_cast<const LagrangianSystem&>(*this).momentum(theta_, omega_)};
+  }
+
+  // The faster small-oscillation mode about the hanging equilibrium, K v = ω²M(0)v with
+  // K = diag((m₁+m₂)gl₁, m₂gl₂) (for m₁ = m₂, l₁ = l₂: ω² = (g/l)(2 + √2)); independent of q, as
+  // Kepler's, because a fixed step has to resolve the whole motion.
+  double omega_max(const Vec&) const override {
+    DenseMatrix M, K;
+    mass_matrix(Vec::Zero(2), M);
+    potential_hessian(Vec::Zero(2), K);
+    const Eigen::GeneralizedSelfAdjointEigenSolver<DenseMatrix> modes(K, M, Eigen::EigenvaluesOnly);
+    return std::sqrt(modes.eigenvalues().maxCoeff());
   }
 
   void mass_matrix(const Vec& q, DenseMatrix& M) const override {

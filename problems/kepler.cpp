@@ -206,6 +206,8 @@ std::unique_ptr<Problem> make_kepler(Params& params) {
   const std::string coordinates =
       params.choice("coordinates", "cartesian", {"cartesian", "polar"},
                     "q = (x, y), or q = (r, phi) with the mass diag(1, r^2) (non_separable)");
+  // Every Cartesian Kepler spec (and committed result) stays as it was.
+  params.omit_default_from_canonical("coordinates");
   if (coordinates == "polar") return std::make_unique<KeplerPolar>(e);
   return std::make_unique<Kepler>(e);
 }

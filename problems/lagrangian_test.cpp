@@ -242,6 +242,14 @@ TEST(GeneralProblems, RegistryHasThem) {
   EXPECT_EQ(general_lagrangian(*make_problem("kepler")), nullptr);
 }
 
+// Equal bobs and rods: the small-oscillation frequencies are ω² = (g/l)(2 ∓ √2)
+// (../shared/MECHANICS.md §5); omega_max is the faster one, at non-unit m, l, g.
+TEST(DoublePendulum, OmegaMaxIsTheFasterNormalMode) {
+  const auto problem = make_problem("double_pendulum:m1=2,m2=2,l1=0.5,l2=0.5,g=3");
+  const double expected = std::sqrt(3 / 0.5 * (2 + std::sqrt(2.0)));
+  EXPECT_NEAR(problem->omega_max(problem->initial_state().q), expected, 1e-14 * expected);
+}
+
 // The polar exact solution is the Cartesian one mapped through (r cos φ, r sin φ), and p_φ is
 // the angular momentum, over more than one turn (φ continuous).
 TEST(KeplerPolar, ExactIsTheCartesianOrbitInPolarCoordinates) {
