@@ -14,6 +14,7 @@
 
 #include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
@@ -78,6 +79,10 @@ class DiscreteLagrangianVI final : public Integrator {
     flags |= interior_.empty() ? kExplicit : (kImplicit | kNeedsHessian);
     if (symmetric_) flags |= kSymmetric;
     if (midpoint_) flags |= kConstrained | kRheonomic;
+    // A one-node rule is L_d = h L((1−α)q_k + αq_{k+1}, v), which general_del_step solves for any
+    // L(q, v) (docs/MECHANICS_GENERAL.md §2); left and right (α = 0, 1) are declared explicit,
+    // which they are not when M depends on q, and the two-node rules assume constant M.
+    if (nodes_.size() == 1 && !interior_.empty()) flags |= kGeneralLagrangian;
     return {"del", order_, flags,
             fmt::format("discrete Euler-Lagrange, quadrature L_d ({}), Marsden-West 2001 §2.3, "
                         "§3.2; Kharevych et al. 2006 §3; docs/METHOD.md §1-2",
@@ -99,6 +104,11 @@ class DiscreteLagrangianVI final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
+    if (is_non_separable(problem)) {
+      return general_del_step(*general_lagrangian(problem), state, h, nodes_.front().a,
+                              {newton_.options().tolerance, newton_.options().max_iterations},
+                              counters_);
+    }
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);

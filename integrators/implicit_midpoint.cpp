@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "integrators/forcing.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
@@ -31,9 +32,10 @@ class ImplicitMidpoint final : public Integrator {
   }
 
   MethodInfo info() const override {
-    return {"implicit_midpoint", 2,
-            kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
-            "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
+    return {
+        "implicit_midpoint", 2,
+        kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian | kGeneralLagrangian,
+        "implicit midpoint rule, GNI §II.1, §VI.3; Marsden-West 2001 §2.6; docs/METHOD.md §1"};
   }
 
   StabilityPrediction predicted_linear_stability() const override {
@@ -47,6 +49,12 @@ class ImplicitMidpoint final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    if (is_non_separable(problem)) {
+      // On z = (q, p) of the Hamiltonian view (docs/MECHANICS_GENERAL.md §4).
+      return general_implicit_midpoint_step(
+          *general_lagrangian(problem), state, h,
+          {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
+    }
     const Vec& mass = problem.mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);

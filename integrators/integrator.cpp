@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "integrators/free_rigid_body_methods.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
 #include "problems/rigid_body.hpp"
 
@@ -166,7 +167,17 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                                "problem '{}' is none",
                                method.spec(), problem.name())};
   }
-  if ((info.flags & kNeedsHessian) && !problem.has(kHessian)) {
+  if (is_non_separable(problem) && !(info.flags & kGeneralLagrangian)) {
+    return {
+        false,
+        fmt::format("method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "
+                    "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
+                    "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
+                    "{}",
+                    method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "))};
+  }
+  // On a non-separable problem the second derivatives come from its LagrangianSystem.
+  if ((info.flags & kNeedsHessian) && !problem.has(kHessian) && !is_non_separable(problem)) {
     return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
                                info.name, problem.name())};
   }
@@ -213,6 +224,15 @@ std::vector<std::string> first_order_methods() {
     const unsigned flags = make_integrator(spec)->info().flags;
     if ((flags & kFirstOrderCapable) && !(flags & kConstraintsOnly)) specs.push_back(spec);
   }
+  return specs;
+}
+
+std::vector<std::string> general_lagrangian_methods() {
+  std::vector<std::string> specs;
+  for (const auto& spec : integrator_test_specs()) {
+    if (make_integrator(spec)->info().flags & kGeneralLagrangian) specs.push_back(spec);
+  }
+  if (specs.empty()) specs.push_back("(none registered yet)");
   return specs;
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "tests/test_util.hpp"
 
@@ -670,9 +671,10 @@ TEST(Registry, LibraryWrappersDeclareOrderAndFlags) {
   const unsigned implicit_adaptive = kImplicit | kAdaptive | kFirstOrderCapable;
   const unsigned explicit_adaptive = kExplicit | kAdaptive | kFirstOrderCapable;
   for (const Expected& e : {
-           Expected{"cvode_bdf", 5, implicit_adaptive},
-           Expected{"cvode_bdf:max_order=3", 3, implicit_adaptive},
-           Expected{"cvode_adams", 12, implicit_adaptive},
+           // CVODE sees only first_order_rhs/_jacobian: it also runs the general Lagrangian kind.
+           Expected{"cvode_bdf", 5, implicit_adaptive | kGeneralLagrangian},
+           Expected{"cvode_bdf:max_order=3", 3, implicit_adaptive | kGeneralLagrangian},
+           Expected{"cvode_adams", 12, implicit_adaptive | kGeneralLagrangian},
            Expected{"ida", 5, implicit_adaptive},
            Expected{"arkode_erk", 5, explicit_adaptive},
            Expected{"arkode_erk:table=verner_8_5_6", 6, explicit_adaptive},

@@ -3,6 +3,7 @@
 // Not symplectic: the negative control of docs/METHOD.md §7. On a first-order-only problem it is
 // the same tableau on y' = f(t, y).
 #include "integrators/fixed_step_loop.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
 
@@ -12,7 +13,7 @@ namespace {
 class Rk4 final : public ExplicitStepper<Rk4> {
  public:
   MethodInfo info() const override {
-    return {"rk4", 4, kExplicit | kFirstOrderCapable,
+    return {"rk4", 4, kExplicit | kFirstOrderCapable | kGeneralLagrangian,
             "classical Runge-Kutta, Hairer-Norsett-Wanner I §II.1"};
   }
 
@@ -54,6 +55,10 @@ class Rk4 final : public ExplicitStepper<Rk4> {
       advance_first_order(problem, state, h);
       return;
     }
+    if (is_non_separable(problem)) {
+      advance_general(problem, state, h);
+      return;
+    }
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
@@ -89,6 +94,28 @@ class Rk4 final : public ExplicitStepper<Rk4> {
     ++counters_.steps;
   }
 
+  // The same tableau on y = (q, p) with Hamilton's equations of the general L,
+  // (q̇, ṗ) = (v(q, p), L_q(q, v)) (Problem::first_order_rhs, docs/MECHANICS_GENERAL.md §4).
+  void advance_general(const Problem& problem, State& state, double h) {
+    const double t = state.t;
+    const long n = state.q.size();
+    general_y_.resize(2 * n);
+    general_y_ << state.q, state.p;
+    const Vec& y = general_y_;
+    first_order(problem, t, y, dq_[0]);
+    stage_q_ = y + (h / 2) * dq_[0];
+    first_order(problem, t + h / 2, stage_q_, dq_[1]);
+    stage_q_ = y + (h / 2) * dq_[1];
+    first_order(problem, t + h / 2, stage_q_, dq_[2]);
+    stage_q_ = y + h * dq_[2];
+    first_order(problem, t + h, stage_q_, dq_[3]);
+    general_y_ += (h / 6) * (dq_[0] + 2 * (dq_[1] + dq_[2]) + dq_[3]);
+    state.q = general_y_.head(n);
+    state.p = general_y_.tail(n);
+    state.t = t + h;
+    ++counters_.steps;
+  }
+
   void first_order(const Problem& problem, double t, const Vec& y, Vec& ydot) {
     ++counters_.force_evals;
     problem.first_order_rhs(t, y, ydot);
@@ -99,7 +126,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
     eval_total_force(problem, q, dq, t, dp);
   }
 
-  Vec dq_[4], dp_[4], stage_q_, stage_p_;
+  Vec dq_[4], dp_[4], stage_q_, stage_p_, general_y_;
 };
 
 }  // namespace

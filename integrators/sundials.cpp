@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "integrators/adaptive.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -246,8 +247,10 @@ class Cvode final : public SundialsIntegrator {
         max_nonlin_iters_(max_nonlin_iters) {}
 
   MethodInfo info() const override {
+    // kGeneralLagrangian: CVODE sees only first_order_rhs/_jacobian, which a non-separable problem
+    // gives as Hamilton's equations of its L (problems/problem.cpp).
     return {bdf_ ? "cvode_bdf" : "cvode_adams", max_order_,
-            kImplicit | kAdaptive | kFirstOrderCapable,
+            kImplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
             bdf_ ? "SUNDIALS CVODE, variable-order BDF (CVODE user guide v6.4.1, §2.1)"
                  : "SUNDIALS CVODE, variable-order Adams-Moulton (CVODE user guide v6.4.1, §2.1)"};
   }

@@ -1,10 +1,13 @@
 // Linearised one-step maps (integrators/tangent.hpp; docs/USAGE.md "Optional structure metrics").
 #include "integrators/tangent.hpp"
 
+#include "problems/lagrangian.hpp"
+
 namespace geomint {
 
 bool tangent_applies(const Problem& problem) {
-  return problem.has(kHessian) && !problem.has(kForce) && !problem.has(kConstraints);
+  return problem.has(kHessian) && !problem.has(kForce) && !problem.has(kConstraints) &&
+         !is_non_separable(problem);
 }
 
 Eigen::MatrixXd dense_hessian(const Problem& problem, const Vec& q) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "integrators/free_rigid_body_methods.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "tests/test_util.hpp"
@@ -519,13 +520,15 @@ TEST(Declared, OrdersAndFlagsFollowTheRule) {
   };
   const unsigned vi = kSymplectic | kVariational;
   const unsigned implicit = kImplicit | kNeedsHessian;
+  const unsigned general = kGeneralLagrangian;  // one interior node: runs any L(q, v)
   const Expect table[] = {
       {"del:rule=left", 1, vi | kExplicit},
       {"del:rule=right", 1, vi | kExplicit},
       {"del:rule=trapezoid", 2, vi | kExplicit | kSymmetric},
-      {"del:rule=midpoint", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic},
-      {"del:rule=alpha,alpha=0.5", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic},
-      {"del:rule=alpha,alpha=0.25", 1, vi | implicit},
+      {"del:rule=midpoint", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic | general},
+      {"del:rule=alpha,alpha=0.5", 2,
+       vi | implicit | kSymmetric | kConstrained | kRheonomic | general},
+      {"del:rule=alpha,alpha=0.25", 1, vi | implicit | general},
       {"del:rule=alpha,alpha=0", 1, vi | kExplicit},
       {"del:rule=symmetric_alpha,alpha=0.25", 2, vi | implicit | kSymmetric},
       {"del:rule=symmetric_alpha,alpha=1", 2, vi | kExplicit | kSymmetric},
@@ -537,7 +540,7 @@ TEST(Declared, OrdersAndFlagsFollowTheRule) {
       {"newmark:beta=0.25,gamma=0.6", 1, implicit},
       {"newmark:beta=0,gamma=0.5", 2, vi | kExplicit | kSymmetric},
       {"newmark:beta=0,gamma=0.7", 1, kExplicit},
-      {"implicit_midpoint", 2, vi | implicit | kSymmetric},
+      {"implicit_midpoint", 2, vi | implicit | kSymmetric | general},
   };
   for (const auto& [spec, order, flags] : table) {
     const MethodInfo info = make_integrator(spec)->info();

@@ -1,12 +1,16 @@
 // Kepler problem V = −1/|q| in the plane, started at perihelion as in Hairer, Lubich & Wanner,
 // GNI (I.2.12): a = 1, period 2π, H = −½. Exact solution from Kepler's equation E − e sin E = t.
+// `coordinates=polar`: the same orbit in q = (r, φ), L = ½(ṙ² + r²φ̇²) + 1/r, a position-dependent
+// mass diag(1, r²) (../shared/MECHANICS.md §5), exact solution mapped from the Cartesian one.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -123,12 +127,88 @@ class Kepler final : public Problem {
   double minor_axis_;  // b = √(1 − e²) for a = 1
 };
 
+// Polar coordinates q = (r, φ), p = (p_r, p_φ) = (ṙ, r²φ̇); unit mass and μ = 1 as Kepler.
+class KeplerPolar final : public Problem, public LagrangianSystem {
+ public:
+  explicit KeplerPolar(double e) : cartesian_(e), e_(e) {
+    set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is diag(1, r²) (is_non_separable)
+    // p_φ is the angular momentum (φ is cyclic): the momentum observer reads it through
+    // angular_momentum().
+    set_capabilities(kExact | kPeriod | kAngularMomentum | kOmegaMax);
+    set_defaults(0.01, 10 * 2 * kPi);
+  }
+
+  State initial_state() const override { return to_polar(cartesian_.initial_state()); }
+
+  void mass_matrix(const Vec& q, DenseMatrix& M) const override {
+    M = DenseMatrix::Zero(2, 2);
+    M(0, 0) = 1;
+    M(1, 1) = q[0] * q[0];
+  }
+  void kinetic_gradient(const Vec& q, const Vec& v, Vec& T_q) const override {
+    T_q.resize(2);
+    T_q << q[0] * v[1] * v[1], 0;  // ∂(½r²φ̇²)/∂r
+  }
+  void mass_velocity_jacobian(const Vec& q, const Vec& v, DenseMatrix& D) const override {
+    D = DenseMatrix::Zero(2, 2);
+    D(1, 0) = 2 * q[0] * v[1];  // ∂(r²φ̇)/∂r
+  }
+  void kinetic_hessian(const Vec&, const Vec& v, DenseMatrix& T_qq) const override {
+    T_qq = DenseMatrix::Zero(2, 2);
+    T_qq(0, 0) = v[1] * v[1];
+  }
+  double potential(const Vec& q) const override { return -1 / q[0]; }
+  void gradient(const Vec& q, Vec& g) const override {
+    g.resize(2);
+    g << 1 / (q[0] * q[0]), 0;
+  }
+  void potential_hessian(const Vec& q, DenseMatrix& K) const override {
+    K = DenseMatrix::Zero(2, 2);
+    K(0, 0) = -2 / (q[0] * q[0] * q[0]);
+  }
+
+  // φ continuous in t: the true anomaly of the reduced time plus the whole turns before it.
+  State exact(double t) const override {
+    State state = to_polar(cartesian_.exact(t));
+    state.q[1] += 2 * kPi * std::round((t - std::remainder(t, 2 * kPi)) / (2 * kPi));
+    return state;
+  }
+  double period() const override { return 2 * kPi; }
+  Vec angular_momentum(const Vec&, const Vec& p) const override { return Vec::Constant(1, p[1]); }
+  // The observable that crosses 0 upwards once per orbit, as Kepler's x: r cos φ.
+  double period_observable(const Vec& q, const Vec&) const override {
+    return q[0] * std::cos(q[1]);
+  }
+  double omega_max(const Vec&) const override { return std::sqrt((1 + e_) / std::pow(1 - e_, 3)); }
+
+ private:
+  // (x, y, p_x, p_y) → (r, φ ∈ (−π, π], p_r = (x p_x + y p_y)/r, p_φ = x p_y − y p_x).
+  static State to_polar(const State& cartesian) {
+    const Vec& x = cartesian.q;
+    const Vec& p = cartesian.p;
+    const double r = x.norm();
+    State state{cartesian.t, Vec(2), Vec(2)};
+    state.q << r, std::atan2(x[1], x[0]);
+    state.p << x.dot(p) / r, x[0] * p[1] - x[1] * p[0];
+    return state;
+  }
+
+  Kepler cartesian_;
+  double e_;
+};
+
 }  // namespace
 
 std::unique_ptr<Problem> make_kepler(Params& params) {
   const double e = params.real(
       "e", 0.6, "eccentricity (semi-major axis 1, period 2pi)",
       [](double x) { return x >= 0 && x < 1; }, "in [0, 1)");
+  const std::string coordinates =
+      params.choice("coordinates", "cartesian", {"cartesian", "polar"},
+                    "q = (x, y), or q = (r, phi) with the mass diag(1, r^2) (non_separable)");
+  // Every Cartesian Kepler spec (and committed result) stays as it was.
+  params.omit_default_from_canonical("coordinates");
+  if (coordinates == "polar") return std::make_unique<KeplerPolar>(e);
   return std::make_unique<Kepler>(e);
 }
 

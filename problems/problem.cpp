@@ -6,6 +6,8 @@
 #include <Eigen/Cholesky>
 #include <limits>
 
+#include "problems/lagrangian.hpp"
+
 namespace geomint {
 
 #define GEOMINT_PROBLEM(name, factory, variants, summary) std::unique_ptr<Problem> factory(Params&);
@@ -119,6 +121,11 @@ std::vector<std::string> capability_names(unsigned capabilities) {
 }
 
 namespace {
+// The LagrangianSystem of a problem that is_non_separable (callers check).
+const LagrangianSystem& general_system(const Problem& problem) {
+  return *general_lagrangian(problem);
+}
+
 [[noreturn]] void missing(const Problem& problem, const char* what) {
   throw std::logic_error(fmt::format("problem '{}' has no {}", problem.name(), what));
 }
@@ -263,6 +270,7 @@ double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass_.c
 
 double Problem::energy(const Vec& q, const Vec& p) const {
   if (has(kFirstOrderOnly)) return std::numeric_limits<double>::quiet_NaN();
+  if (is_non_separable(*this)) return general_system(*this).hamiltonian(q, p);
   return kinetic(p) + potential(q);
 }
 
@@ -296,6 +304,19 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
   }
   const int n = dof();
   ydot.resize(2 * n);
+  if (is_non_separable(*this)) {
+    // Hamilton's equations of the general L: q̇ = v(q, p), ṗ = L_q(q, v) (docs/MECHANICS_GENERAL.md
+    // §4; the Euler–Lagrange equation d/dt L_v = L_q with p = L_v, so one Cholesky solve per
+    // evaluation, the same as M(q)v̇ = L_q − L_vq v would need).
+    const LagrangianSystem& system = general_system(*this);
+    const Vec q = y.head(n);
+    const Vec v = system.velocity(q, y.tail(n));
+    Vec L_q;
+    system.lagrangian_q(q, v, L_q);
+    ydot.head(n) = v;
+    ydot.tail(n) = L_q;
+    return;
+  }
   const Vec v = inverse_mass_.cwiseProduct(y.tail(n));
   Vec g;
   gradient(y.head(n), g);
@@ -314,6 +335,19 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
     return;
   }
   const int n = dof();
+  if (is_non_separable(*this)) {
+    DenseMatrix dense;
+    general_system(*this).hamiltonian_vector_field_jacobian(y.head(n), y.tail(n), dense);
+    // Every entry, zeros included: a sparse solver (CVODE's KLU) keeps one pattern per run.
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(static_cast<size_t>(4 * n * n));
+    for (int j = 0; j < 2 * n; ++j) {
+      for (int i = 0; i < 2 * n; ++i) entries.emplace_back(i, j, dense(i, j));
+    }
+    J.resize(2 * n, 2 * n);
+    J.setFromTriplets(entries.begin(), entries.end());
+    return;
+  }
   const Vec q = y.head(n);
   const Vec v = inverse_mass_.cwiseProduct(y.tail(n));
   SparseMatrix H;

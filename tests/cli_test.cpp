@@ -440,7 +440,7 @@ std::string readme_block(const std::string& marker) {
 // fails here with the rows to paste.
 TEST(Readme, TablesAreTheOutputOfListMarkdown) {
   for (const std::string what : {"methods", "problems"}) {
-    const Outcome listing = geomint("list " + what + " --markdown");
+    Outcome listing = geomint("list " + what + " --markdown");
     ASSERT_EQ(listing.exit_code, 0) << listing.output;
     const std::string readme = readme_block(what);
     if (readme == listing.output) continue;

@@ -1,0 +1,152 @@
+// DEL α-rule and implicit midpoint steps on the general Lagrangian kind (docs/MECHANICS_GENERAL.md
+// §3–4; ../shared/MECHANICS.md §2). The step Jacobians are not symmetric (α L_vq − (1−α) L_qv),
+// so Newton factorises them with Eigen's PartialPivLU (dense: these problems have a few dof).
+#include "integrators/general_step.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+namespace geomint {
+namespace {
+
+bool finite(const Vec& x) { return x.allFinite(); }
+
+// ‖x‖∞ without the NaN-swallowing of max over an empty vector.
+double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
+
+}  // namespace
+
+StepStatus general_del_step(const LagrangianSystem& system, State& state, double h, double alpha,
+                            const GeneralNewtonSettings& newton, Counters& counters) {
+  const Vec q0 = state.q;
+  const Vec p0 = state.p;
+  Vec v = system.velocity(q0, p0);
+  Vec L_q, residual;
+  DenseMatrix M, L_vq, L_qq, jacobian;
+  // R(v) = L_v(q̄, v) − h(1−α)L_q(q̄, v) − p₀ at q̄ = q₀ + αh v; returns the size of its terms.
+  const auto evaluate = [&](const Vec& velocity) {
+    const Vec q_bar = q0 + (alpha * h) * velocity;
+    system.lagrangian_q(q_bar, velocity, L_q);
+    ++counters.force_evals;
+    const Vec p_bar = system.momentum(q_bar, velocity);
+    residual = p_bar - (h * (1 - alpha)) * L_q - p0;
+    return inf_norm(p_bar) + std::abs(h) * inf_norm(L_q) + inf_norm(p0);
+  };
+  // ∂R/∂v = L_vv + hα L_vq − h(1−α) L_qv − h²α(1−α) L_qq (h times ∂R/∂q₁ of MECHANICS.md §2).
+  const auto factorise = [&](const Vec& velocity) {
+    const Vec q_bar = q0 + (alpha * h) * velocity;
+    system.mass_matrix(q_bar, M);
+    system.lagrangian_vq(q_bar, velocity, L_vq);
+    system.lagrangian_qq(q_bar, velocity, L_qq);
+    jacobian = M + (h * alpha) * L_vq - (h * (1 - alpha)) * L_vq.transpose() -
+               (h * h * alpha * (1 - alpha)) * L_qq;
+    ++counters.factorizations;
+    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
+  };
+  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
+  for (int iteration = 0;; ++iteration) {
+    const double scale = evaluate(v);
+    if (!finite(residual)) return StepStatus::failure("nan", "general del: non-finite residual");
+    if (inf_norm(residual) <= floor * scale) {
+      // One more correction with a fresh LU, kept only if it lowers ‖R‖: the momentum maps of a
+      // variational step are exact only for the exact solve (discrete Noether), so p_φ wants the
+      // residual at its round-off floor, not at the tolerance.
+      const Vec before = residual;
+      const Vec polished = v - factorise(v).solve(residual);
+      ++counters.linear_solves;
+      evaluate(polished);
+      if (finite(residual) && inf_norm(residual) < inf_norm(before)) {
+        v = polished;
+      } else {
+        evaluate(v);
+      }
+      break;
+    }
+    if (iteration == newton.max_iterations) {
+      return StepStatus::failure(
+          "newton_max_iter",
+          fmt::format("general del: |R| = {:.3g} after {} Newton iterations (tol {:.3g})",
+                      inf_norm(residual), iteration, newton.tolerance));
+    }
+    v -= factorise(v).solve(residual);
+    ++counters.linear_solves;
+    ++counters.newton_iters;
+  }
+  const Vec q_bar = q0 + (alpha * h) * v;
+  state.p = system.momentum(q_bar, v) + (h * alpha) * L_q;  // L_q is at the accepted v
+  state.q = q0 + h * v;
+  state.t += h;
+  ++counters.steps;
+  if (!finite(state.q) || !finite(state.p)) {
+    return StepStatus::failure("nan", "general del: non-finite state");
+  }
+  return StepStatus::success();
+}
+
+StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State& state, double h,
+                                          const GeneralNewtonSettings& newton, Counters& counters) {
+  const long n = state.q.size();
+  Vec z0(2 * n);
+  z0 << state.q, state.p;
+  Vec z = z0;  // the midpoint z̄, started at z₀
+  Vec f(2 * n), residual(2 * n), L_q;
+  DenseMatrix field_jacobian, jacobian;
+  // R(z̄) = z̄ − z₀ − (h/2) f(z̄), block-wise scales for the q and p rows (different units).
+  double q_scale = 0, p_scale = 0;
+  const auto evaluate = [&](const Vec& midpoint) {
+    const Vec q = midpoint.head(n);
+    const Vec v = system.velocity(q, midpoint.tail(n));
+    system.lagrangian_q(q, v, L_q);
+    ++counters.force_evals;
+    f << v, L_q;
+    residual = midpoint - z0 - (h / 2) * f;
+    q_scale = inf_norm(z0.head(n)) + std::abs(h) * inf_norm(v);
+    p_scale = inf_norm(z0.tail(n)) + std::abs(h) * inf_norm(L_q);
+  };
+  const auto converged = [&](double floor) {
+    return inf_norm(residual.head(n)) <= floor * q_scale &&
+           inf_norm(residual.tail(n)) <= floor * p_scale;
+  };
+  const auto factorise = [&](const Vec& midpoint) {
+    system.hamiltonian_vector_field_jacobian(midpoint.head(n), midpoint.tail(n), field_jacobian);
+    jacobian = DenseMatrix::Identity(2 * n, 2 * n) - (h / 2) * field_jacobian;
+    ++counters.factorizations;
+    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
+  };
+  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
+  for (int iteration = 0;; ++iteration) {
+    evaluate(z);
+    if (!finite(residual)) {
+      return StepStatus::failure("nan", "general implicit midpoint: non-finite residual");
+    }
+    if (converged(floor)) {
+      const Vec before = residual;
+      const Vec polished = z - factorise(z).solve(residual);
+      ++counters.linear_solves;
+      evaluate(polished);
+      if (finite(residual) && inf_norm(residual) < inf_norm(before)) z = polished;
+      break;
+    }
+    if (iteration == newton.max_iterations) {
+      return StepStatus::failure(
+          "newton_max_iter",
+          fmt::format("general implicit midpoint: |R| = {:.3g} after {} Newton iterations",
+                      inf_norm(residual), iteration));
+    }
+    z -= factorise(z).solve(residual);
+    ++counters.linear_solves;
+    ++counters.newton_iters;
+  }
+  const Vec z1 = 2 * z - z0;
+  state.q = z1.head(n);
+  state.p = z1.tail(n);
+  state.t += h;
+  ++counters.steps;
+  if (!finite(z1)) return StepStatus::failure("nan", "general implicit midpoint: non-finite state");
+  return StepStatus::success();
+}
+
+}  // namespace geomint

@@ -1,0 +1,279 @@
+// Registry-driven checks of the general Lagrangian kind (problems/lagrangian.hpp): every
+// primitive and assembled derivative against central finite differences, the Legendre identities,
+// energy along an accurate trajectory, and polar Kepler against Cartesian Kepler.
+#include "problems/lagrangian.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "problems/problem.hpp"
+
+namespace geomint {
+namespace {
+
+double inf_norm(const Eigen::MatrixXd& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
+
+std::vector<std::string> general_specs() {
+  std::vector<std::string> specs;
+  for (const auto& spec : problem_test_specs()) {
+    if (is_non_separable(*make_problem(spec))) specs.push_back(spec);
+  }
+  return specs;
+}
+
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string out;
+  for (char c : info.param) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+// Central-difference Jacobian of a vector function (columns = ∂f/∂x_j), step relative to |x|.
+Eigen::MatrixXd difference_jacobian(const std::function<Vec(const Vec&)>& f, const Vec& x) {
+  const Vec f0 = f(x);
+  Eigen::MatrixXd J(f0.size(), x.size());
+  for (int j = 0; j < x.size(); ++j) {
+    const double delta = 1e-6 * std::max(1.0, std::abs(x[j]));
+    Vec plus = x, minus = x;
+    plus[j] += delta;
+    minus[j] -= delta;
+    J.col(j) = (f(plus) - f(minus)) / (2 * delta);
+  }
+  return J;
+}
+
+// Central differences have truncation ~δ² and rounding ~ε/δ ≈ 1e-10 relative: 1e-7 leaves room
+// and still catches a wrong factor or sign (which is O(1) of the entry).
+void expect_close(const Eigen::MatrixXd& analytic, const Eigen::MatrixXd& numeric,
+                  const std::string& what) {
+  const double scale = std::max({inf_norm(analytic), inf_norm(numeric), 1e-300});
+  EXPECT_LE(inf_norm(analytic - numeric), 1e-7 * scale) << what << "\nanalytic\n"
+                                                        << analytic << "\nfinite differences\n"
+                                                        << numeric;
+}
+
+class GeneralProblem : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    problem_ = make_problem(GetParam());
+    ASSERT_NE(general_lagrangian(*problem_), nullptr)
+        << "is_non_separable needs the LagrangianSystem";
+  }
+  const LagrangianSystem& system() const { return *general_lagrangian(*problem_); }
+  // States the checks probe: the start and two nearby ones, each with a velocity that makes
+  // every v-dependent term non-zero (the double pendulum starts from rest).
+  std::vector<std::pair<Vec, Vec>> samples() const {
+    const State start = problem_->initial_state();
+    std::vector<std::pair<Vec, Vec>> out;
+    const int n = problem_->dof();
+    for (int k = 0; k < 3; ++k) {
+      Vec q = start.q, v(n);
+      for (int i = 0; i < n; ++i) {
+        q[i] += 0.07 * k * (i + 1) * (i % 2 == 0 ? 1 : -1);
+        v[i] = 0.6 + 0.45 * i - 0.3 * k;
+      }
+      out.emplace_back(q, v);
+    }
+    return out;
+  }
+  std::unique_ptr<Problem> problem_;
+};
+
+TEST_P(GeneralProblem, MassIsSymmetricPositiveDefinite) {
+  for (const auto& [q, v] : samples()) {
+    DenseMatrix M;
+    system().mass_matrix(q, M);
+    EXPECT_LE(inf_norm(M - M.transpose()), 0.0) << M;
+    EXPECT_EQ(Eigen::LLT<DenseMatrix>(M).info(), Eigen::Success) << M;
+  }
+}
+
+TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
+  const LagrangianSystem& L = system();
+  for (const auto& [q, v] : samples()) {
+    const auto kinetic = [&](const Vec& x) {
+      DenseMatrix M;
+      L.mass_matrix(x, M);
+      return Vec::Constant(1, 0.5 * v.dot(M * v));
+    };
+    Vec T_q;
+    L.kinetic_gradient(q, v, T_q);
+    expect_close(T_q.transpose(), difference_jacobian(kinetic, q), "T_q");
+    DenseMatrix D;
+    L.mass_velocity_jacobian(q, v, D);
+    const auto mass_times_v = [&](const Vec& x) {
+      DenseMatrix M;
+      L.mass_matrix(x, M);
+      return Vec(M * v);
+    };
+    expect_close(D, difference_jacobian(mass_times_v, q), "d(M v)/dq");
+    DenseMatrix T_qq;
+    L.kinetic_hessian(q, v, T_qq);
+    const auto kinetic_gradient = [&](const Vec& x) {
+      Vec g;
+      L.kinetic_gradient(x, v, g);
+      return g;
+    };
+    expect_close(T_qq, difference_jacobian(kinetic_gradient, q), "T_qq");
+    DenseMatrix A;
+    L.gyroscopic_jacobian(q, A);
+    const auto gyroscopic = [&](const Vec& x) {
+      Vec a;
+      L.gyroscopic(x, a);
+      return a;
+    };
+    expect_close(A, difference_jacobian(gyroscopic, q), "da/dq");
+    DenseMatrix a_qq;
+    L.gyroscopic_hessian(q, v, a_qq);
+    const auto gyroscopic_gradient = [&](const Vec& x) {
+      DenseMatrix Ax;
+      L.gyroscopic_jacobian(x, Ax);
+      return Vec(Ax.transpose() * v);
+    };
+    expect_close(a_qq, difference_jacobian(gyroscopic_gradient, q), "d²(a·v)/dq²");
+    Vec g;
+    L.gradient(q, g);
+    const auto potential = [&](const Vec& x) { return Vec::Constant(1, L.potential(x)); };
+    expect_close(g.transpose(), difference_jacobian(potential, q), "grad V");
+    DenseMatrix K;
+    L.potential_hessian(q, K);
+    const auto gradient = [&](const Vec& x) {
+      Vec gx;
+      L.gradient(x, gx);
+      return gx;
+    };
+    expect_close(K, difference_jacobian(gradient, q), "hess V");
+  }
+}
+
+TEST_P(GeneralProblem, AssembledBlocksMatchFiniteDifferencesOfTheLagrangian) {
+  const LagrangianSystem& L = system();
+  for (const auto& [q, v] : samples()) {
+    Vec L_q;
+    L.lagrangian_q(q, v, L_q);
+    const auto lagrangian_at_q = [&](const Vec& x) { return Vec::Constant(1, L.lagrangian(x, v)); };
+    expect_close(L_q.transpose(), difference_jacobian(lagrangian_at_q, q), "L_q");
+    const auto lagrangian_at_v = [&](const Vec& w) { return Vec::Constant(1, L.lagrangian(q, w)); };
+    expect_close(L.momentum(q, v).transpose(), difference_jacobian(lagrangian_at_v, v), "L_v");
+    DenseMatrix L_vq, L_qq, M;
+    L.lagrangian_vq(q, v, L_vq);
+    expect_close(L_vq, difference_jacobian([&](const Vec& x) { return L.momentum(x, v); }, q),
+                 "L_vq");
+    L.mass_matrix(q, M);
+    expect_close(M, difference_jacobian([&](const Vec& w) { return L.momentum(q, w); }, v), "L_vv");
+    L.lagrangian_qq(q, v, L_qq);
+    const auto lagrangian_q = [&](const Vec& x) {
+      Vec g;
+      L.lagrangian_q(x, v, g);
+      return g;
+    };
+    expect_close(L_qq, difference_jacobian(lagrangian_q, q), "L_qq");
+  }
+}
+
+TEST_P(GeneralProblem, HamiltonianViewIsTheLegendreTransform) {
+  const LagrangianSystem& L = system();
+  for (const auto& [q, v] : samples()) {
+    const Vec p = L.momentum(q, v);
+    EXPECT_LE(inf_norm(L.velocity(q, p) - v), 1e-14 * inf_norm(v));
+    // H = pᵀv − L at p = L_v.
+    const double legendre = p.dot(v) - L.lagrangian(q, v);
+    EXPECT_NEAR(L.hamiltonian(q, p), legendre, 1e-14 * (std::abs(p.dot(v)) + std::abs(legendre)));
+    EXPECT_EQ(problem_->energy(q, p), L.hamiltonian(q, p));
+    Vec H_q, H_p;
+    L.hamiltonian_gradient(q, p, H_q, H_p);
+    const auto h_of_q = [&](const Vec& x) { return Vec::Constant(1, L.hamiltonian(x, p)); };
+    const auto h_of_p = [&](const Vec& y) { return Vec::Constant(1, L.hamiltonian(q, y)); };
+    expect_close(H_q.transpose(), difference_jacobian(h_of_q, q), "H_q");
+    expect_close(H_p.transpose(), difference_jacobian(h_of_p, p), "H_p");
+    // Hamilton's vector field and its Jacobian, as the ODE solvers see them.
+    Vec y(2 * q.size());
+    y << q, p;
+    Vec ydot;
+    problem_->first_order_rhs(0.0, y, ydot);
+    expect_close(ydot.head(q.size()), H_p, "q' = H_p");
+    expect_close(ydot.tail(q.size()), -H_q, "p' = -H_q");
+    SparseMatrix J;
+    problem_->first_order_jacobian(0.0, y, J);
+    const auto field = [&](const Vec& z) {
+      Vec zdot;
+      problem_->first_order_rhs(0.0, z, zdot);
+      return zdot;
+    };
+    expect_close(Eigen::MatrixXd(J), difference_jacobian(field, y), "d(q', p')/d(q, p)");
+  }
+}
+
+// Hamilton's equations through first_order_rhs keep H: classical RK4 at a step far inside its
+// accuracy (error ~ (hω)⁴ per unit time) over a few time units.
+TEST_P(GeneralProblem, EnergyIsKeptByAnAccurateTrajectory) {
+  const State start = problem_->initial_state();
+  const int n = problem_->dof();
+  Vec y(2 * n);
+  y << start.q, start.p;
+  const double h = problem_->default_dt() / 10;
+  const long steps = std::lround(2.0 / h);
+  const auto f = [&](const Vec& z) {
+    Vec zdot;
+    problem_->first_order_rhs(0.0, z, zdot);
+    return zdot;
+  };
+  const double energy0 = problem_->energy(start.q, start.p);
+  double worst = 0;
+  for (long k = 0; k < steps; ++k) {
+    const Vec k1 = f(y), k2 = f(y + h / 2 * k1), k3 = f(y + h / 2 * k2), k4 = f(y + h * k3);
+    y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    worst = std::max(worst, std::abs(problem_->energy(y.head(n), y.tail(n)) - energy0));
+  }
+  EXPECT_LE(worst, 1e-10 * std::max(std::abs(energy0), 1.0));
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, GeneralProblem, ::testing::ValuesIn(general_specs()), test_name);
+
+TEST(GeneralProblems, RegistryHasThem) {
+  EXPECT_GE(general_specs().size(), 4u);
+  EXPECT_TRUE(is_non_separable(*make_problem("double_pendulum")));
+  EXPECT_FALSE(is_non_separable(*make_problem("kepler")));
+  EXPECT_EQ(general_lagrangian(*make_problem("kepler")), nullptr);
+}
+
+// Equal bobs and rods: the small-oscillation frequencies are ω² = (g/l)(2 ∓ √2)
+// (../shared/MECHANICS.md §5); omega_max is the faster one, at non-unit m, l, g.
+TEST(DoublePendulum, OmegaMaxIsTheFasterNormalMode) {
+  const auto problem = make_problem("double_pendulum:m1=2,m2=2,l1=0.5,l2=0.5,g=3");
+  const double expected = std::sqrt(3 / 0.5 * (2 + std::sqrt(2.0)));
+  EXPECT_NEAR(problem->omega_max(problem->initial_state().q), expected, 1e-14 * expected);
+}
+
+// The polar exact solution is the Cartesian one mapped through (r cos φ, r sin φ), and p_φ is
+// the angular momentum, over more than one turn (φ continuous).
+TEST(KeplerPolar, ExactIsTheCartesianOrbitInPolarCoordinates) {
+  for (const char* e : {"0.3", "0.6", "0.9"}) {
+    const auto polar = make_problem(std::string("kepler:coordinates=polar,e=") + e);
+    const auto cartesian = make_problem(std::string("kepler:e=") + e);
+    double previous_phi = -1.0;
+    for (int k = 0; k <= 50; ++k) {
+      const double t = 0.37 * k;
+      const State s = polar->exact(t);
+      const State c = cartesian->exact(t);
+      const double r = s.q[0], phi = s.q[1];
+      Vec x(2), p(2);
+      x << r * std::cos(phi), r * std::sin(phi);
+      p << s.p[0] * std::cos(phi) - s.p[1] / r * std::sin(phi),
+          s.p[0] * std::sin(phi) + s.p[1] / r * std::cos(phi);
+      EXPECT_LE(inf_norm(x - c.q), 1e-14 * 4) << "e=" << e << " t=" << t;
+      EXPECT_LE(inf_norm(p - c.p), 1e-14 * 4 * inf_norm(c.p)) << "e=" << e << " t=" << t;
+      EXPECT_GT(phi, previous_phi) << "phi must increase continuously, t=" << t;
+      previous_phi = phi;
+      EXPECT_NEAR(s.p[1], (cartesian->angular_momentum(c.q, c.p))[0], 1e-14);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace geomint
