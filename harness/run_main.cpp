@@ -310,7 +310,8 @@ int run_main(int argc, char** argv) {
   run->add_option("--metric", extra_metrics,
                   "also compute an optional metric (repeatable): symplecticity_defect, "
                   "period_measured (with period_err_rel), energy_growth_exponent, "
-                  "mode_freq_err_max, mode_damping_max");
+                  "mode_freq_err_max, mode_damping_max, symplecticity_defect_map (with "
+                  "symplecticity_defect_map_fd_err and symplecticity_defect_map_slope)");
   std::string initial_path;
   const std::string initial_help =
       "start from the state in this CSV (rows q,p, or q,v under a 'q,v' header; one per dof): "
