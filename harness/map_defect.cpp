@@ -66,7 +66,7 @@ std::string map_defect_not_applicable(const Integrator& method, const Problem& p
     return "constrained problem: the map acts on the constraint manifold (not measured yet)";
   }
   if (problem.dof() > kMaxMapDefectDof) {
-    return fmt::format("{} degrees of freedom: more than the {} the 12n-step difference takes",
+    return fmt::format("{} degrees of freedom: more than the {} the 32n-step difference takes",
                        problem.dof(), kMaxMapDefectDof);
   }
   if (!(h > 0 && std::isfinite(h))) {
@@ -104,22 +104,35 @@ MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, co
   const double q_scale = block_scale(
       state.q, h * (problem.inverse_mass().cwiseProduct(state.p)).cwiseAbs().maxCoeff());
   const double p_scale = block_scale(state.p, h * gradient.cwiseAbs().maxCoeff());
-  // D(δ), D(δ/2), D(δ/4) column by column.
-  std::vector<Eigen::MatrixXd> differences(3, Eigen::MatrixXd(2 * n, 2 * n));
+  // D(δ/2^m) for m = 0 … levels−1, the coarsest δ the first of kMapDefectRelativeSteps, column
+  // by column; every three consecutive levels give a J and its error estimate.
+  const int levels = static_cast<int>(std::log2(kMapDefectRelativeSteps.front() /
+                                                kMapDefectRelativeSteps.back())) +
+                     3;
+  std::vector<Eigen::MatrixXd> differences(levels, Eigen::MatrixXd(2 * n, 2 * n));
   for (long k = 0; k < 2 * n; ++k) {
-    const double step = kMapDefectRelativeStep * (k < n ? q_scale : p_scale);
-    for (int level = 0; level < 3; ++level) {
+    const double step = kMapDefectRelativeSteps.front() * (k < n ? q_scale : p_scale);
+    for (int level = 0; level < levels; ++level) {
       if (!central_difference(method, problem, state, h, k, std::ldexp(step, -level),
                               differences[level].col(k))) {
         return {};
       }
     }
   }
-  const Eigen::MatrixXd coarse = (4 * differences[1] - differences[0]) / 3;
-  MapJacobian out;
-  out.jacobian = (4 * differences[2] - differences[1]) / 3;
-  out.error = (out.jacobian - coarse).norm();
-  return out;
+  MapJacobian best;
+  for (const double relative : kMapDefectRelativeSteps) {
+    const int m =
+        static_cast<int>(std::lround(std::log2(kMapDefectRelativeSteps.front() / relative)));
+    const Eigen::MatrixXd coarse = (4 * differences[m + 1] - differences[m]) / 3;
+    const Eigen::MatrixXd fine = (4 * differences[m + 2] - differences[m + 1]) / 3;
+    const double error = (fine - coarse).norm();
+    if (best.jacobian.size() == 0 || error < best.error) {
+      best.jacobian = fine;
+      best.error = error;
+      best.relative_step = relative;
+    }
+  }
+  return best;
 }
 
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
@@ -145,8 +158,8 @@ namespace {
 // the defects are computed in finish() from fresh integrators, so the run is not disturbed.
 class MapDefectObserver : public Observer {
  public:
-  MapDefectObserver(std::string method_spec, double h)
-      : method_spec_(std::move(method_spec)), h_(h) {}
+  MapDefectObserver(std::string method_spec, double h, bool adaptive)
+      : method_spec_(std::move(method_spec)), h_(h), adaptive_(adaptive) {}
   void begin(const Problem& problem, const State& state, double t_end) override {
     problem_ = &problem;
     states_ = {state};
@@ -180,7 +193,8 @@ class MapDefectObserver : public Observer {
     }
     metrics["symplecticity_defect_map"] = defect;
     metrics["symplecticity_defect_map_fd_err"] = error;
-    if (defect > 10 * error && defect_half > 10 * error_half) {
+    // An adaptive solver's map over h is governed by its tolerance, not by h: no slope.
+    if (!adaptive_ && defect > 10 * error && defect_half > 10 * error_half) {
       metrics["symplecticity_defect_map_slope"] = std::log2(defect / defect_half);
     }
   }
@@ -188,6 +202,7 @@ class MapDefectObserver : public Observer {
  private:
   std::string method_spec_;
   double h_;
+  bool adaptive_;
   const Problem* problem_ = nullptr;
   std::vector<State> states_;
   State last_;
@@ -201,8 +216,10 @@ std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spe
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names) {
   if (!requested(names, "symplecticity_defect_map")) return nullptr;
-  if (!map_defect_not_applicable(*make_integrator(method_spec), problem, h).empty()) return nullptr;
-  return std::make_unique<MapDefectObserver>(method_spec, h);
+  const auto method = make_integrator(method_spec);
+  if (!map_defect_not_applicable(*method, problem, h).empty()) return nullptr;
+  return std::make_unique<MapDefectObserver>(method_spec, h,
+                                             (method->info().flags & kAdaptive) != 0);
 }
 
 }  // namespace geomint

@@ -3,6 +3,7 @@
 // Φ_h: (q, p) ↦ (q', p') as the method's real steps (and nonlinear solves) compute it.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
@@ -20,37 +21,42 @@ struct MapDefect {
   double jacobian_norm = 0;  // ‖J‖_F
 };
 
-// Relative size of the coarsest of the three central-difference steps (δ, δ/2, δ/4 times the
-// scale of q or of p): two Richardson extrapolations, each with a truncation error O(δ⁴) against
-// the map's noise η amplified as η/δ, are balanced near δ ~ η^{1/5}; for round-off η ~ 1e-16
-// that is 1e-3 (tests/map_defect_test.cpp measures the floor).
-inline constexpr double kMapDefectRelativeStep = 1.0 / 256;
+// Relative sizes δ tried for the coarsest of three central-difference steps (δ, δ/2, δ/4 times
+// the scale of q or of p), halving: two Richardson extrapolations, each with a truncation error
+// O(δ⁴) against the map's noise η amplified as η/δ, balance near δ ~ η^{1/5}: 1e-3 for round-off
+// (η ~ 1e-16), 3e-2 for an adaptive solver at rtol 1e-8. The δ with the smallest error estimate
+// is kept (tests/map_defect_test.cpp measures the floor).
+inline constexpr std::array<double, 6> kMapDefectRelativeSteps = {1.0 / 16,  1.0 / 32,  1.0 / 64,
+                                                                  1.0 / 128, 1.0 / 256, 1.0 / 512};
 
 // Why the black-box defect does not apply to `method` on `problem` with step h, or "": it needs
 // a canonical unconstrained, unforced problem (a (q, p) pair and a Hamiltonian map) of at most
 // kMaxMapDefectDof degrees of freedom, and h > 0 (an adaptive solver's map is its integration
 // over h, so a run of one needs --dt).
 std::string map_defect_not_applicable(const Integrator& method, const Problem& problem, double h);
-// 12n steps per state: more than this many degrees of freedom costs more than a run.
-inline constexpr int kMaxMapDefectDof = 200;
+// 32n steps per state: more than this many degrees of freedom costs more than a run.
+inline constexpr int kMaxMapDefectDof = 100;
 
 // The one-step map as the harness takes it: a fresh `method` reset at `state`, then one step()
 // (fixed-step methods) or adaptive_step()s up to state.t + h (adaptive ones). False on failure.
 bool computed_step(Integrator& method, const Problem& problem, State& state, double h);
 
-// J at `state` with the estimate ‖E‖_F of its error (empty J when a step fails).
+// J at `state` with the estimate ‖E‖_F of its error (empty J when a step fails), for the δ of
+// kMapDefectRelativeSteps with the smallest estimate: 2n(|steps| + 2) pairs of steps.
 struct MapJacobian {
   Eigen::MatrixXd jacobian;
   double error = 0;
+  double relative_step = 0;  // the δ kept
 };
 MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, const State& state,
                                   double h);
 
-// J at `state` from central differences of computed_step at steps δ_k = s·δ·2^-m (m = 0, 1, 2;
-// s the scale of the q or p block: its max norm, or the other block times h, or 1), extrapolated
-// pairwise (R = (4D(δ/2) − D(δ))/3); J is the finer extrapolation and the difference of the two
-// extrapolations, ‖E‖_F, bounds its error (truncation and the map's noise alike), so that
-// fd_error = (2‖J‖_F‖E‖_F + 4ε‖J‖²_F)/‖Ω‖_F. NaN defect when a step fails.
+// The defect at `state` from computed_map_jacobian: central differences of computed_step at steps
+// s·δ·2^-m (m = 0, 1, 2; s the scale of the q or p block: its max norm, or the step's change of
+// it, or 1), extrapolated pairwise (R = (4D(δ/2) − D(δ))/3); J is the finer extrapolation and the
+// difference of the two extrapolations, ‖E‖_F, bounds its error (truncation and the map's noise
+// alike), so that fd_error = (2‖J‖_F‖E‖_F + 4ε‖J‖²_F)/‖Ω‖_F (first order in E: JᵀΩJ changes by
+// EᵀΩJ + JᵀΩE). NaN defect when a step fails.
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h);
 
@@ -63,7 +69,7 @@ double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian);
 // finite-difference error estimate (symplecticity_defect_map_fd_err), and the slope
 // log₂(max defect at h / max defect at h/2) at the same states (symplecticity_defect_map_slope:
 // p + 1 for a non-symplectic map of order p) when both stand above ten times their error
-// estimate.
+// estimate and the method is not adaptive.
 std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names);
