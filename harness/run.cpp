@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "harness/map_defect.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference.hpp"
@@ -283,6 +284,10 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   check_optional_metrics(config.extra_metrics, "--metric");
   for (auto& observer : make_optional_observers(*problem, config.extra_metrics)) {
     observers.push_back(std::move(observer));
+  }
+  if (auto map_defect =
+          make_map_defect_observer(integrator->spec(), *problem, config.dt, config.extra_metrics)) {
+    observers.push_back(std::move(map_defect));
   }
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());

@@ -95,7 +95,8 @@ Verb add_run(CLI::App& app) {
   command->add_option("--metric", options->extra_metrics,
                       "also compute an optional metric (repeatable): symplecticity_defect, "
                       "period_measured (with period_err_rel), energy_growth_exponent, "
-                      "mode_freq_err_max, mode_damping_max");
+                      "mode_freq_err_max, mode_damping_max, symplecticity_defect_map (with "
+                      "symplecticity_defect_map_fd_err and symplecticity_defect_map_slope)");
   command->add_option("--initial", options->initial_path, kInitialStateHelp);
   return {"run", command, [options, command](const Context& context) {
             RunOptions given = *options;
