@@ -1,8 +1,9 @@
 // geomint command line (docs/CLI.md, docs/DESIGN.md §4) as geomint::run_main, so a user's
-// executable with registered methods is a full geomint (docs/VERIFY.md "Verify your own integrator").
-// Each verb lives in harness/cli/<verb>.cpp; this file parses and dispatches. Exit codes: 0 ok,
-// 1 a run or gate failed, 2 bad input (checked before any computing, outputs included), 3 an
-// internal error (a defect, or an I/O failure after the up-front checks, e.g. a full disk).
+// executable with registered methods is a full geomint (docs/VERIFY.md "Verify your own
+// integrator"). Each verb lives in harness/cli/<verb>.cpp; this file parses and dispatches. Exit
+// codes: 0 ok, 1 a run or gate failed, 2 bad input (checked before any computing, outputs
+// included), 3 an internal error (a defect, or an I/O failure after the up-front checks, e.g. a
+// full disk).
 #include "harness/run_main.hpp"
 
 #include <fmt/format.h>
@@ -35,10 +36,9 @@ int run_main(int argc, char** argv) {
       "disk. A numerical failure is a row whose status says what happened; a sweep exits 0 with "
       "its failures as rows.");
   // The order of `geomint --help`.
-  const std::vector<Verb> verbs = {add_list(app),      add_run(app),   add_order(app),
-                                   add_sweep(app),     add_merge(app), add_slurm(app),
-                                   add_reference(app), add_modes(app), add_gate(app),
-                                   add_report(app)};
+  const std::vector<Verb> verbs = {
+      add_list(app),  add_run(app),       add_order(app), add_sweep(app), add_merge(app),
+      add_slurm(app), add_reference(app), add_modes(app), add_gate(app),  add_report(app)};
   std::vector<std::string> commands;
   for (const Verb& verb : verbs) commands.push_back(verb.name);
 

@@ -1,5 +1,5 @@
 // DEL α-rule and implicit midpoint steps on the general Lagrangian kind (docs/MECHANICS_GENERAL.md
-// §3–4; ../shared/MECHANICS.md §2). The step Jacobians are not symmetric (α L_vq − (1−α) L_qv),
+// §2–3; ../shared/MECHANICS.md §2). The step Jacobians are not symmetric (α L_vq − (1−α) L_qv),
 // so Newton factorises them with Eigen's PartialPivLU (dense: these problems have a few dof).
 #include "integrators/general_step.hpp"
 

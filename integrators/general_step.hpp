@@ -1,5 +1,5 @@
 // Steps of the variational and Hamiltonian-side schemes on the general Lagrangian kind
-// L = ½vᵀM(q)v + a(q)ᵀv − V(q) (docs/MECHANICS_GENERAL.md §3–4; Marsden & West 2001 §2.1, §2.6):
+// L = ½vᵀM(q)v + a(q)ᵀv − V(q) (docs/MECHANICS_GENERAL.md §2–3; Marsden & West 2001 §2.1, §2.6):
 // dense Newton on the non-symmetric step Jacobian with a partially pivoted LU.
 #pragma once
 
@@ -11,12 +11,9 @@
 
 namespace geomint {
 
-// MethodInfo::flags bit, next to integrator.hpp's MethodFlag (kept here so this step leaves that
-// header unchanged; problems/lagrangian.hpp says why): the method runs the general Lagrangian kind
-// (is_non_separable problems). Without it a method assumes the separable constant-mass form (its
-// step uses M⁻¹p and ∇V: Verlet, symplectic Euler, Newmark, RATTLE, hp's minimisation form), and
-// applicable() refuses it there with the reason.
-inline constexpr unsigned kGeneralLagrangian = 1u << 12;
+// MethodInfo::flags bit kGeneralLagrangian (integrator.hpp): without it a method assumes the
+// separable constant-mass form (its step uses M⁻¹p and ∇V: Verlet, symplectic Euler, Newmark,
+// RATTLE, hp's minimisation form), and applicable() refuses it on is_non_separable problems.
 
 // The registry's test specs flagged kGeneralLagrangian (for refusal messages and tests).
 std::vector<std::string> general_lagrangian_methods();

@@ -50,7 +50,7 @@ class ImplicitMidpoint final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     if (is_non_separable(problem)) {
-      // On z = (q, p) of the Hamiltonian view (docs/MECHANICS_GENERAL.md §4).
+      // On z = (q, p) of the Hamiltonian view (docs/MECHANICS_GENERAL.md §3).
       return general_implicit_midpoint_step(
           *general_lagrangian(problem), state, h,
           {newton_.options().tolerance, newton_.options().max_iterations}, counters_);

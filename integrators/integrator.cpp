@@ -7,7 +7,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "integrators/free_rigid_body_methods.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
 #include "problems/rigid_body.hpp"
@@ -92,7 +91,8 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kRheonomic, "rheonomic"},
       {kFirstOrderCapable, "first_order"},
       {kConservativeOnly, "conservative_only"},
-      {static_cast<MethodFlag>(kFreeRigidBodyOnly), "free_rigid_body_only"},
+      {kGeneralLagrangian, "general_lagrangian"},
+      {kFreeRigidBodyOnly, "free_rigid_body_only"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {

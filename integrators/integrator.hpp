@@ -31,6 +31,12 @@ enum MethodFlag : unsigned {
   // Integrates separable conservative systems only (Boost.Odeint's symplectic steppers): not run
   // on problems with a force F(q, v, t) (kForce), and applicable() says so.
   kConservativeOnly = 1u << 11,
+  // Runs the general Lagrangian kind (non-separable problems, problems/lagrangian.hpp); without
+  // it a method assumes ½vᵀMv − V with a constant M, and applicable() refuses it there.
+  kGeneralLagrangian = 1u << 12,
+  // Runs on free rigid bodies only (the Lie–Poisson splitting): applicable() admits it exactly
+  // where free_rigid_body(problem) (problems/rigid_body.hpp) finds the structure it reads.
+  kFreeRigidBodyOnly = 1u << 13,
 };
 std::vector<std::string> flag_names(unsigned flags);
 

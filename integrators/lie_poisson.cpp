@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "integrators/fixed_step_loop.hpp"
-#include "integrators/free_rigid_body_methods.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/rigid_body.hpp"
 

@@ -95,7 +95,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
   }
 
   // The same tableau on y = (q, p) with Hamilton's equations of the general L,
-  // (q̇, ṗ) = (v(q, p), L_q(q, v)) (Problem::first_order_rhs, docs/MECHANICS_GENERAL.md §4).
+  // (q̇, ṗ) = (v(q, p), L_q(q, v)) (Problem::first_order_rhs, docs/MECHANICS_GENERAL.md §1).
   void advance_general(const Problem& problem, State& state, double h) {
     const double t = state.t;
     const long n = state.q.size();

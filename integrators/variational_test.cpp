@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "integrators/free_rigid_body_methods.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"

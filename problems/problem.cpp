@@ -306,7 +306,7 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
   ydot.resize(2 * n);
   if (is_non_separable(*this)) {
     // Hamilton's equations of the general L: q̇ = v(q, p), ṗ = L_q(q, v) (docs/MECHANICS_GENERAL.md
-    // §4; the Euler–Lagrange equation d/dt L_v = L_q with p = L_v, so one Cholesky solve per
+    // §1; the Euler–Lagrange equation d/dt L_v = L_q with p = L_v, so one Cholesky solve per
     // evaluation, the same as M(q)v̇ = L_q − L_vq v would need).
     const LagrangianSystem& system = general_system(*this);
     const Vec q = y.head(n);

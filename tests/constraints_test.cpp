@@ -15,7 +15,7 @@
 #include "harness/run.hpp"
 #include "harness/sweep.hpp"
 #include "harness/table.hpp"
-#include "integrators/free_rigid_body_methods.hpp"
+#include "integrators/integrator.hpp"
 #include "verify/verify.hpp"
 
 namespace geomint {

@@ -78,7 +78,7 @@ def check_links(root: str) -> list[str]:
 # A citation names a Markdown file of the repository, then (after a comma, spaces or a comment
 # marker that wraps the line) a quoted section title or a § number.
 CITATION = re.compile(
-    r"(?<![\w/.])(README(?:\.md)?|docs/[A-Za-z_]+\.md|results/[a-z0-9_]+/README\.md)"
+    r"(?<![\w/.\"])(README(?:\.md)?|docs/[A-Za-z_]+\.md|results/[a-z0-9_]+/README\.md)"
     r"(,?(?:\s|//|#)*)(?:\\?\"([^\"\\]+)|§(\d+))")
 CITED_EXTENSIONS = (".cpp", ".hpp", ".h", ".py", ".sh", ".cmake", ".txt", ".gp", ".awk", ".toml",
                     ".in", ".md", "Makefile", ".ci/run")

@@ -65,7 +65,8 @@ TEST(MapDefect, DeclaredFlagAgreesWithTheComputedMapForEveryFixedStepMethod) {
         !map_defect_not_applicable(*method, *problem, 0.05).empty()) {
       continue;
     }
-    const MapDefect value = symplecticity_defect_map(spec, *problem, problem->initial_state(), 0.05);
+    const MapDefect value =
+        symplecticity_defect_map(spec, *problem, problem->initial_state(), 0.05);
     if (method->info().flags & kSymplectic) {
       EXPECT_LE(value.defect, value.fd_error) << spec;
       ++symplectic;

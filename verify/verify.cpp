@@ -8,7 +8,7 @@
 
 #include "harness/order.hpp"
 #include "harness/run.hpp"
-#include "integrators/free_rigid_body_methods.hpp"
+#include "integrators/integrator.hpp"
 
 namespace geomint::verify {
 namespace {

@@ -49,9 +49,10 @@ int run_modes(const ModesOptions& options, const Context& context) {
 
 Verb add_modes(CLI::App& app) {
   auto options = std::make_shared<ModesOptions>();
-  auto* command = app.add_subcommand(
-      "modes",
-      "Print the normal modes of a method's one-step map on a linear problem (README \"Metrics\")");
+  auto* command =
+      app.add_subcommand("modes",
+                         "Print the normal modes of a method's one-step map on a linear problem "
+                         "(docs/USAGE.md \"Optional structure metrics\")");
   command->add_option("--problem", options->problem_spec, "linear problem spec")->required();
   command->add_option("--method", options->method_spec, "method spec")->required();
   command->add_option("--dt", options->dt, "step (> 0)")->required();

@@ -1,12 +1,13 @@
 // `geomint report`: the static results site (harness/report.hpp, docs/REPORT.md): every scene's
 // tables, figures and gate verdicts, written into a folder it replaces whole.
+#include "harness/report.hpp"
+
 #include <fmt/format.h>
 
 #include <filesystem>
 #include <memory>
 
 #include "harness/cli/verbs.hpp"
-#include "harness/report.hpp"
 
 namespace geomint::cli {
 
@@ -25,7 +26,8 @@ Verb add_report(CLI::App& app) {
             options->command_line = context.command_line;
             const ReportSummary summary = write_report(*options);
             // 0 once written: the gate verdicts are in the pages (`geomint gate` is what fails).
-            fmt::print(stderr, "report: {} scenes, {} tables, gates {} passed, {} failed; open {}\n",
+            fmt::print(stderr,
+                       "report: {} scenes, {} tables, gates {} passed, {} failed; open {}\n",
                        summary.scenes, summary.tables, summary.gates_passed, summary.gates_failed,
                        (std::filesystem::path(options->out_dir) / "index.html").string());
             return kExitOk;
