@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "harness/cli/verbs.hpp"
+#include "harness/report.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint::cli {
@@ -34,27 +35,15 @@ std::string outcome_message(const GateOutcome& outcome, bool verbose) {
   return message;
 }
 
+// The report's HTML escaping (harness/report.hpp) is valid XML too; a newline in an attribute
+// value would be read back as a space, so it becomes a character reference.
 std::string xml_escaped(const std::string& text) {
   std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\n':
-        out += "&#10;";
-        break;  // kept in an attribute value
-      default:
-        out += c;
+  for (char c : html_escape(text)) {
+    if (c == '\n') {
+      out += "&#10;";
+    } else {
+      out += c;
     }
   }
   return out;
