@@ -85,7 +85,10 @@ class GeneralProblem : public ::testing::TestWithParam<std::string> {
 };
 
 TEST_P(GeneralProblem, MassIsSymmetricPositiveDefinite) {
-  for (const auto& [q, v] : samples()) {
+  // Named copies, not a structured binding: lambdas below capture them (clang 14 refuses that).
+  for (const auto& sample : samples()) {
+    const Vec& q = sample.first;
+    const Vec& v = sample.second;
     DenseMatrix M;
     system().mass_matrix(q, M);
     EXPECT_LE(inf_norm(M - M.transpose()), 0.0) << M;
@@ -95,7 +98,10 @@ TEST_P(GeneralProblem, MassIsSymmetricPositiveDefinite) {
 
 TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
   const LagrangianSystem& L = system();
-  for (const auto& [q, v] : samples()) {
+  // Named copies, not a structured binding: lambdas below capture them (clang 14 refuses that).
+  for (const auto& sample : samples()) {
+    const Vec& q = sample.first;
+    const Vec& v = sample.second;
     const auto kinetic = [&](const Vec& x) {
       DenseMatrix M;
       L.mass_matrix(x, M);
@@ -153,7 +159,10 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
 
 TEST_P(GeneralProblem, AssembledBlocksMatchFiniteDifferencesOfTheLagrangian) {
   const LagrangianSystem& L = system();
-  for (const auto& [q, v] : samples()) {
+  // Named copies, not a structured binding: lambdas below capture them (clang 14 refuses that).
+  for (const auto& sample : samples()) {
+    const Vec& q = sample.first;
+    const Vec& v = sample.second;
     Vec L_q;
     L.lagrangian_q(q, v, L_q);
     const auto lagrangian_at_q = [&](const Vec& x) { return Vec::Constant(1, L.lagrangian(x, v)); };
@@ -178,7 +187,10 @@ TEST_P(GeneralProblem, AssembledBlocksMatchFiniteDifferencesOfTheLagrangian) {
 
 TEST_P(GeneralProblem, HamiltonianViewIsTheLegendreTransform) {
   const LagrangianSystem& L = system();
-  for (const auto& [q, v] : samples()) {
+  // Named copies, not a structured binding: lambdas below capture them (clang 14 refuses that).
+  for (const auto& sample : samples()) {
+    const Vec& q = sample.first;
+    const Vec& v = sample.second;
     const Vec p = L.momentum(q, v);
     EXPECT_LE(inf_norm(L.velocity(q, p) - v), 1e-14 * inf_norm(v));
     // H = pᵀv − L at p = L_v.
