@@ -85,10 +85,8 @@ class GeneralProblem : public ::testing::TestWithParam<std::string> {
 };
 
 TEST_P(GeneralProblem, MassIsSymmetricPositiveDefinite) {
-  // Named copies, not a structured binding: lambdas below capture them (clang 14 refuses that).
   for (const auto& sample : samples()) {
     const Vec& q = sample.first;
-    const Vec& v = sample.second;
     DenseMatrix M;
     system().mass_matrix(q, M);
     EXPECT_LE(inf_norm(M - M.transpose()), 0.0) << M;
