@@ -90,6 +90,11 @@ const std::vector<Case>& cases() {
       {"LiePoissonOrderThree",
        "run --problem rigid_body_euler --method lie_poisson:order=3 --dt 0.1 --t-end 1", 2,
        "order"},
+      // --- the SPRK family: a table name from its list, conservative problems only ---
+      {"SprkUnknownTable", "run --problem kepler --method sprk:table=mclachlan7 --dt 0.1 --t-end 1",
+       2, "table='mclachlan7' is not allowed (allowed: euler1"},
+      {"SprkWithAForce", "run --problem damped_oscillator --method sprk --dt 0.1 --t-end 1", 2,
+       "integrates separable conservative systems only; problem 'damped_oscillator'"},
       // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
