@@ -90,6 +90,10 @@ const std::vector<Case>& cases() {
       {"LiePoissonOrderThree",
        "run --problem rigid_body_euler --method lie_poisson:order=3 --dt 0.1 --t-end 1", 2,
        "order"},
+      {"QuaternionOnHeavyTop", "run --problem heavy_top --method quaternion --dt 0.1 --t-end 1", 2,
+       "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
+      {"QuaternionUnknownBase",
+       "run --problem rigid_body --method quaternion:base=rk5 --dt 0.1 --t-end 1", 2, "rk4"},
       // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
