@@ -95,6 +95,10 @@ const std::vector<Case>& cases() {
        2, "table='mclachlan7' is not allowed (allowed: euler1"},
       {"SprkWithAForce", "run --problem damped_oscillator --method sprk --dt 0.1 --t-end 1", 2,
        "integrates separable conservative systems only; problem 'damped_oscillator'"},
+      {"QuaternionOnHeavyTop", "run --problem heavy_top --method quaternion --dt 0.1 --t-end 1", 2,
+       "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
+      {"QuaternionUnknownBase",
+       "run --problem rigid_body --method quaternion:base=rk5 --dt 0.1 --t-end 1", 2, "rk4"},
       // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
