@@ -17,8 +17,11 @@ struct SweepOptions {
   // Written as `# scene:` and `# variant:` provenance lines, which `geomint gate` selects by.
   std::string scene_name;
   std::string variant = "full";  // "full" or "quick"
-  bool progress = true;          // progress on stderr when it is a terminal
-  bool timing = true;            // false: accuracy runs only (--no-timing)
+  // Progress on stderr: a line redrawn in place on a terminal, elsewhere a heartbeat line every
+  // progress_interval seconds (--quiet: none).
+  bool progress = true;
+  double progress_interval = 10;
+  bool timing = true;  // false: accuracy runs only (--no-timing)
   // Sharded sweep (--shard i/N, docs/CLUSTER.md "Running on a cluster"): only the units k of the
   // canonical expansion (runs, then order studies, then stability searches) with k mod N == i,
   // written to <out_dir>/shards/<table>.i-of-N.csv with a canonical_index column; never timed.
@@ -39,6 +42,11 @@ struct SceneUnits {
   size_t total() const { return runs + orders + stability; }
 };
 SceneUnits scene_units(const Scene& scene);
+
+// The expected steps of each unit of the scene in the canonical order (runs, order studies,
+// stability searches), the weights of the sweep's ETA: t_end/dt for a fixed-step run, the sum
+// over the ladder for an order study, scan and bisection runs for a stability search.
+std::vector<double> expected_unit_steps(const Scene& scene);
 
 // `geomint sweep --timing-only`: reads the summary.csv of <out_dir> (a merge or a --no-timing
 // sweep of this scene), runs the timing passes one at a time, writes wall_s into it and the

@@ -94,6 +94,29 @@ TEST(SweepSkippedRows, MessageNamesTheMethodByItsShortLabel) {
 }
 
 // Scene and gates files share one reader: its messages name the block and the key.
+// The heartbeat's ETA weighs units by expected steps (docs/CLI.md "sweep"): t_end/dt for a
+// fixed-step run (at a non-unit scale), the ladder's sum for an order study, the scene's finest
+// fixed step for an adaptive run.
+TEST(SweepProgress, UnitsWeighExpectedSteps) {
+  const fs::path dir = fs::path(testing::TempDir()) / "geomint_sweep_steps";
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic\"]\n"
+         "methods = [\"stormer_verlet\"]\ndt = [0.004, 0.25]\nt_end = 7.0\n"
+         "[[runs]]\nlabel = \"b\"\nproblems = [\"harmonic\"]\nmethods = [\"odeint_dopri5\"]\n"
+         "t_end = 3.0\n"
+         "[[orders]]\nlabel = \"c\"\nproblems = [\"harmonic\"]\nmethods = [\"rk4\"]\n"
+         "dt0 = 0.5\nlevels = 3\nt_end = 2.0\n";
+  const std::vector<double> steps =
+      expected_unit_steps(load_scene((dir / "scene.toml").string(), false));
+  ASSERT_EQ(steps.size(), 4u);
+  EXPECT_DOUBLE_EQ(steps[0], 7.0 / 0.004);
+  EXPECT_DOUBLE_EQ(steps[1], 7.0 / 0.25);
+  EXPECT_DOUBLE_EQ(steps[2], 3.0 / 0.004);
+  EXPECT_DOUBLE_EQ(steps[3], 2.0 / 0.5 * (1 + 2 + 4));
+  fs::remove_all(dir);
+}
+
 TEST(TomlReader, MessagesNameBlockAndKey) {
   const toml::table table = toml::parse("n = 'x'\nk = 1\nextra = true\n");
   TomlBlock block(table, "file.toml: [[runs]] 'a'");

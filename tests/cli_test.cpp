@@ -513,6 +513,37 @@ TEST(Cli, ShardMergeAndSlurmScripts) {
   fs::remove_all(folder);
 }
 
+// A sweep whose stderr is a pipe (a Slurm or CI log) prints heartbeat lines at the interval
+// given by --progress-interval or GEOMINT_PROGRESS_INTERVAL (docs/CLI.md "sweep"), each with
+// done/total runs and an ETA, and no carriage return.
+TEST(Cli, SweepInALogPrintsHeartbeatLines) {
+  const fs::path folder = scratch("heartbeat_scene");
+  fs::create_directories(folder);
+  std::ofstream(folder / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic:omega=3\"]\n"
+         "methods = [\"stormer_verlet\", \"symplectic_euler_a\"]\ndt = 2e-4\nt_end = 20.0\n"
+         "timing_repeats = 0\n";
+  const std::string scene = (folder / "scene.toml").string();
+  const std::regex heartbeat(
+      R"(\[sweep\] [0-2]/2 runs, [0-9]+% of expected steps, [0-9.]+ s elapsed, ETA [^\n]+\n)");
+  for (const std::string& sweep :
+       {std::string(GEOMINT_BINARY) + " sweep --progress-interval 0.01 " + scene,
+        "GEOMINT_PROGRESS_INTERVAL=0.01 " + std::string(GEOMINT_BINARY) + " sweep " + scene}) {
+    const Outcome logged = geomint_shell(sweep + " < /dev/null");
+    EXPECT_EQ(logged.exit_code, 0) << logged.output;
+    const auto lines =
+        std::distance(std::sregex_iterator(logged.output.begin(), logged.output.end(), heartbeat),
+                      std::sregex_iterator());
+    EXPECT_GE(lines, 1) << sweep << ":\n" << logged.output;
+    EXPECT_EQ(logged.output.find('\r'), std::string::npos) << logged.output;
+  }
+  const Outcome bad = geomint_shell("GEOMINT_PROGRESS_INTERVAL=soon " +
+                                    std::string(GEOMINT_BINARY) + " sweep " + scene);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("$GEOMINT_PROGRESS_INTERVAL"), std::string::npos) << bad.output;
+  fs::remove_all(folder);
+}
+
 // One word for sh: the tests below name folders with spaces, quotes and `$(...)`.
 std::string sh_word(const std::string& text) {
   std::string out = "'";

@@ -23,12 +23,14 @@ struct SweepCliOptions {
   std::string shard_text;
   bool shard_from_env = false;
   int shard_count = 0;
+  double progress_interval = 10;
 };
 
 int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   const Scene scene = load_scene(cli.scene_path, cli.quick);
   SweepOptions options;
   options.jobs = cli.jobs;
+  options.progress_interval = cli.progress_interval;
   options.command_line = context.command_line;
   const auto folder = std::filesystem::path(cli.scene_path).parent_path();
   options.out_dir = !cli.out.empty() ? cli.out
@@ -125,6 +127,13 @@ Verb add_sweep(CLI::App& app) {
   command->add_flag("--timing-only", options->timing_only,
                     "run only the timing passes, one at a time, into the merged tables of the "
                     "output folder (after `geomint merge`), with this node's CPU in provenance");
+  command
+      ->add_option("--progress-interval", options->progress_interval,
+                   "seconds between the heartbeat lines printed when stderr is not a terminal "
+                   "(a log): done/total runs and an ETA weighted by expected steps; default 10, or "
+                   "$GEOMINT_PROGRESS_INTERVAL")
+      ->envname("GEOMINT_PROGRESS_INTERVAL")
+      ->check(CLI::Range(0.01, 86400.0));
   return {"sweep", command,
           [options](const Context& context) { return run_sweep_verb(*options, context); }};
 }
