@@ -31,6 +31,7 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   SweepOptions options;
   options.jobs = cli.jobs;
   options.progress_interval = cli.progress_interval;
+  options.progress = !context.quiet;
   options.command_line = context.command_line;
   const auto folder = std::filesystem::path(cli.scene_path).parent_path();
   options.out_dir = !cli.out.empty() ? cli.out
@@ -59,8 +60,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
           "--shard and --shard-from-env");
     }
     run_timing_only(scene, options);
-    fmt::print(stderr, "{}: timing passes of '{}' written into {}\n", context.program, scene.title,
-               options.out_dir);
+    inform(context, fmt::format("{}: timing passes of '{}' written into {}", context.program,
+                                scene.title, options.out_dir));
     return kExitOk;
   }
   options.timing = !cli.no_timing;
@@ -83,8 +84,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     }
     const auto tables = shard_tables(units.runs, units.orders, units.stability);
     if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
-      fmt::print(stderr, "{}: shard {}/{} of '{}' is complete on disk; skipped\n", context.program,
-                 id.index, id.count, scene.title);
+      inform(context, fmt::format("{}: shard {}/{} of '{}' is complete on disk; skipped",
+                                  context.program, id.index, id.count, scene.title));
       return kExitOk;
     }
     if (shard_fails_on_purpose(id)) {
@@ -96,8 +97,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     throw InputError("--shards N goes with --shard-from-env");
   }
   const int failed = run_sweep(scene, options);
-  fmt::print(stderr, "{}: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
-             context.program, scene.title, failed, options.out_dir);
+  inform(context, fmt::format("{}: sweep '{}' done: {} failed run(s) reported as rows in {}",
+                              context.program, scene.title, failed, options.out_dir));
   return kExitOk;
 }
 
