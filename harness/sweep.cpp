@@ -629,7 +629,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         to_csv(tables.stability, column_union(tables.stability, stability_columns()), lines));
   }
   write_file_atomic((out / "table.md").string(),
-                    scene_markdown(scene, tables, options.command_line));
+                    scene_markdown(scene, tables, options.command_line,
+                                   table_citation(lines, options.scene_hash)));
   return failed;
 }
 
@@ -749,15 +750,68 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     write_file_atomic(path.string(), header + without_provenance(text));
   }
   write_file_atomic(summary_path.string(), to_csv(tables.summary, ordered, lines));
-  write_file_atomic((out / "table.md").string(), scene_markdown(scene, tables, timed_command));
+  write_file_atomic(
+      (out / "table.md").string(),
+      scene_markdown(scene, tables, timed_command, table_citation(lines, options.scene_hash)));
 }
 
 std::vector<Row> rows_with_short_specs(std::vector<Row> rows) {
   return with_short_specs(std::move(rows));
 }
 
+TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
+                             const std::string& scene_hash) {
+  TableCitation citation;
+  citation.scene_hash = scene_hash;
+  for (const auto& [key, value] : lines) {
+    if (key == "geomint") citation.geomint = value;
+    if (key == "scene") citation.scene = value;
+    if (key == "variant") citation.variant = value;
+    if (key == "date") citation.date = value;
+  }
+  return citation;
+}
+
+namespace {
+
+// "| name | value |" with an absent value shown as such, so a block is never half empty.
+std::string citation_row(const std::string& name, const std::string& value) {
+  return fmt::format("| {} | {} |\n", name, value.empty() ? "(not recorded)" : value);
+}
+
+std::string how_to_cite(const TableCitation& citation) {
+  // "0.1.0 (cd4c0e47a208)": the version, then the commit in parentheses.
+  std::string version = citation.geomint, sha;
+  const auto open = citation.geomint.find(" (");
+  if (open != std::string::npos && citation.geomint.back() == ')') {
+    version = citation.geomint.substr(0, open);
+    sha = citation.geomint.substr(open + 2, citation.geomint.size() - open - 3);
+  }
+  const std::string scene = citation.variant.empty() || citation.scene.empty()
+                                ? citation.scene
+                                : fmt::format("{} ({} variant)", citation.scene, citation.variant);
+  std::string block = "## How to cite\n\n";
+  block +=
+      "Cite these tables by the geomint version and commit that computed them, the scene and "
+      "the hash of its scene.toml (CITATION.cff cites geomint itself):\n\n";
+  block += "| field | value |\n|---|---|\n";
+  block += citation_row("geomint version", version);
+  block += citation_row("git SHA", sha);
+  block += citation_row("scene", scene);
+  block += citation_row("scene hash", citation.scene_hash);
+  block += citation_row("date", citation.date);
+  block += fmt::format("\n> geomint {}{}, scene {}, scene.toml {}, tables of {}.\n", version,
+                       sha.empty() ? "" : " (git " + sha + ")",
+                       citation.scene.empty() ? "?" : citation.scene,
+                       citation.scene_hash.empty() ? "(hash not recorded)" : citation.scene_hash,
+                       citation.date.empty() ? "(date not recorded)" : citation.date);
+  return block;
+}
+
+}  // namespace
+
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
-                           const std::string& command_line) {
+                           const std::string& command_line, const TableCitation& citation) {
   std::string markdown = fmt::format("# {}\n\n", scene.title);
   if (!scene.description.empty()) markdown += scene.description + "\n\n";
   if (!tables.summary.empty()) {
@@ -782,8 +836,8 @@ std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                             6) +
                 "\n";
   }
-  markdown += fmt::format("Produced by `{}`.\n", command_line);
-  return markdown;
+  markdown += fmt::format("Produced by `{}`.\n\n", command_line);
+  return markdown + how_to_cite(citation);
 }
 
 void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
@@ -795,6 +849,7 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
   for (const auto& job : plan.stability_jobs) stability_labels.push_back(job.label);
   SceneTables tables;
   std::string command_line;
+  std::vector<std::pair<std::string, std::string>> provenance_lines;
   // A table of another scene or variant (a copied folder, a wrong --out) would put this scene's
   // title over its rows: its provenance and its rows' blocks must be this scene's.
   const auto read = [&](const char* name, std::vector<Row>& rows,
@@ -829,7 +884,10 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
       }
     }
     rows = table.rows;
-    if (command_line.empty()) command_line = table.value("command");
+    if (command_line.empty()) {
+      command_line = table.value("command");
+      provenance_lines = table.provenance;
+    }
   };
   read("summary.csv", tables.summary, run_labels);
   read("order.csv", tables.order, order_labels);
@@ -841,7 +899,8 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
         options.out_dir));
   }
   write_file_atomic((fs::path(options.out_dir) / "table.md").string(),
-                    scene_markdown(scene, tables, command_line));
+                    scene_markdown(scene, tables, command_line,
+                                   table_citation(provenance_lines, options.scene_hash)));
 }
 
 }  // namespace geomint

@@ -72,9 +72,22 @@ std::vector<std::string> order_points_columns(std::vector<std::string> record_co
 // from the defaults); `geomint report` shows its tables the same way.
 std::vector<Row> rows_with_short_specs(std::vector<Row> rows);
 
-// table.md: the scene's title and description, then a Markdown table per non-empty table.
+// What table.md's "How to cite" block names (docs/REPORT.md "Citing a table"): the geomint
+// version and git SHA of the tables' `# geomint: VERSION (SHA)` line, the scene and its variant,
+// the scene hash (scene_content_hash of scene.toml, the one `geomint merge` checks shards
+// against) and the tables' `# date:`.
+struct TableCitation {
+  std::string geomint;  // "VERSION (SHA)"
+  std::string scene, variant, scene_hash, date;
+};
+// The citation of tables with these provenance lines (geomint, date, scene, variant) and hash.
+TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
+                             const std::string& scene_hash);
+
+// table.md: the scene's title and description, a Markdown table per non-empty table, the
+// command that produced them and the "How to cite" block.
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
-                           const std::string& command_line);
+                           const std::string& command_line, const TableCitation& citation);
 
 // Rewrites <out_dir>/table.md from the CSVs a sweep wrote there, without running anything
 // (`geomint sweep --markdown-only`); the `Produced by` line keeps the CSVs' `# command:`.

@@ -38,6 +38,8 @@ class SweepTables : public testing::Test {
     options.out_dir = dir_.string();
     options.progress = false;
     options.command_line = "geomint sweep scene.toml";
+    options.scene_name = "tables_scene";
+    options.scene_hash = "fnv1a64:00000000deadbeef";
     ASSERT_EQ(run_sweep(scene_, options), 0);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -58,11 +60,40 @@ TEST_F(SweepTables, MarkdownShowsShortLabelsAndCsvCanonicalSpecs) {
   EXPECT_NE(markdown.find("| harmonic:omega=2 | stormer_verlet |"), std::string::npos) << markdown;
 }
 
+// table.md ends with the "How to cite" block (docs/REPORT.md "Citing a table"): version and
+// SHA of the tables' `# geomint:` line, scene, scene hash and date, none of them missing.
+TEST_F(SweepTables, MarkdownEndsWithTheHowToCiteBlock) {
+  const std::string markdown = read_text(dir_ / "table.md");
+  const auto block = markdown.find("\n## How to cite\n");
+  ASSERT_NE(block, std::string::npos) << markdown;
+  const std::string cite = markdown.substr(block);
+  const CsvTable summary = read_csv_file((dir_ / "summary.csv").string());
+  const std::string geomint = summary.value("geomint");  // "VERSION (SHA)"
+  const std::string version = geomint.substr(0, geomint.find(' '));
+  const std::string sha =
+      geomint.substr(geomint.find('(') + 1, geomint.size() - 2 - geomint.find('('));
+  ASSERT_FALSE(version.empty());
+  ASSERT_FALSE(sha.empty());
+  for (const std::string& row :
+       {"| geomint version | " + version + " |", "| git SHA | " + sha + " |",
+        std::string("| scene | tables_scene (full variant) |"),
+        std::string("| scene hash | fnv1a64:00000000deadbeef |"),
+        "| date | " + summary.value("date") + " |"}) {
+    EXPECT_NE(cite.find(row + "\n"), std::string::npos) << row << " in\n" << cite;
+  }
+  EXPECT_EQ(cite.find("(not recorded)"), std::string::npos) << cite;
+  EXPECT_NE(cite.find("> geomint " + version + " (git " + sha + "), scene tables_scene"),
+            std::string::npos)
+      << cite;
+}
+
 TEST_F(SweepTables, MarkdownOnlyRebuildsTheSameTableFromTheCsvs) {
   const std::string written = read_text(dir_ / "table.md");
   fs::remove(dir_ / "table.md");
   SweepOptions options;
   options.out_dir = dir_.string();
+  options.scene_name = "tables_scene";
+  options.scene_hash = "fnv1a64:00000000deadbeef";
   rewrite_scene_markdown(scene_, options);
   EXPECT_EQ(read_text(dir_ / "table.md"), written);
   fs::remove(dir_ / "summary.csv");

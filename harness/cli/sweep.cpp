@@ -41,6 +41,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   // holds scene.toml, whatever --out says.
   options.scene_name = std::filesystem::absolute(cli.scene_path).parent_path().filename().string();
   options.variant = cli.quick ? "quick" : "full";
+  // table.md's "How to cite" block names it; a shard's provenance carries it for merge.
+  options.scene_hash = scene_content_hash(cli.scene_path, cli.quick);
   const std::string out_option = cli.out.empty() ? "output folder" : "--out";
   check_output_dir(options.out_dir, out_option);
   const auto out_file = [&](const char* name) {
@@ -73,7 +75,6 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
         cli.shard_from_env ? shard_from_env(cli.shard_count) : parse_shard(cli.shard_text);
     options.shard_index = id.index;
     options.shard_count = id.count;
-    options.scene_hash = scene_content_hash(cli.scene_path, cli.quick);
     const SceneUnits units = scene_units(scene);
     if (static_cast<size_t>(id.count) > units.total()) {
       // Merge refuses such a set: shards past the last unit would hold nothing.
