@@ -66,7 +66,7 @@ std::string json_escaped(const std::string& text) {
   return out;
 }
 
-// Plain text, no colour (docs/CLI.md "Colour"); --quiet prints the failing gates alone.
+// Plain text, no colour (docs/CLI.md "Quiet and colour"); --quiet prints the failing gates alone.
 void print_text(const std::vector<const GateOutcome*>& applied, bool verbose, bool quiet) {
   for (const GateOutcome* outcome : applied) {
     if (quiet && outcome->passed) continue;
