@@ -40,7 +40,13 @@ int run_main(int argc, char** argv) {
       add_list(app),  add_run(app),       add_order(app), add_sweep(app), add_merge(app),
       add_slurm(app), add_reference(app), add_modes(app), add_gate(app),  add_report(app)};
   std::vector<std::string> commands;
-  for (const Verb& verb : verbs) commands.push_back(verb.name);
+  bool quiet = false;
+  for (const Verb& verb : verbs) {
+    commands.push_back(verb.name);
+    verb.command->add_flag("--quiet", quiet,
+                           "no progress and no informational lines on stderr (errors are still "
+                           "printed; exit codes unchanged)");
+  }
 
   if (!check_command(program, commands, argc, argv)) return kExitBadInput;
   try {
@@ -57,7 +63,7 @@ int run_main(int argc, char** argv) {
     return kExitBadInput;
   }
 
-  const Context context{program, joined_command_line(argc, argv)};
+  const Context context{program, joined_command_line(argc, argv), quiet};
   try {
     for (const Verb& verb : verbs) {
       if (verb.command->parsed()) return verb.run(context);

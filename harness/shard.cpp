@@ -391,7 +391,9 @@ void merge_shards(const Scene& scene, const MergeOptions& options) {
         (out / "stability.csv").string(),
         to_csv(merged.stability, column_union({present}, stability_columns()), lines));
   }
-  write_file_atomic((out / "table.md").string(), scene_markdown(scene, merged, sweep_command));
+  write_file_atomic(
+      (out / "table.md").string(),
+      scene_markdown(scene, merged, sweep_command, table_citation(lines, options.scene_hash)));
   write_file_atomic((out / "hosts.csv").string(),
                     to_csv(hosts, {"shard", "host", "cpu", "date"}, {}));
 }

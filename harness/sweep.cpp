@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -43,25 +45,74 @@ struct Job {
   bool ok = true;
 };
 
+// The sweep's progress on stderr, counted in expected steps (expected_steps()), not in units: a
+// scene's runs differ in length by orders of magnitude, so a count of runs says little of the
+// time left. On a terminal one line is redrawn after every unit; elsewhere (a Slurm or CI log,
+// where `\r` piles up) a background thread prints a heartbeat line every `interval` seconds,
+// so a log shows life during a long run instead of staying empty until the sweep ends.
 class Progress {
  public:
-  Progress(size_t total, bool enabled) : total_(total), enabled_(enabled && ::isatty(2)) {}
-  void tick() {
+  Progress(std::vector<double> unit_steps, const SweepOptions& options)
+      : unit_steps_(std::move(unit_steps)),
+        enabled_(options.progress),
+        terminal_(::isatty(2) != 0),
+        interval_(options.progress_interval) {
+    for (double steps : unit_steps_) total_steps_ += steps;
+    if (enabled_ && !terminal_ && !unit_steps_.empty()) {
+      heartbeat_ = std::thread([this] { beat(); });
+    }
+  }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  ~Progress() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    if (heartbeat_.joinable()) heartbeat_.join();
+  }
+  // Unit `unit` (an index into unit_steps) is done.
+  void tick(size_t unit) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++done_;
-    if (!enabled_) return;
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double eta = done_ ? elapsed * (total_ - done_) / done_ : 0;
-    std::fprintf(stderr, "\r[sweep] %zu/%zu runs, %.1f s elapsed, ETA %.1f s   ", done_, total_,
-                 elapsed, eta);
-    if (done_ == total_) std::fprintf(stderr, "\n");
+    if (unit < unit_steps_.size()) done_steps_ += unit_steps_[unit];
+    if (!enabled_ || !terminal_) return;
+    std::fprintf(stderr, "\r%s   ", line().c_str());
+    if (done_ == unit_steps_.size()) std::fprintf(stderr, "\n");
   }
 
  private:
-  size_t total_, done_ = 0;
-  bool enabled_;
+  // "[sweep] 3/12 runs, 41% of expected steps, 12.0 s elapsed, ETA 17.3 s"; mutex_ held.
+  std::string line() const {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double fraction = total_steps_ > 0 ? done_steps_ / total_steps_ : 0;
+    const std::string eta = fraction > 0
+                                ? fmt::format("ETA {:.1f} s", elapsed * (1 - fraction) / fraction)
+                                : std::string("ETA unknown");
+    return fmt::format("[sweep] {}/{} runs, {:.0f}% of expected steps, {:.1f} s elapsed, {}", done_,
+                       unit_steps_.size(), 100 * fraction, elapsed, eta);
+  }
+  void beat() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!stopping_ && done_ < unit_steps_.size()) {
+      const auto period = std::chrono::duration<double>(interval_);
+      if (wake_.wait_for(lock, period, [this] { return stopping_; })) break;
+      std::fprintf(stderr, "%s\n", line().c_str());
+      std::fflush(stderr);
+    }
+  }
+
+  std::vector<double> unit_steps_;
+  double total_steps_ = 0, done_steps_ = 0;
+  size_t done_ = 0;
+  bool enabled_, terminal_;
+  double interval_;
+  bool stopping_ = false;
   std::mutex mutex_;
+  std::condition_variable wake_;
+  std::thread heartbeat_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
@@ -267,6 +318,44 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
   return plan;
 }
 
+// Expected steps of a fixed-step run; an adaptive one (dt 0) is assumed to take the steps of
+// the scene's finest fixed step, or 100 per unit of time in a scene without one: an estimate
+// that only weighs the ETA.
+double run_steps(double t_end, double dt, double adaptive_dt) {
+  return std::max(1.0, t_end / (dt > 0 ? dt : adaptive_dt));
+}
+
+std::vector<double> plan_unit_steps(const Plan& plan) {
+  double finest_dt = 0.01;
+  bool any_fixed = false;
+  for (const auto& job : plan.jobs) {
+    if (job.config.dt > 0) {
+      finest_dt = any_fixed ? std::min(finest_dt, job.config.dt) : job.config.dt;
+      any_fixed = true;
+    }
+  }
+  std::vector<double> steps;
+  for (const auto& job : plan.jobs) {
+    steps.push_back(run_steps(job.config.t_end, job.config.dt, finest_dt));
+  }
+  for (const auto& job : plan.order_jobs) {
+    // Levels dt0, dt0/2, ...: t_end/dt0 · (1 + 2 + ... + 2^(levels-1)).
+    steps.push_back(run_steps(job.block->t_end, job.block->dt0, finest_dt) *
+                    (std::ldexp(1.0, job.block->levels) - 1));
+  }
+  for (const auto& job : plan.stability_jobs) {
+    // A geometric scan over the range, then a bisection to rel_tol, each run at least
+    // min_steps long.
+    const StabilityOptions& options = *job.options;
+    const double low = options.h_min > 0 ? options.h_min : options.homega_min;
+    const double high = options.h_min > 0 ? options.h_max : options.homega_max;
+    const double scan = options.scan_points_per_decade * std::log10(std::max(high / low, 10.0));
+    const double bisection = std::log2(1 / std::max(options.rel_tol, 1e-16));
+    steps.push_back((scan + bisection) * static_cast<double>(options.min_steps));
+  }
+  return steps;
+}
+
 // A shard's tables (see SweepOptions::shard_count): the rows of its units with their canonical
 // index, each table over the columns its own rows set; `geomint merge` unites them.
 int write_shard(const Plan& plan, const std::vector<size_t>& accuracy_units,
@@ -415,9 +504,19 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (mine(jobs.size() + order_jobs.size() + s)) stability_units.push_back(s);
   }
   const bool timing = options.timing && !sharded;
-  size_t timed = 0;
-  for (const auto& job : jobs) timed += timing && job.timing_repeats > 0;
-  Progress progress(accuracy_units.size() + stability_units.size() + timed, options.progress);
+  // Progress units: this sweep's accuracy units, its stability searches, its timing passes.
+  const std::vector<double> all_steps = plan_unit_steps(plan);
+  std::vector<double> unit_steps;
+  for (size_t k : accuracy_units) unit_steps.push_back(all_steps[k]);
+  for (size_t s : stability_units) {
+    unit_steps.push_back(all_steps[jobs.size() + order_jobs.size() + s]);
+  }
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    if (timing && jobs[k].timing_repeats > 0) {
+      unit_steps.push_back(jobs[k].timing_repeats * all_steps[k]);
+    }
+  }
+  Progress progress(unit_steps, options);
 
   // Accuracy runs (parallel); specs were validated when the scene was loaded.
   parallel_for(accuracy_units.size(), options.jobs, [&](size_t unit) {
@@ -432,7 +531,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
           job.record.status = "skipped";
           job.ok = false;
           job.record.label = job.label;
-          progress.tick();
+          progress.tick(unit);
           return;
         }
         RunResult result = run_one(job.problem, job.method, job.config);
@@ -453,7 +552,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         job.study.record = error_record<OrderRecord>(job.problem, job.method, error.what());
       }
     }
-    progress.tick();
+    progress.tick(unit);
   });
   // Stability searches (parallel; each is a sequence of short runs without observers).
   parallel_for(stability_units.size(), options.jobs, [&](size_t unit) {
@@ -465,9 +564,10 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       job.row = to_row(error_record(job.problem, job.method, error.what()));
     }
     job.row["label"] = job.label;
-    progress.tick();
+    progress.tick(accuracy_units.size() + unit);
   });
   // Timing runs, one at a time so they do not compete for cores.
+  size_t timing_unit = accuracy_units.size() + stability_units.size();
   for (auto& job : jobs) {
     if (!timing || job.timing_repeats == 0) continue;
     if (job.ok) {
@@ -483,7 +583,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         job.record.message = fmt::format("timing pass failed: {}", error.what());
       }
     }
-    progress.tick();
+    progress.tick(timing_unit++);
   }
 
   auto lines = provenance(options.command_line);
@@ -529,7 +629,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
         to_csv(tables.stability, column_union(tables.stability, stability_columns()), lines));
   }
   write_file_atomic((out / "table.md").string(),
-                    scene_markdown(scene, tables, options.command_line));
+                    scene_markdown(scene, tables, options.command_line,
+                                   table_citation(lines, options.scene_hash)));
   return failed;
 }
 
@@ -541,6 +642,10 @@ std::vector<std::string> order_points_columns(std::vector<std::string> columns) 
     columns.insert(columns.begin() + (columns.front() == "label"), "order_level");
   }
   return columns;
+}
+
+std::vector<double> expected_unit_steps(const Scene& scene) {
+  return plan_unit_steps(expand_scene(scene, SweepOptions{}));
 }
 
 SceneUnits scene_units(const Scene& scene) {
@@ -581,9 +686,15 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     }
   }
   // Timing runs one at a time on this node, as in a single-machine sweep.
-  size_t timed = 0;
-  for (const auto& job : plan.jobs) timed += job.timing_repeats > 0;
-  Progress progress(timed, options.progress);
+  const std::vector<double> all_steps = plan_unit_steps(plan);
+  std::vector<double> unit_steps;
+  for (size_t k = 0; k < plan.jobs.size(); ++k) {
+    if (plan.jobs[k].timing_repeats > 0) {
+      unit_steps.push_back(plan.jobs[k].timing_repeats * all_steps[k]);
+    }
+  }
+  Progress progress(unit_steps, options);
+  size_t timing_unit = 0;
   std::set<std::string> present(columns.begin(), columns.end());
   for (size_t k = 0; k < plan.jobs.size(); ++k) {
     const Job& job = plan.jobs[k];
@@ -610,7 +721,7 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
         }
       }
     }
-    progress.tick();
+    progress.tick(timing_unit++);
   }
   std::vector<std::string> ordered;
   for (const auto& column : record_schema()) {
@@ -639,15 +750,68 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     write_file_atomic(path.string(), header + without_provenance(text));
   }
   write_file_atomic(summary_path.string(), to_csv(tables.summary, ordered, lines));
-  write_file_atomic((out / "table.md").string(), scene_markdown(scene, tables, timed_command));
+  write_file_atomic(
+      (out / "table.md").string(),
+      scene_markdown(scene, tables, timed_command, table_citation(lines, options.scene_hash)));
 }
 
 std::vector<Row> rows_with_short_specs(std::vector<Row> rows) {
   return with_short_specs(std::move(rows));
 }
 
+TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
+                             const std::string& scene_hash) {
+  TableCitation citation;
+  citation.scene_hash = scene_hash;
+  for (const auto& [key, value] : lines) {
+    if (key == "geomint") citation.geomint = value;
+    if (key == "scene") citation.scene = value;
+    if (key == "variant") citation.variant = value;
+    if (key == "date") citation.date = value;
+  }
+  return citation;
+}
+
+namespace {
+
+// "| name | value |" with an absent value shown as such, so a block is never half empty.
+std::string citation_row(const std::string& name, const std::string& value) {
+  return fmt::format("| {} | {} |\n", name, value.empty() ? "(not recorded)" : value);
+}
+
+std::string how_to_cite(const TableCitation& citation) {
+  // "0.1.0 (cd4c0e47a208)": the version, then the commit in parentheses.
+  std::string version = citation.geomint, sha;
+  const auto open = citation.geomint.find(" (");
+  if (open != std::string::npos && citation.geomint.back() == ')') {
+    version = citation.geomint.substr(0, open);
+    sha = citation.geomint.substr(open + 2, citation.geomint.size() - open - 3);
+  }
+  const std::string scene = citation.variant.empty() || citation.scene.empty()
+                                ? citation.scene
+                                : fmt::format("{} ({} variant)", citation.scene, citation.variant);
+  std::string block = "## How to cite\n\n";
+  block +=
+      "Cite these tables by the geomint version and commit that computed them, the scene and "
+      "the hash of its scene.toml (CITATION.cff cites geomint itself):\n\n";
+  block += "| field | value |\n|---|---|\n";
+  block += citation_row("geomint version", version);
+  block += citation_row("git SHA", sha);
+  block += citation_row("scene", scene);
+  block += citation_row("scene hash", citation.scene_hash);
+  block += citation_row("date", citation.date);
+  block += fmt::format("\n> geomint {}{}, scene {}, scene.toml {}, tables of {}.\n", version,
+                       sha.empty() ? "" : " (git " + sha + ")",
+                       citation.scene.empty() ? "?" : citation.scene,
+                       citation.scene_hash.empty() ? "(hash not recorded)" : citation.scene_hash,
+                       citation.date.empty() ? "(date not recorded)" : citation.date);
+  return block;
+}
+
+}  // namespace
+
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
-                           const std::string& command_line) {
+                           const std::string& command_line, const TableCitation& citation) {
   std::string markdown = fmt::format("# {}\n\n", scene.title);
   if (!scene.description.empty()) markdown += scene.description + "\n\n";
   if (!tables.summary.empty()) {
@@ -672,8 +836,8 @@ std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                             6) +
                 "\n";
   }
-  markdown += fmt::format("Produced by `{}`.\n", command_line);
-  return markdown;
+  markdown += fmt::format("Produced by `{}`.\n\n", command_line);
+  return markdown + how_to_cite(citation);
 }
 
 void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
@@ -685,6 +849,7 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
   for (const auto& job : plan.stability_jobs) stability_labels.push_back(job.label);
   SceneTables tables;
   std::string command_line;
+  std::vector<std::pair<std::string, std::string>> provenance_lines;
   // A table of another scene or variant (a copied folder, a wrong --out) would put this scene's
   // title over its rows: its provenance and its rows' blocks must be this scene's.
   const auto read = [&](const char* name, std::vector<Row>& rows,
@@ -719,7 +884,10 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
       }
     }
     rows = table.rows;
-    if (command_line.empty()) command_line = table.value("command");
+    if (command_line.empty()) {
+      command_line = table.value("command");
+      provenance_lines = table.provenance;
+    }
   };
   read("summary.csv", tables.summary, run_labels);
   read("order.csv", tables.order, order_labels);
@@ -731,7 +899,8 @@ void rewrite_scene_markdown(const Scene& scene, const SweepOptions& options) {
         options.out_dir));
   }
   write_file_atomic((fs::path(options.out_dir) / "table.md").string(),
-                    scene_markdown(scene, tables, command_line));
+                    scene_markdown(scene, tables, command_line,
+                                   table_citation(provenance_lines, options.scene_hash)));
 }
 
 }  // namespace geomint

@@ -17,8 +17,11 @@ struct SweepOptions {
   // Written as `# scene:` and `# variant:` provenance lines, which `geomint gate` selects by.
   std::string scene_name;
   std::string variant = "full";  // "full" or "quick"
-  bool progress = true;          // progress on stderr when it is a terminal
-  bool timing = true;            // false: accuracy runs only (--no-timing)
+  // Progress on stderr: a line redrawn in place on a terminal, elsewhere a heartbeat line every
+  // progress_interval seconds (--quiet: none).
+  bool progress = true;
+  double progress_interval = 10;
+  bool timing = true;  // false: accuracy runs only (--no-timing)
   // Sharded sweep (--shard i/N, docs/CLUSTER.md "Running on a cluster"): only the units k of the
   // canonical expansion (runs, then order studies, then stability searches) with k mod N == i,
   // written to <out_dir>/shards/<table>.i-of-N.csv with a canonical_index column; never timed.
@@ -39,6 +42,11 @@ struct SceneUnits {
   size_t total() const { return runs + orders + stability; }
 };
 SceneUnits scene_units(const Scene& scene);
+
+// The expected steps of each unit of the scene in the canonical order (runs, order studies,
+// stability searches), the weights of the sweep's ETA: t_end/dt for a fixed-step run, the sum
+// over the ladder for an order study, scan and bisection runs for a stability search.
+std::vector<double> expected_unit_steps(const Scene& scene);
 
 // `geomint sweep --timing-only`: reads the summary.csv of <out_dir> (a merge or a --no-timing
 // sweep of this scene), runs the timing passes one at a time, writes wall_s into it and the
@@ -64,9 +72,22 @@ std::vector<std::string> order_points_columns(std::vector<std::string> record_co
 // from the defaults); `geomint report` shows its tables the same way.
 std::vector<Row> rows_with_short_specs(std::vector<Row> rows);
 
-// table.md: the scene's title and description, then a Markdown table per non-empty table.
+// What table.md's "How to cite" block names (docs/REPORT.md "Citing a table"): the geomint
+// version and git SHA of the tables' `# geomint: VERSION (SHA)` line, the scene and its variant,
+// the scene hash (scene_content_hash of scene.toml, the one `geomint merge` checks shards
+// against) and the tables' `# date:`.
+struct TableCitation {
+  std::string geomint;  // "VERSION (SHA)"
+  std::string scene, variant, scene_hash, date;
+};
+// The citation of tables with these provenance lines (geomint, date, scene, variant) and hash.
+TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
+                             const std::string& scene_hash);
+
+// table.md: the scene's title and description, a Markdown table per non-empty table, the
+// command that produced them and the "How to cite" block.
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
-                           const std::string& command_line);
+                           const std::string& command_line, const TableCitation& citation);
 
 // Rewrites <out_dir>/table.md from the CSVs a sweep wrote there, without running anything
 // (`geomint sweep --markdown-only`); the `Produced by` line keeps the CSVs' `# command:`.

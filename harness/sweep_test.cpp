@@ -38,6 +38,8 @@ class SweepTables : public testing::Test {
     options.out_dir = dir_.string();
     options.progress = false;
     options.command_line = "geomint sweep scene.toml";
+    options.scene_name = "tables_scene";
+    options.scene_hash = "fnv1a64:00000000deadbeef";
     ASSERT_EQ(run_sweep(scene_, options), 0);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -58,11 +60,40 @@ TEST_F(SweepTables, MarkdownShowsShortLabelsAndCsvCanonicalSpecs) {
   EXPECT_NE(markdown.find("| harmonic:omega=2 | stormer_verlet |"), std::string::npos) << markdown;
 }
 
+// table.md ends with the "How to cite" block (docs/REPORT.md "Citing a table"): version and
+// SHA of the tables' `# geomint:` line, scene, scene hash and date, none of them missing.
+TEST_F(SweepTables, MarkdownEndsWithTheHowToCiteBlock) {
+  const std::string markdown = read_text(dir_ / "table.md");
+  const auto block = markdown.find("\n## How to cite\n");
+  ASSERT_NE(block, std::string::npos) << markdown;
+  const std::string cite = markdown.substr(block);
+  const CsvTable summary = read_csv_file((dir_ / "summary.csv").string());
+  const std::string geomint = summary.value("geomint");  // "VERSION (SHA)"
+  const std::string version = geomint.substr(0, geomint.find(' '));
+  const std::string sha =
+      geomint.substr(geomint.find('(') + 1, geomint.size() - 2 - geomint.find('('));
+  ASSERT_FALSE(version.empty());
+  ASSERT_FALSE(sha.empty());
+  for (const std::string& row :
+       {"| geomint version | " + version + " |", "| git SHA | " + sha + " |",
+        std::string("| scene | tables_scene (full variant) |"),
+        std::string("| scene hash | fnv1a64:00000000deadbeef |"),
+        "| date | " + summary.value("date") + " |"}) {
+    EXPECT_NE(cite.find(row + "\n"), std::string::npos) << row << " in\n" << cite;
+  }
+  EXPECT_EQ(cite.find("(not recorded)"), std::string::npos) << cite;
+  EXPECT_NE(cite.find("> geomint " + version + " (git " + sha + "), scene tables_scene"),
+            std::string::npos)
+      << cite;
+}
+
 TEST_F(SweepTables, MarkdownOnlyRebuildsTheSameTableFromTheCsvs) {
   const std::string written = read_text(dir_ / "table.md");
   fs::remove(dir_ / "table.md");
   SweepOptions options;
   options.out_dir = dir_.string();
+  options.scene_name = "tables_scene";
+  options.scene_hash = "fnv1a64:00000000deadbeef";
   rewrite_scene_markdown(scene_, options);
   EXPECT_EQ(read_text(dir_ / "table.md"), written);
   fs::remove(dir_ / "summary.csv");
@@ -94,6 +125,29 @@ TEST(SweepSkippedRows, MessageNamesTheMethodByItsShortLabel) {
 }
 
 // Scene and gates files share one reader: its messages name the block and the key.
+// The heartbeat's ETA weighs units by expected steps (docs/CLI.md "sweep"): t_end/dt for a
+// fixed-step run (at a non-unit scale), the ladder's sum for an order study, the scene's finest
+// fixed step for an adaptive run.
+TEST(SweepProgress, UnitsWeighExpectedSteps) {
+  const fs::path dir = fs::path(testing::TempDir()) / "geomint_sweep_steps";
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic\"]\n"
+         "methods = [\"stormer_verlet\"]\ndt = [0.004, 0.25]\nt_end = 7.0\n"
+         "[[runs]]\nlabel = \"b\"\nproblems = [\"harmonic\"]\nmethods = [\"odeint_dopri5\"]\n"
+         "t_end = 3.0\n"
+         "[[orders]]\nlabel = \"c\"\nproblems = [\"harmonic\"]\nmethods = [\"rk4\"]\n"
+         "dt0 = 0.5\nlevels = 3\nt_end = 2.0\n";
+  const std::vector<double> steps =
+      expected_unit_steps(load_scene((dir / "scene.toml").string(), false));
+  ASSERT_EQ(steps.size(), 4u);
+  EXPECT_DOUBLE_EQ(steps[0], 7.0 / 0.004);
+  EXPECT_DOUBLE_EQ(steps[1], 7.0 / 0.25);
+  EXPECT_DOUBLE_EQ(steps[2], 3.0 / 0.004);
+  EXPECT_DOUBLE_EQ(steps[3], 2.0 / 0.5 * (1 + 2 + 4));
+  fs::remove_all(dir);
+}
+
 TEST(TomlReader, MessagesNameBlockAndKey) {
   const toml::table table = toml::parse("n = 'x'\nk = 1\nextra = true\n");
   TomlBlock block(table, "file.toml: [[runs]] 'a'");

@@ -381,6 +381,35 @@ TEST(Cli, GateFormatsJunitAndJsonCarryTheVerdictsAndTheExitCode) {
   fs::remove(xml);
 }
 
+// gate --quiet (docs/CLI.md "Quiet and colour"): the text format prints the failing gates alone
+// (nothing when all pass), exit codes unchanged; geomint prints no colour (no escape sequence),
+// so NO_COLOR has nothing to turn off.
+TEST(Cli, GateQuietPrintsOnlyFailuresAndNoColour) {
+  const std::string results =
+      std::string(GEOMINT_SOURCE_DIR) + "/results/fig1_pendulum/summary.csv";
+  const fs::path gates = scratch("quiet_gates.toml");
+  std::ofstream(gates) << "[[gate]]\nname = \"fig1 runs\"\ncolumn = \"status\"\nequals = \"ok\"\n"
+                          "[[gate]]\nname = \"too strict\"\ncolumn = \"steps\"\nmax = 0\n";
+  const fs::path passing = scratch("quiet_passing.toml");
+  std::ofstream(passing) << "[[gate]]\nname = \"fig1 runs\"\ncolumn = \"status\"\nequals = "
+                            "\"ok\"\n";
+  const Outcome loud = geomint("gate " + gates.string() + " " + results);
+  EXPECT_EQ(loud.exit_code, 1) << loud.output;
+  EXPECT_NE(loud.output.find("PASS fig1 runs"), std::string::npos) << loud.output;
+  EXPECT_EQ(loud.output.find('\x1b'), std::string::npos) << loud.output;
+  const Outcome quiet = geomint("gate --quiet " + gates.string() + " " + results);
+  EXPECT_EQ(quiet.exit_code, 1) << quiet.output;
+  EXPECT_NE(quiet.output.find("FAIL too strict"), std::string::npos) << quiet.output;
+  EXPECT_EQ(quiet.output.find("PASS"), std::string::npos) << quiet.output;
+  EXPECT_EQ(quiet.output.find("gate(s) passed"), std::string::npos) << quiet.output;
+  const Outcome quiet_pass = geomint("gate --quiet " + passing.string() + " " + results);
+  EXPECT_EQ(quiet_pass.exit_code, 0) << quiet_pass.output;
+  EXPECT_EQ(quiet_pass.output, "");
+  const Outcome quiet_bad = geomint("gate --quiet " + passing.string() + " /nonexistent.csv");
+  EXPECT_EQ(quiet_bad.exit_code, 2) << quiet_bad.output;
+  EXPECT_NE(quiet_bad.output.find("nonexistent.csv"), std::string::npos) << quiet_bad.output;
+}
+
 TEST(Readme, MethodAndProblemTablesMatchTheRegistry) {
   std::set<std::string> methods, problems;
   for (const auto& entry : integrator_registry()) methods.insert(entry.name);
@@ -510,6 +539,44 @@ TEST(Cli, ShardMergeAndSlurmScripts) {
   const std::string timing_script{std::istreambuf_iterator<char>(timing), {}};
   EXPECT_NE(timing_script.find("#SBATCH --exclusive"), std::string::npos) << timing_script;
   EXPECT_NE(timing_script.find("srun --cpu-bind=cores"), std::string::npos) << timing_script;
+  fs::remove_all(folder);
+}
+
+// A sweep whose stderr is a pipe (a Slurm or CI log) prints heartbeat lines at the interval
+// given by --progress-interval or GEOMINT_PROGRESS_INTERVAL (docs/CLI.md "sweep"), each with
+// done/total runs and an ETA, and no carriage return; --quiet prints nothing but errors.
+TEST(Cli, SweepInALogPrintsHeartbeatLines) {
+  const fs::path folder = scratch("heartbeat_scene");
+  fs::create_directories(folder);
+  std::ofstream(folder / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic:omega=3\"]\n"
+         "methods = [\"stormer_verlet\", \"symplectic_euler_a\"]\ndt = 2e-4\nt_end = 20.0\n"
+         "timing_repeats = 0\n";
+  const std::string scene = (folder / "scene.toml").string();
+  const std::regex heartbeat(
+      R"(\[sweep\] [0-2]/2 runs, [0-9]+% of expected steps, [0-9.]+ s elapsed, ETA [^\n]+\n)");
+  for (const std::string& sweep :
+       {std::string(GEOMINT_BINARY) + " sweep --progress-interval 0.01 " + scene,
+        "GEOMINT_PROGRESS_INTERVAL=0.01 " + std::string(GEOMINT_BINARY) + " sweep " + scene}) {
+    const Outcome logged = geomint_shell(sweep + " < /dev/null");
+    EXPECT_EQ(logged.exit_code, 0) << logged.output;
+    const auto lines =
+        std::distance(std::sregex_iterator(logged.output.begin(), logged.output.end(), heartbeat),
+                      std::sregex_iterator());
+    EXPECT_GE(lines, 1) << sweep << ":\n" << logged.output;
+    EXPECT_EQ(logged.output.find('\r'), std::string::npos) << logged.output;
+  }
+  // --quiet: no heartbeat, no closing line; bad input is still reported, with exit 2.
+  const Outcome quiet = geomint("sweep --quiet --progress-interval 0.01 " + scene);
+  EXPECT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
+  const Outcome quiet_bad = geomint("sweep --quiet " + (folder / "nosuch.toml").string());
+  EXPECT_EQ(quiet_bad.exit_code, 2) << quiet_bad.output;
+  EXPECT_NE(quiet_bad.output.find("nosuch.toml"), std::string::npos) << quiet_bad.output;
+  const Outcome bad = geomint_shell("GEOMINT_PROGRESS_INTERVAL=soon " +
+                                    std::string(GEOMINT_BINARY) + " sweep " + scene);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("$GEOMINT_PROGRESS_INTERVAL"), std::string::npos) << bad.output;
   fs::remove_all(folder);
 }
 

@@ -11,6 +11,10 @@
 
 namespace geomint::cli {
 
+void inform(const Context& context, const std::string& line) {
+  if (!context.quiet) fmt::print(stderr, "{}\n", line);
+}
+
 std::string program_name(int argc, char** argv) {
   if (argc < 1 || argv[0] == nullptr) return "geomint";
   std::string name = argv[0];

@@ -15,12 +15,18 @@ constexpr int kExitFailed = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 3;
 
-// What a verb knows of the invocation besides its options: the name its messages start with and
-// the `# command:` provenance line.
+// What a verb knows of the invocation besides its options: the name its messages start with,
+// the `# command:` provenance line, and --quiet (every verb takes it: no progress, no
+// informational line on stderr; errors and exit codes unchanged).
 struct Context {
   std::string program;
   std::string command_line;
+  bool quiet = false;
 };
+
+// An informational line on stderr ("sweep done", "merged", an order's ladder), which --quiet
+// drops; errors are printed directly and never dropped.
+void inform(const Context& context, const std::string& line);
 
 // One verb: its CLI11 subcommand (options bound to an options struct the closure owns) and what
 // runs it. Throws InputError for bad input (exit 2); returns the exit code otherwise.

@@ -66,8 +66,10 @@ std::string json_escaped(const std::string& text) {
   return out;
 }
 
-void print_text(const std::vector<const GateOutcome*>& applied, bool verbose) {
+// Plain text, no colour (docs/CLI.md "Quiet and colour"); --quiet prints the failing gates alone.
+void print_text(const std::vector<const GateOutcome*>& applied, bool verbose, bool quiet) {
   for (const GateOutcome* outcome : applied) {
+    if (quiet && outcome->passed) continue;
     fmt::print("{} {} ({} row(s))\n", outcome->passed ? "PASS" : "FAIL", outcome->gate->name,
                outcome->rows_checked);
     if (!outcome->passed || verbose) {
@@ -119,7 +121,7 @@ void print_json(const std::vector<const GateOutcome*>& applied, bool verbose) {
   fmt::print("{}]\n", applied.empty() ? "" : "\n");
 }
 
-int run_gate(const GateCliOptions& cli, const Context&) {
+int run_gate(const GateCliOptions& cli, const Context& context) {
   const std::vector<Gate> gates = load_gates(cli.gates_path);
   const auto outcomes = check_gates(gates, load_result_files(cli.results));
   std::vector<const GateOutcome*> applied;
@@ -140,9 +142,11 @@ int run_gate(const GateCliOptions& cli, const Context&) {
   } else if (cli.format == "json") {
     print_json(applied, cli.verbose);
   } else {
-    print_text(applied, cli.verbose);
-    fmt::print("{} of {} gate(s) passed ({} not applicable to the scenes given)\n",
-               applied.size() - failed, applied.size(), outcomes.size() - applied.size());
+    print_text(applied, cli.verbose, context.quiet);
+    if (!context.quiet) {
+      fmt::print("{} of {} gate(s) passed ({} not applicable to the scenes given)\n",
+                 applied.size() - failed, applied.size(), outcomes.size() - applied.size());
+    }
   }
   return failed == 0 ? kExitOk : kExitFailed;
 }

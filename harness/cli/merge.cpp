@@ -49,8 +49,8 @@ int run_merge(const MergeCliOptions& cli, const Context& context) {
     fmt::print(stderr, "{}: merge: {}\n", context.program, refused.what());
     return kExitFailed;
   }
-  fmt::print(stderr, "{}: merged the shards of '{}' into {}\n", context.program, scene.title,
-             cli.dir);
+  inform(context, fmt::format("{}: merged the shards of '{}' into {}", context.program, scene.title,
+                              cli.dir));
   return kExitOk;
 }
 

@@ -33,8 +33,9 @@ int run_order(OrderOptions options, const Context& context) {
                   static_cast<int>(options.levels), options.t_end, options.diverge_factor);
   for (const auto& run_result : study.runs) {
     const Row row = to_row(run_result.record);
-    fmt::print(stderr, "dt={:<12} status={:<8} error_final={}\n", row.at("dt"), row.at("status"),
-               row.count("error_final") ? row.at("error_final") : "-");
+    inform(context,
+           fmt::format("dt={:<12} status={:<8} error_final={}", row.at("dt"), row.at("status"),
+                       row.count("error_final") ? row.at("error_final") : "-"));
   }
   if (!options.out_path.empty()) {
     std::vector<RunRecord> records;
@@ -46,14 +47,15 @@ int run_order(OrderOptions options, const Context& context) {
     return kExitFailed;
   }
   fmt::print("{:.3f}\n", study.fit.order);
-  fmt::print(stderr, "order {:.3f} (declared {}) from dt = {}{}\n", study.fit.order,
-             study.record.declared_order, to_row(study.record).at("points_used"),
-             study.fit.note.empty() ? "" : "; " + study.fit.note);
+  inform(context, fmt::format("order {:.3f} (declared {}) from dt = {}{}", study.fit.order,
+                              study.record.declared_order, to_row(study.record).at("points_used"),
+                              study.fit.note.empty() ? "" : "; " + study.fit.note));
   const Row orders = to_row(study.record);
   const auto shown = [](const std::string& cell) { return cell.empty() ? "no fit" : cell; };
-  fmt::print(stderr, "order_q {}, order_p {}, order_multiplier {}{}\n", shown(orders.at("order_q")),
-             shown(orders.at("order_p")), shown(orders.at("order_multiplier")),
-             study.multiplier_from_state ? " (multiplier from (q, p))" : "");
+  inform(context,
+         fmt::format("order_q {}, order_p {}, order_multiplier {}{}", shown(orders.at("order_q")),
+                     shown(orders.at("order_p")), shown(orders.at("order_multiplier")),
+                     study.multiplier_from_state ? " (multiplier from (q, p))" : ""));
   return kExitOk;
 }
 

@@ -36,11 +36,10 @@ int run_reference(const ReferenceCliOptions& cli, const Context& context) {
   options.command_line = context.command_line;
   const ReferenceSummary summary = generate_reference(options);
   fmt::print("{}\n", summary.path);
-  fmt::print(stderr,
-             "reference: dt={:.6g}, {} steps, estimated error final {:.3g}, max {:.3g} "
-             "(difference to the 2*dt run), {:.1f} s\n",
-             summary.dt, summary.steps, summary.estimated_error_final, summary.estimated_error_max,
-             summary.seconds);
+  inform(context, fmt::format("reference: dt={:.6g}, {} steps, estimated error final {:.3g}, max "
+                              "{:.3g} (difference to the 2*dt run), {:.1f} s",
+                              summary.dt, summary.steps, summary.estimated_error_final,
+                              summary.estimated_error_max, summary.seconds));
   return kExitOk;
 }
 

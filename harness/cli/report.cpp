@@ -26,10 +26,11 @@ Verb add_report(CLI::App& app) {
             options->command_line = context.command_line;
             const ReportSummary summary = write_report(*options);
             // 0 once written: the gate verdicts are in the pages (`geomint gate` is what fails).
-            fmt::print(stderr,
-                       "report: {} scenes, {} tables, gates {} passed, {} failed; open {}\n",
-                       summary.scenes, summary.tables, summary.gates_passed, summary.gates_failed,
-                       (std::filesystem::path(options->out_dir) / "index.html").string());
+            inform(context,
+                   fmt::format("report: {} scenes, {} tables, gates {} passed, {} failed; open {}",
+                               summary.scenes, summary.tables, summary.gates_passed,
+                               summary.gates_failed,
+                               (std::filesystem::path(options->out_dir) / "index.html").string()));
             return kExitOk;
           }};
 }

@@ -44,7 +44,7 @@ int run_slurm(const SlurmCliOptions& cli, const Context& context) {
     std::string dependency;
     for (const auto& path : scripts) {
       const std::string id = submit_sbatch(path, dependency);
-      fmt::print(stderr, "{}: submitted {} as job {}\n", context.program, path, id);
+      inform(context, fmt::format("{}: submitted {} as job {}", context.program, path, id));
       dependency = id;
     }
   }

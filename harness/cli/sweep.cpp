@@ -23,12 +23,15 @@ struct SweepCliOptions {
   std::string shard_text;
   bool shard_from_env = false;
   int shard_count = 0;
+  double progress_interval = 10;
 };
 
 int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   const Scene scene = load_scene(cli.scene_path, cli.quick);
   SweepOptions options;
   options.jobs = cli.jobs;
+  options.progress_interval = cli.progress_interval;
+  options.progress = !context.quiet;
   options.command_line = context.command_line;
   const auto folder = std::filesystem::path(cli.scene_path).parent_path();
   options.out_dir = !cli.out.empty() ? cli.out
@@ -38,6 +41,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   // holds scene.toml, whatever --out says.
   options.scene_name = std::filesystem::absolute(cli.scene_path).parent_path().filename().string();
   options.variant = cli.quick ? "quick" : "full";
+  // table.md's "How to cite" block names it; a shard's provenance carries it for merge.
+  options.scene_hash = scene_content_hash(cli.scene_path, cli.quick);
   const std::string out_option = cli.out.empty() ? "output folder" : "--out";
   check_output_dir(options.out_dir, out_option);
   const auto out_file = [&](const char* name) {
@@ -57,8 +62,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
           "--shard and --shard-from-env");
     }
     run_timing_only(scene, options);
-    fmt::print(stderr, "{}: timing passes of '{}' written into {}\n", context.program, scene.title,
-               options.out_dir);
+    inform(context, fmt::format("{}: timing passes of '{}' written into {}", context.program,
+                                scene.title, options.out_dir));
     return kExitOk;
   }
   options.timing = !cli.no_timing;
@@ -70,7 +75,6 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
         cli.shard_from_env ? shard_from_env(cli.shard_count) : parse_shard(cli.shard_text);
     options.shard_index = id.index;
     options.shard_count = id.count;
-    options.scene_hash = scene_content_hash(cli.scene_path, cli.quick);
     const SceneUnits units = scene_units(scene);
     if (static_cast<size_t>(id.count) > units.total()) {
       // Merge refuses such a set: shards past the last unit would hold nothing.
@@ -81,8 +85,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     }
     const auto tables = shard_tables(units.runs, units.orders, units.stability);
     if (shard_complete(options.out_dir, tables, id, options.scene_hash)) {
-      fmt::print(stderr, "{}: shard {}/{} of '{}' is complete on disk; skipped\n", context.program,
-                 id.index, id.count, scene.title);
+      inform(context, fmt::format("{}: shard {}/{} of '{}' is complete on disk; skipped",
+                                  context.program, id.index, id.count, scene.title));
       return kExitOk;
     }
     if (shard_fails_on_purpose(id)) {
@@ -94,8 +98,8 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     throw InputError("--shards N goes with --shard-from-env");
   }
   const int failed = run_sweep(scene, options);
-  fmt::print(stderr, "{}: sweep '{}' done: {} failed run(s) reported as rows in {}\n",
-             context.program, scene.title, failed, options.out_dir);
+  inform(context, fmt::format("{}: sweep '{}' done: {} failed run(s) reported as rows in {}",
+                              context.program, scene.title, failed, options.out_dir));
   return kExitOk;
 }
 
@@ -125,6 +129,13 @@ Verb add_sweep(CLI::App& app) {
   command->add_flag("--timing-only", options->timing_only,
                     "run only the timing passes, one at a time, into the merged tables of the "
                     "output folder (after `geomint merge`), with this node's CPU in provenance");
+  command
+      ->add_option("--progress-interval", options->progress_interval,
+                   "seconds between the heartbeat lines printed when stderr is not a terminal "
+                   "(a log): done/total runs and an ETA weighted by expected steps; default 10, or "
+                   "$GEOMINT_PROGRESS_INTERVAL")
+      ->envname("GEOMINT_PROGRESS_INTERVAL")
+      ->check(CLI::Range(0.01, 86400.0));
   return {"sweep", command,
           [options](const Context& context) { return run_sweep_verb(*options, context); }};
 }
