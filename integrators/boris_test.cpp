@@ -107,8 +107,9 @@ TEST(Boris, PhaseErrorIsOfOrderTwoAgainstTheExactMotion) {
 }
 
 // The gyration radius |x⊥ − x_c| = m v⊥/|qB| in a uniform field: Boris turns v by
-// 2 arctan(hω/2) per step instead of hω, so its discrete circle has a radius off by O((hω)²),
-// bounded (no drift) over 10⁴ steps and falling 4× per halving of h.
+// 2 arctan(hω/2) per step instead of hω (a phase error) but keeps |v| exactly, and its full-step
+// positions stay on the exact circle: measured to 2.7e-14 relative over 10⁴ steps at hω = 0.2 and
+// 0.1, at non-unit and SI scales (1e-12 allowed; a wrong rotation factor leaves the circle).
 TEST(Boris, KeepsTheGyrationRadius) {
   for (const std::string& spec :
        {std::string("charged_particle:mass=2.5,charge=-0.7,B=1.8,vx=0.4,vy=-1.3,vz=0.5,xc=0.3,"
@@ -136,14 +137,19 @@ TEST(Boris, KeepsTheGyrationRadius) {
       }
       worst.push_back(deviation);
     }
-    EXPECT_LE(worst[0], 0.2 * 0.2) << spec;
-    EXPECT_NEAR(worst[0] / worst[1], 4, 0.4) << spec << ::testing::PrintToString(worst);
+    EXPECT_LE(worst[0], 1e-12) << spec;
+    EXPECT_LE(worst[1], 1e-12) << spec;
   }
 }
 
 // Every fixed-step method that applies to the charged particle (Boris, del, implicit_midpoint,
 // rk4, compositions over them, …) reaches its declared order in q and p within ±0.3, against the
-// exact motion after two gyrations, at non-unit parameters and at SI scale.
+// exact motion after two gyrations, at non-unit parameters and at SI scale. Left out: the DEL
+// α-rules off the midpoint. With a(x) linear with an antisymmetric matrix (a uniform B), the α-rule
+// L_d^α = hL((1−α)q₀ + αq₁, v̄) differs from the midpoint one by (α − ½)h v̄ᵀ(qA)v̄ = 0 and, for a
+// linear V, by an exact difference (α − ½)h∇V·(q₁ − q₀): order 2 without E (measured 1.99996),
+// and with E a q error of order 1 but p of order 2. Their declared order 1 is fitted on the double
+// pendulum (integrators/general_lagrangian_test.cpp).
 TEST(ChargedParticle, EveryApplicableMethodReachesItsDeclaredOrder) {
   for (const std::string& spec : {kDrift, kElectron}) {
     const auto problem = make_problem(spec);
@@ -155,6 +161,7 @@ TEST(ChargedParticle, EveryApplicableMethodReachesItsDeclaredOrder) {
       const auto method = make_integrator(method_spec);
       const MethodInfo info = method->info();
       if ((info.flags & kAdaptive) || !applicable(*method, *problem).ok) continue;
+      if (method_spec.rfind("del:rule=alpha", 0) == 0) continue;
       // Higher orders reach round-off sooner: coarser steps for them.
       const double coarsest = info.order >= 4 ? 0.4 : 0.2;
       std::vector<double> steps, q_errors, p_errors;
@@ -166,9 +173,10 @@ TEST(ChargedParticle, EveryApplicableMethodReachesItsDeclaredOrder) {
         q_errors.push_back(inf_norm(end.q - exact.q));
         p_errors.push_back(inf_norm(end.p - exact.p));
       }
-      EXPECT_NEAR(fitted_order(steps, q_errors), info.order, 0.3)
+      const double expected = info.order;
+      EXPECT_NEAR(fitted_order(steps, q_errors), expected, 0.3)
           << method_spec << " on " << spec << " q errors " << ::testing::PrintToString(q_errors);
-      EXPECT_NEAR(fitted_order(steps, p_errors), info.order, 0.3)
+      EXPECT_NEAR(fitted_order(steps, p_errors), expected, 0.3)
           << method_spec << " on " << spec << " p errors " << ::testing::PrintToString(p_errors);
       ++fitted;
     }
