@@ -156,12 +156,8 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   // first-order rigid_body_euler or the constrained rigid_body.
   if ((info.flags & kFreeRigidBodyOnly) && free_rigid_body(problem) != nullptr) return {};
   // Likewise a charged particle gives the Boris pusher its m, q, E(x), B(x) and A(x).
-  if (info.flags & kChargedParticleOnly) {
-    if (charged_particle_structure(problem) != nullptr) return {};
-    return {false, fmt::format("method '{}' integrates charged particles only (charged_particle, "
-                               "which offers its mass, charge, fields and vector potential); "
-                               "problem '{}' is none",
-                               method.spec(), problem.name())};
+  if ((info.flags & kChargedParticleOnly) && charged_particle_structure(problem) != nullptr) {
+    return {};
   }
   if (problem.has(kFirstOrderOnly)) {
     if (info.flags & kFirstOrderCapable) return {};
@@ -174,6 +170,12 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   if (info.flags & kFreeRigidBodyOnly) {
     return {false, fmt::format("method '{}' integrates free rigid bodies only (rigid_body, "
                                "rigid_body_euler, which offer their moments and (Q, Pi)); "
+                               "problem '{}' is none",
+                               method.spec(), problem.name())};
+  }
+  if (info.flags & kChargedParticleOnly) {
+    return {false, fmt::format("method '{}' integrates charged particles only (charged_particle, "
+                               "which offers its mass, charge, fields and vector potential); "
                                "problem '{}' is none",
                                method.spec(), problem.name())};
   }

@@ -503,6 +503,9 @@ const std::map<std::string, std::vector<std::string>>& exact_branches() {
         "theta0=12.9,v0=0.4",             // libration about 4π (turns offset)
         "theta0=-9.5,v0=-4"}},            // rotation with a turns offset
       {"kepler", {"e=0.3", "e=0.95"}},
+      // A parallel E that reverses the motion along B; a strong perpendicular E (drift faster
+      // than the gyration speed, a trochoid with loops removed).
+      {"charged_particle", {"Ez=-0.3,vz=0.6", "mass=3,charge=2,B=0.5,Ex=1.2,vx=-0.7,vy=0.2"}},
       {"damped_oscillator",
        {"zeta=0,omega=1.7,q0=0.3,v0=-1",               // no damping (no force)
         "zeta=0.999999,omega=2",                       // just underdamped
