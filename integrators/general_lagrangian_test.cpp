@@ -179,8 +179,10 @@ TEST(GeneralStep, ApplicabilityFollowsTheDeclaredFlag) {
     const Applicability verdict = applicable(*method, *problem);
     const bool general = (method->info().flags & kGeneralLagrangian) != 0;
     EXPECT_EQ(verdict.ok, general) << spec << ": " << verdict.reason;
-    // A free-rigid-body-only method is refused first for lacking the body it reads.
-    const bool rigid_only = (method->info().flags & kFreeRigidBodyOnly) != 0;
+    // A free-rigid-body-only or charged-particle-only method is refused first for lacking the
+    // structure it reads.
+    const bool rigid_only =
+        (method->info().flags & (kFreeRigidBodyOnly | kChargedParticleOnly)) != 0;
     if (general) {
       ++admitted;
     } else {

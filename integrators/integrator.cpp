@@ -9,6 +9,7 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
+#include "problems/charged_particle.hpp"
 #include "problems/rigid_body.hpp"
 
 namespace geomint {
@@ -93,6 +94,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kConservativeOnly, "conservative_only"},
       {kGeneralLagrangian, "general_lagrangian"},
       {kFreeRigidBodyOnly, "free_rigid_body_only"},
+      {kChargedParticleOnly, "charged_particle_only"},
   };
   std::vector<std::string> out;
   for (const auto& [bit, label] : kNames) {
@@ -153,6 +155,10 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   // A free rigid body gives such a method all it reads (moments and the (Q, Π) view), be it the
   // first-order rigid_body_euler or the constrained rigid_body.
   if ((info.flags & kFreeRigidBodyOnly) && free_rigid_body(problem) != nullptr) return {};
+  // Likewise a charged particle gives the Boris pusher its m, q, E(x), B(x) and A(x).
+  if ((info.flags & kChargedParticleOnly) && charged_particle_structure(problem) != nullptr) {
+    return {};
+  }
   if (problem.has(kFirstOrderOnly)) {
     if (info.flags & kFirstOrderCapable) return {};
     return {false,
@@ -164,6 +170,12 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   if (info.flags & kFreeRigidBodyOnly) {
     return {false, fmt::format("method '{}' integrates free rigid bodies only (rigid_body, "
                                "rigid_body_euler, which offer their moments and (Q, Pi)); "
+                               "problem '{}' is none",
+                               method.spec(), problem.name())};
+  }
+  if (info.flags & kChargedParticleOnly) {
+    return {false, fmt::format("method '{}' integrates charged particles only (charged_particle, "
+                               "which offers its mass, charge, fields and vector potential); "
                                "problem '{}' is none",
                                method.spec(), problem.name())};
   }

@@ -37,6 +37,9 @@ enum MethodFlag : unsigned {
   // Runs on free rigid bodies only (the Lie–Poisson splitting): applicable() admits it exactly
   // where free_rigid_body(problem) (problems/rigid_body.hpp) finds the structure it reads.
   kFreeRigidBodyOnly = 1u << 13,
+  // Runs on charged particles only (the Boris pusher): applicable() admits it exactly where
+  // charged_particle_structure(problem) (problems/charged_particle.hpp) finds m, q, E, B and A.
+  kChargedParticleOnly = 1u << 16,
 };
 std::vector<std::string> flag_names(unsigned flags);
 

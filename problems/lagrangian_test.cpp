@@ -33,12 +33,15 @@ std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
   return out;
 }
 
-// Central-difference Jacobian of a vector function (columns = ∂f/∂x_j), step relative to |x|.
-Eigen::MatrixXd difference_jacobian(const std::function<Vec(const Vec&)>& f, const Vec& x) {
+// Central-difference Jacobian of a vector function (columns = ∂f/∂x_j), step relative to |x_j| or
+// to the component's typical size `scale[j]` (its units: an electron's x ~ 1e-5 m and p ~ 1e-24
+// kg m/s, where a unit floor would step across the whole orbit or swamp p).
+Eigen::MatrixXd difference_jacobian(const std::function<Vec(const Vec&)>& f, const Vec& x,
+                                    const Vec& scale) {
   const Vec f0 = f(x);
   Eigen::MatrixXd J(f0.size(), x.size());
   for (int j = 0; j < x.size(); ++j) {
-    const double delta = 1e-6 * std::max(1.0, std::abs(x[j]));
+    const double delta = 1e-6 * std::max(scale[j], std::abs(x[j]));
     Vec plus = x, minus = x;
     plus[j] += delta;
     minus[j] -= delta;
@@ -66,7 +69,9 @@ class GeneralProblem : public ::testing::TestWithParam<std::string> {
   }
   const LagrangianSystem& system() const { return *general_lagrangian(*problem_); }
   // States the checks probe: the start and two nearby ones, each with a velocity that makes
-  // every v-dependent term non-zero (the double pendulum starts from rest).
+  // every v-dependent term non-zero (the double pendulum starts from rest). Offsets and
+  // velocities are in the problem's own length and speed (an electron's orbit is 6 µm across at
+  // 10⁶ m/s: unit offsets would put qA(x) 10¹⁰ times above m v and leave v = (p − qA)/m no digit).
   std::vector<std::pair<Vec, Vec>> samples() const {
     const State start = problem_->initial_state();
     std::vector<std::pair<Vec, Vec>> out;
@@ -74,12 +79,31 @@ class GeneralProblem : public ::testing::TestWithParam<std::string> {
     for (int k = 0; k < 3; ++k) {
       Vec q = start.q, v(n);
       for (int i = 0; i < n; ++i) {
-        q[i] += 0.07 * k * (i + 1) * (i % 2 == 0 ? 1 : -1);
-        v[i] = 0.6 + 0.45 * i - 0.3 * k;
+        q[i] += 0.07 * k * (i + 1) * (i % 2 == 0 ? 1 : -1) * length();
+        v[i] = (0.6 + 0.45 * i - 0.3 * k) * speed();
       }
       out.emplace_back(q, v);
     }
     return out;
+  }
+  // The size of the start's q and v (1 where it is zero: a pendulum at rest).
+  double length() const {
+    const double size = inf_norm(problem_->initial_state().q);
+    return size > 0 ? size : 1.0;
+  }
+  double speed() const {
+    const State start = problem_->initial_state();
+    const double size = inf_norm(system().velocity(start.q, start.p));
+    return size > 0 ? size : 1.0;
+  }
+  // Per-component scales for difference_jacobian: of q, of v, and of (q, p) at a sample.
+  Vec q_scale() const { return Vec::Constant(problem_->dof(), length()); }
+  Vec v_scale() const { return Vec::Constant(problem_->dof(), speed()); }
+  Vec qp_scale(const Vec& p) const {
+    const int n = problem_->dof();
+    Vec scale(2 * n);
+    scale << q_scale(), Vec::Constant(n, inf_norm(p) > 0 ? inf_norm(p) : 1.0);
+    return scale;
   }
   std::unique_ptr<Problem> problem_;
 };
@@ -107,7 +131,7 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
     };
     Vec T_q;
     L.kinetic_gradient(q, v, T_q);
-    expect_close(T_q.transpose(), difference_jacobian(kinetic, q), "T_q");
+    expect_close(T_q.transpose(), difference_jacobian(kinetic, q, q_scale()), "T_q");
     DenseMatrix D;
     L.mass_velocity_jacobian(q, v, D);
     const auto mass_times_v = [&](const Vec& x) {
@@ -115,7 +139,7 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
       L.mass_matrix(x, M);
       return Vec(M * v);
     };
-    expect_close(D, difference_jacobian(mass_times_v, q), "d(M v)/dq");
+    expect_close(D, difference_jacobian(mass_times_v, q, q_scale()), "d(M v)/dq");
     DenseMatrix T_qq;
     L.kinetic_hessian(q, v, T_qq);
     const auto kinetic_gradient = [&](const Vec& x) {
@@ -123,7 +147,7 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
       L.kinetic_gradient(x, v, g);
       return g;
     };
-    expect_close(T_qq, difference_jacobian(kinetic_gradient, q), "T_qq");
+    expect_close(T_qq, difference_jacobian(kinetic_gradient, q, q_scale()), "T_qq");
     DenseMatrix A;
     L.gyroscopic_jacobian(q, A);
     const auto gyroscopic = [&](const Vec& x) {
@@ -131,7 +155,7 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
       L.gyroscopic(x, a);
       return a;
     };
-    expect_close(A, difference_jacobian(gyroscopic, q), "da/dq");
+    expect_close(A, difference_jacobian(gyroscopic, q, q_scale()), "da/dq");
     DenseMatrix a_qq;
     L.gyroscopic_hessian(q, v, a_qq);
     const auto gyroscopic_gradient = [&](const Vec& x) {
@@ -139,11 +163,11 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
       L.gyroscopic_jacobian(x, Ax);
       return Vec(Ax.transpose() * v);
     };
-    expect_close(a_qq, difference_jacobian(gyroscopic_gradient, q), "d²(a·v)/dq²");
+    expect_close(a_qq, difference_jacobian(gyroscopic_gradient, q, q_scale()), "d²(a·v)/dq²");
     Vec g;
     L.gradient(q, g);
     const auto potential = [&](const Vec& x) { return Vec::Constant(1, L.potential(x)); };
-    expect_close(g.transpose(), difference_jacobian(potential, q), "grad V");
+    expect_close(g.transpose(), difference_jacobian(potential, q, q_scale()), "grad V");
     DenseMatrix K;
     L.potential_hessian(q, K);
     const auto gradient = [&](const Vec& x) {
@@ -151,7 +175,7 @@ TEST_P(GeneralProblem, PrimitivesMatchFiniteDifferences) {
       L.gradient(x, gx);
       return gx;
     };
-    expect_close(K, difference_jacobian(gradient, q), "hess V");
+    expect_close(K, difference_jacobian(gradient, q, q_scale()), "hess V");
   }
 }
 
@@ -164,22 +188,26 @@ TEST_P(GeneralProblem, AssembledBlocksMatchFiniteDifferencesOfTheLagrangian) {
     Vec L_q;
     L.lagrangian_q(q, v, L_q);
     const auto lagrangian_at_q = [&](const Vec& x) { return Vec::Constant(1, L.lagrangian(x, v)); };
-    expect_close(L_q.transpose(), difference_jacobian(lagrangian_at_q, q), "L_q");
+    expect_close(L_q.transpose(), difference_jacobian(lagrangian_at_q, q, q_scale()), "L_q");
     const auto lagrangian_at_v = [&](const Vec& w) { return Vec::Constant(1, L.lagrangian(q, w)); };
-    expect_close(L.momentum(q, v).transpose(), difference_jacobian(lagrangian_at_v, v), "L_v");
+    expect_close(L.momentum(q, v).transpose(), difference_jacobian(lagrangian_at_v, v, v_scale()),
+                 "L_v");
     DenseMatrix L_vq, L_qq, M;
     L.lagrangian_vq(q, v, L_vq);
-    expect_close(L_vq, difference_jacobian([&](const Vec& x) { return L.momentum(x, v); }, q),
+    expect_close(L_vq,
+                 difference_jacobian([&](const Vec& x) { return L.momentum(x, v); }, q, q_scale()),
                  "L_vq");
     L.mass_matrix(q, M);
-    expect_close(M, difference_jacobian([&](const Vec& w) { return L.momentum(q, w); }, v), "L_vv");
+    expect_close(M,
+                 difference_jacobian([&](const Vec& w) { return L.momentum(q, w); }, v, v_scale()),
+                 "L_vv");
     L.lagrangian_qq(q, v, L_qq);
     const auto lagrangian_q = [&](const Vec& x) {
       Vec g;
       L.lagrangian_q(x, v, g);
       return g;
     };
-    expect_close(L_qq, difference_jacobian(lagrangian_q, q), "L_qq");
+    expect_close(L_qq, difference_jacobian(lagrangian_q, q, q_scale()), "L_qq");
   }
 }
 
@@ -199,8 +227,9 @@ TEST_P(GeneralProblem, HamiltonianViewIsTheLegendreTransform) {
     L.hamiltonian_gradient(q, p, H_q, H_p);
     const auto h_of_q = [&](const Vec& x) { return Vec::Constant(1, L.hamiltonian(x, p)); };
     const auto h_of_p = [&](const Vec& y) { return Vec::Constant(1, L.hamiltonian(q, y)); };
-    expect_close(H_q.transpose(), difference_jacobian(h_of_q, q), "H_q");
-    expect_close(H_p.transpose(), difference_jacobian(h_of_p, p), "H_p");
+    expect_close(H_q.transpose(), difference_jacobian(h_of_q, q, q_scale()), "H_q");
+    expect_close(H_p.transpose(), difference_jacobian(h_of_p, p, qp_scale(p).tail(p.size())),
+                 "H_p");
     // Hamilton's vector field and its Jacobian, as the ODE solvers see them.
     Vec y(2 * q.size());
     y << q, p;
@@ -215,7 +244,8 @@ TEST_P(GeneralProblem, HamiltonianViewIsTheLegendreTransform) {
       problem_->first_order_rhs(0.0, z, zdot);
       return zdot;
     };
-    expect_close(Eigen::MatrixXd(J), difference_jacobian(field, y), "d(q', p')/d(q, p)");
+    expect_close(Eigen::MatrixXd(J), difference_jacobian(field, y, qp_scale(p)),
+                 "d(q', p')/d(q, p)");
   }
 }
 
@@ -227,7 +257,9 @@ TEST_P(GeneralProblem, EnergyIsKeptByAnAccurateTrajectory) {
   Vec y(2 * n);
   y << start.q, start.p;
   const double h = problem_->default_dt() / 10;
-  const long steps = std::lround(2.0 / h);
+  // Two time units, or the default run where that is shorter (an electron gyrates 10¹¹ times a
+  // second).
+  const long steps = std::lround(std::min(2.0, problem_->default_t_end()) / h);
   const auto f = [&](const Vec& z) {
     Vec zdot;
     problem_->first_order_rhs(0.0, z, zdot);
@@ -240,7 +272,9 @@ TEST_P(GeneralProblem, EnergyIsKeptByAnAccurateTrajectory) {
     y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     worst = std::max(worst, std::abs(problem_->energy(y.head(n), y.tail(n)) - energy0));
   }
-  EXPECT_LE(worst, 1e-10 * std::max(std::abs(energy0), 1.0));
+  // Relative to the sizes of kinetic and potential energy, not to 1 (an electron's is 1e-19 J).
+  const double potential0 = problem_->potential(start.q);
+  EXPECT_LE(worst, 1e-10 * (std::abs(energy0 - potential0) + std::abs(potential0)));
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, GeneralProblem, ::testing::ValuesIn(general_specs()), test_name);

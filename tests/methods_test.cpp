@@ -19,12 +19,13 @@ namespace {
 
 // Constraints-only methods (rattle, penalty) are checked on constrained problems instead
 // (integrators/constrained_methods_test.cpp): the problems here have no constraints; the
-// free-rigid-body splitting on the rigid bodies (integrators/lie_poisson_test.cpp).
+// free-rigid-body splitting on the rigid bodies (integrators/lie_poisson_test.cpp), the Boris
+// pusher on the charged particle (integrators/boris_test.cpp).
 std::vector<std::string> fixed_step_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
     if (!(make_integrator(spec)->info().flags &
-          (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly))) {
+          (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly | kChargedParticleOnly))) {
       out.push_back(spec);
     }
   }

@@ -212,6 +212,9 @@ CheckResult run_check(const std::string& method, const std::string& name,
   }
   if (constraints_only) return not_declared(name.c_str(), method, "unconstrained");
   if (flags & kFreeRigidBodyOnly) return not_declared(name.c_str(), method, "free-rigid-body-only");
+  if (flags & kChargedParticleOnly) {
+    return not_declared(name.c_str(), method, "charged-particle-only");
+  }
   if (name == "declared_order_pendulum" || name == "declared_order_kepler") {
     if (flags & kAdaptive) return not_declared(name.c_str(), method, "fixed-step");
     return declared_order(method,
