@@ -69,6 +69,7 @@ std::vector<RecordColumn> build_schema() {
       {"label", text(&RunRecord::label)},
       {"problem", [](const RunRecord& r) { return std::optional(r.problem); }},
       {"method", [](const RunRecord& r) { return std::optional(r.method); }},
+      {"family", text(&RunRecord::family)},
       {"dt", real(&RunRecord::dt)},
       {"t_end", real(&RunRecord::t_end)},
       {"status", [](const RunRecord& r) { return std::optional(r.status); }},
@@ -90,6 +91,9 @@ std::vector<RecordColumn> build_schema() {
                       }});
   }
   schema.push_back({"wall_s", real(&RunRecord::wall_s)});
+  schema.push_back({"wall_s_min", real(&RunRecord::wall_s_min)});
+  schema.push_back({"wall_s_iqr", real(&RunRecord::wall_s_iqr)});
+  schema.push_back({"wall_s_repeats", integer(&RunRecord::wall_s_repeats)});
   schema.push_back({"order_level", integer(&RunRecord::order_level)});
   schema.push_back({"reference", text(&RunRecord::reference)});
   return schema;

@@ -17,10 +17,11 @@ namespace geomint {
 
 // Absent optionals are empty cells (and columns no record sets are left out of the table).
 struct RunRecord {
-  std::optional<std::string> label;  // [[runs]] block label (sweeps)
-  std::optional<long> order_level;   // k of the dt ladder dt0·2⁻ᵏ (order studies)
-  std::string problem, method;       // canonical specs (error records: the specs as given)
-  std::optional<double> dt;          // fixed-step methods only
+  std::optional<std::string> label;   // [[runs]] block label (sweeps)
+  std::optional<long> order_level;    // k of the dt ladder dt0·2⁻ᵏ (order studies)
+  std::string problem, method;        // canonical specs (error records: the specs as given)
+  std::optional<std::string> family;  // method_family() of the method (sweeps and runs)
+  std::optional<double> dt;           // fixed-step methods only
   std::optional<double> t_end;
   std::string status;                  // ok, nan, diverged, error, ...
   std::optional<std::string> message;  // why a run failed (or its timing pass did)
@@ -28,8 +29,12 @@ struct RunRecord {
   std::optional<long> steps;
   std::map<std::string, double> metrics;  // metric columns of the schema, by name
   std::optional<Counters> counters;       // the integrator's work counters
-  std::optional<double> wall_s;           // median of the timing pass
-  std::optional<std::string> reference;   // file name of the reference solution used
+  // Timing pass (harness/run.hpp TimingStats): wall_s is the median of the timed repeats, as
+  // before repeats had a spread; wall_s_min and wall_s_iqr (Q3 − Q1) their minimum and
+  // interquartile range, wall_s_repeats their count (fewer than asked: the budget cut them).
+  std::optional<double> wall_s, wall_s_min, wall_s_iqr;
+  std::optional<long> wall_s_repeats;
+  std::optional<std::string> reference;  // file name of the reference solution used
 };
 
 // One order study (order.csv). A study that threw has only problem, method, status and

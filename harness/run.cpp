@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
 
 #include "harness/map_defect.hpp"
 #include "harness/observers.hpp"
@@ -241,24 +243,86 @@ std::string TimingOutcome::failure_message() const {
   return fmt::format("timing pass failed: {}: {}", status.reason, status.message);
 }
 
+TimingStats timing_stats(std::vector<double> seconds) {
+  if (seconds.empty()) throw std::invalid_argument("timing_stats: no timed run");
+  std::sort(seconds.begin(), seconds.end());
+  const auto quantile = [&](double p) {
+    const double position = p * static_cast<double>(seconds.size() - 1);
+    const auto j = static_cast<size_t>(std::floor(position));
+    const double f = position - static_cast<double>(j);
+    return j + 1 < seconds.size() ? seconds[j] + f * (seconds[j + 1] - seconds[j]) : seconds[j];
+  };
+  TimingStats stats;
+  stats.min = seconds.front();
+  stats.median = quantile(0.5);
+  stats.iqr = quantile(0.75) - quantile(0.25);
+  stats.count = static_cast<int>(seconds.size());
+  return stats;
+}
+
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats) {
   const auto problem = make_problem(problem_spec);
-  std::vector<double> seconds;
-  for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
+  const int wanted = std::max(1, repeats);
+  using Clock = std::chrono::steady_clock;
+  const auto pass_start = Clock::now();
+  // One run from a fresh integrator; its wall time, or nullopt with the failed status.
+  StepStatus failed = StepStatus::success();
+  const auto one_run = [&]() -> std::optional<double> {
     auto integrator = make_integrator(method_spec);
     const bool adaptive = (integrator->info().flags & kAdaptive) != 0;
     State state = problem->initial_state();
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     integrator->reset(*problem, state, config.dt);
     LoopOutcome outcome =
         integrate(*problem, *integrator, state, config, adaptive, false, [](const State&, bool) {});
-    if (!outcome.status.ok) return {std::move(outcome.status), 0};
-    seconds.push_back(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!outcome.status.ok) {
+      failed = std::move(outcome.status);
+      return std::nullopt;
+    }
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(Clock::now() - pass_start).count();
+  };
+  TimingOutcome outcome;
+  const std::optional<double> warm_up = one_run();
+  if (!warm_up) return {std::move(failed), {}, 0, {}};
+  std::vector<double> seconds;
+  // A repeat starts only when one more run of the longest duration seen so far still ends
+  // inside the budget. A warm-up that alone leaves no room is the pass's only sample.
+  double longest = *warm_up;
+  while (static_cast<int>(seconds.size()) < wanted) {
+    if (elapsed() + longest > config.timing_budget_s) break;
+    const std::optional<double> run = one_run();
+    if (!run) return {std::move(failed), {}, 0, {}};
+    seconds.push_back(*run);
+    longest = std::max(longest, *run);
   }
-  std::nth_element(seconds.begin(), seconds.begin() + seconds.size() / 2, seconds.end());
-  return {StepStatus::success(), seconds[seconds.size() / 2]};
+  if (static_cast<int>(seconds.size()) < wanted) {
+    const bool warm_up_only = seconds.empty();
+    if (warm_up_only) seconds.push_back(*warm_up);
+    outcome.budget_note =
+        fmt::format("timing budget: {} of {} repeats fit in timing_budget_s = {:g} s{}",
+                    warm_up_only ? 0 : seconds.size(), wanted, config.timing_budget_s,
+                    warm_up_only ? " (the warm-up run is the only sample)" : "");
+  }
+  outcome.status = StepStatus::success();
+  outcome.stats = timing_stats(seconds);
+  outcome.seconds = outcome.stats.median;
+  return outcome;
+}
+
+void record_timing(const TimingOutcome& timing, RunRecord& record) {
+  if (!timing.status.ok) {
+    record.message = timing.failure_message();
+    return;
+  }
+  record.wall_s = timing.stats.median;
+  record.wall_s_min = timing.stats.min;
+  record.wall_s_iqr = timing.stats.iqr;
+  record.wall_s_repeats = timing.stats.count;
+  if (!timing.budget_note.empty()) record.message = timing.budget_note;
 }
 
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
@@ -277,6 +341,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   RunRecord& record = result.record;
   record.problem = problem->spec();
   record.method = integrator->spec();
+  record.family = method_family(info);
   if (!adaptive) record.dt = config.dt;
   record.t_end = config.t_end;
 
@@ -334,12 +399,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
-    const TimingOutcome timing = time_run(problem_spec, method_spec, config, config.timing_repeats);
-    if (timing.status.ok) {
-      record.wall_s = timing.seconds;
-    } else {
-      record.message = timing.failure_message();
-    }
+    record_timing(time_run(problem_spec, method_spec, config, config.timing_repeats), record);
   }
   return result;
 }

@@ -1,6 +1,7 @@
 // One run = (problem spec, method spec, dt, t_end): the step loop with observers at step points,
 // the metrics of docs/DESIGN.md §3 that apply to the problem, failure rows, optional time series,
-// and a separate timing pass without observers (median of repeats) for wall_s.
+// and a separate timing pass without observers (a warm-up, then the median, minimum and
+// interquartile range of repeats) for wall_s, wall_s_min, wall_s_iqr.
 #pragma once
 
 #include <optional>
@@ -19,6 +20,11 @@ namespace geomint {
 constexpr double kDefaultDivergeFactor = 1e8;
 // Caps on counts that would otherwise let one option request unbounded work.
 constexpr int kMaxTimingRepeats = 100;
+// Wall-clock budget of one timing pass (warm-up + repeats), scene key `timing_budget_s`: a pass
+// starts no repeat it cannot finish inside the budget (judged from the runs so far), so a slow
+// run gets fewer repeats — a point with its count in wall_s_repeats and a message, not a hole.
+constexpr double kDefaultTimingBudgetSeconds = 600;
+constexpr double kMaxTimingBudgetSeconds = 86400;
 constexpr double kMaxFixedSteps = 1e10;  // t_end/dt of one fixed-step run
 // The step budget of a fixed-step run (`--max-steps`, scene key `max_steps`), as the library
 // wrappers have theirs: a run whose grid has more steps ends at once as the failure row
@@ -33,7 +39,8 @@ struct RunConfig {
   long series_every = 1;      // write every N-th step point (the last point always)
   bool series_state = false;  // force q, p columns for problems with > 64 dof
   int timing_repeats = 3;     // separate timed runs without observers (0..kMaxTimingRepeats)
-  double diverge_factor = kDefaultDivergeFactor;  // see kDefaultDivergeFactor; 0/inf = off
+  double timing_budget_s = kDefaultTimingBudgetSeconds;  // see kDefaultTimingBudgetSeconds
+  double diverge_factor = kDefaultDivergeFactor;         // see kDefaultDivergeFactor; 0/inf = off
   long max_steps = kDefaultMaxSteps;  // fixed-step runs: grid steps allowed (1..kMaxFixedSteps)
   std::string command_line;           // for the series provenance
   // Problems without an exact solution: error_final/error_max against the reference file
@@ -62,16 +69,34 @@ struct RunResult {
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
                   const RunConfig& config);
 
-// Timing pass alone: median wall time of `repeats` runs without observers or per-step checks,
-// or the status of the first pass that failed (a method whose runs differ; it gets no time).
+// Order statistics of the timed repeats of one run: the minimum (the least disturbed run), the
+// median (wall_s; the mean of the two middle values for an even count) and the interquartile
+// range Q3 − Q1, with quartiles interpolated linearly between order statistics (Hyndman–Fan
+// type 7, R's and NumPy's default): Q(p) = x₍ⱼ₎ + f·(x₍ⱼ₊₁₎ − x₍ⱼ₎), j + f = p·(n − 1), 0-based.
+struct TimingStats {
+  double min = 0, median = 0, iqr = 0;
+  int count = 0;  // repeats the statistics are taken over
+};
+// Throws std::invalid_argument on an empty sample (a timing pass always times one run).
+TimingStats timing_stats(std::vector<double> seconds);
+
+// Timing pass alone: one untimed warm-up run (caches, page faults, lazy library setup), then
+// `repeats` timed runs without observers or per-step checks, inside config.timing_budget_s; or
+// the status of the first run that failed (a method whose runs differ; it gets no time).
 struct [[nodiscard]] TimingOutcome {
   StepStatus status;
-  double seconds = 0;
+  TimingStats stats;
+  double seconds = 0;  // stats.median
+  // Why fewer than `repeats` runs were timed (the budget), empty otherwise.
+  std::string budget_note;
   // "timing pass failed: reason: message", the row's message when the status failed.
   std::string failure_message() const;
 };
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats);
+// Writes a successful outcome's statistics into the record (wall_s = median, wall_s_min,
+// wall_s_iqr, wall_s_repeats) and a budget note as its message; a failed one's message.
+void record_timing(const TimingOutcome& timing, RunRecord& record);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
 // --timing-repeats, --diverge-factor and --max-steps (InputError naming the offending option).

@@ -155,7 +155,8 @@ Scene load_scene(const std::string& path, bool quick) {
     block.series_every = reader.integer("series_every", false, 0, 0, 1000000000000L);
     block.series_state = reader.boolean("series_state", false);
     block.timing_repeats =
-        static_cast<int>(reader.integer("timing_repeats", false, 3, 0, kMaxTimingRepeats));
+        static_cast<int>(reader.integer("timing_repeats", false, 5, 0, kMaxTimingRepeats));
+    block.timing_budget_s = reader.number("timing_budget_s", false, kDefaultTimingBudgetSeconds);
     block.diverge_factor = reader.number("diverge_factor", false, kDefaultDivergeFactor);
     block.max_steps =
         reader.integer("max_steps", false, kDefaultMaxSteps, 1, static_cast<long>(kMaxFixedSteps));
@@ -165,6 +166,10 @@ Scene load_scene(const std::string& path, bool quick) {
     const auto quick_problems = reader.strings("quick_problems", false);
     reader.finish();
     check_diverge_factor(block.diverge_factor, where);
+    if (!(block.timing_budget_s > 0 && block.timing_budget_s <= kMaxTimingBudgetSeconds)) {
+      throw InputError(fmt::format("{}: 'timing_budget_s' must be in (0, {:g}] seconds (got {})",
+                                   where, kMaxTimingBudgetSeconds, block.timing_budget_s));
+    }
     for (double dt : quick_dts) check_positive(dt, where, "quick_dt");
     // Both the full and the quick configuration are checked, whichever runs now.
     RunBlock quick_block = block;

@@ -269,6 +269,7 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
           job.config.dt = dt;
           job.config.t_end = block.t_end;
           job.config.timing_repeats = 0;
+          job.config.timing_budget_s = block.timing_budget_s;
           job.config.diverge_factor = block.diverge_factor;
           job.config.max_steps = block.max_steps;
           job.config.extra_metrics = requested_metrics;
@@ -572,13 +573,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (!timing || job.timing_repeats == 0) continue;
     if (job.ok) {
       try {
-        const TimingOutcome timed =
-            time_run(job.problem, job.method, job.config, job.timing_repeats);
-        if (timed.status.ok) {
-          job.record.wall_s = timed.seconds;
-        } else {
-          job.record.message = timed.failure_message();
-        }
+        record_timing(time_run(job.problem, job.method, job.config, job.timing_repeats),
+                      job.record);
       } catch (const std::exception& error) {
         job.record.message = fmt::format("timing pass failed: {}", error.what());
       }
@@ -704,13 +700,7 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
     if (status != row.end() && status->second == "ok") {
       RunRecord timing;
       try {
-        const TimingOutcome timed =
-            time_run(job.problem, job.method, job.config, job.timing_repeats);
-        if (timed.status.ok) {
-          timing.wall_s = timed.seconds;
-        } else {
-          timing.message = timed.failure_message();
-        }
+        record_timing(time_run(job.problem, job.method, job.config, job.timing_repeats), timing);
       } catch (const std::exception& error) {
         timing.message = fmt::format("timing pass failed: {}", error.what());
       }

@@ -94,6 +94,7 @@ const std::vector<std::string>& standard_columns() {
   static const std::vector<std::string> columns = {"label",
                                                    "problem",
                                                    "method",
+                                                   "family",
                                                    "dt",
                                                    "tol",
                                                    "t_end",
@@ -135,7 +136,10 @@ const std::vector<std::string>& standard_columns() {
                                                    "linear_solves",
                                                    "factorizations",
                                                    "rejected",
-                                                   "wall_s"};
+                                                   "wall_s",
+                                                   "wall_s_min",
+                                                   "wall_s_iqr",
+                                                   "wall_s_repeats"};
   return columns;
 }
 

@@ -78,6 +78,37 @@ std::vector<std::string> integrator_test_specs() {
   return specs;
 }
 
+bool library_method(const std::string& name) {
+  for (const char* prefix : {"cvode_", "ida", "arkode_", "gsl_", "odeint_"}) {
+    if (name.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+const std::vector<std::string>& method_families() {
+  static const std::vector<std::string> families = {"explicit_symplectic",  "explicit_rk",
+                                                    "implicit_variational", "implicit_other",
+                                                    "adaptive_geomint",     "adaptive_library"};
+  return families;
+}
+
+std::string method_family(const MethodInfo& info) {
+  // Error control first: an adaptive method's cost is set by its tolerance, not a step.
+  if (info.flags & kAdaptive) {
+    return library_method(info.name) ? "adaptive_library" : "adaptive_geomint";
+  }
+  if (info.flags & kExplicit) {
+    return (info.flags & kSymplectic) ? "explicit_symplectic" : "explicit_rk";
+  }
+  if (info.flags & kImplicit) {
+    // Every implicit symplectic method here comes from a discrete Lagrangian (HP, DEL, Gauss,
+    // Lobatto IIIA–IIIB, midpoint): one family, so no front is drawn for an empty class.
+    return (info.flags & (kVariational | kSymplectic)) ? "implicit_variational" : "implicit_other";
+  }
+  throw std::logic_error(info.name +
+                         ": neither kExplicit nor kImplicit nor kAdaptive, so no method family");
+}
+
 std::vector<std::string> flag_names(unsigned flags) {
   static const std::pair<MethodFlag, const char*> kNames[] = {
       {kExplicit, "explicit"},

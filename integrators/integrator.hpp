@@ -50,6 +50,20 @@ struct MethodInfo {
   std::string reference;  // where the scheme is defined
 };
 
+// The method's family for work-precision fronts and the `family` column: adaptive_library
+// (SUNDIALS, GSL, Boost.Odeint error-controlled solvers), adaptive_geomint (this suite's own
+// error-controlled ones), explicit_symplectic, explicit_rk (explicit, not symplectic: RK4,
+// Euler, the penalty wrapper), implicit_variational (implicit and variational or symplectic),
+// implicit_other (implicit, neither: backward Euler, Newmark, HHT, generalized-α). Derived from the
+// flags alone, plus the library name prefixes of library_method(); a method with neither kExplicit
+// nor kImplicit is a defect (std::logic_error), so a new flag combination cannot silently leave a
+// method unlabelled.
+std::string method_family(const MethodInfo& info);
+// Every value method_family() returns, in the order figures list them.
+const std::vector<std::string>& method_families();
+// A registry name implemented by a library wrapper (cvode_*, ida, arkode_*, gsl_*, odeint_*).
+bool library_method(const std::string& name);
+
 // Result of one step; a failed step leaves the state unspecified and ends the run. [[nodiscard]]:
 // a caller that drops a status turns a failed run into an `ok` row (a step loop that ignored its
 // body's status once reported position Verlet's unconverged force kick as success), so dropping

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 
 #include "integrators/integrator.hpp"
@@ -703,6 +704,37 @@ TEST(Registry, EveryEntryNamesItselfAndDeclaresAnOrder) {
     // Exactly one of explicit/implicit (adaptive library solvers may be either).
     EXPECT_NE((info.flags & kExplicit) != 0, (info.flags & kImplicit) != 0);
   }
+}
+
+// Every registered configuration gets a family from method_family(), one of the listed ones;
+// every listed family is some method's (no dead label in the figures' legend); the anchors pin
+// the classification of one method per family, so a swapped branch or flag test fails here.
+TEST(Registry, EveryMethodHasAFamily) {
+  std::set<std::string> reached;
+  const auto& families = method_families();
+  for (const auto& spec : integrator_test_specs()) {
+    SCOPED_TRACE(spec);
+    const std::string family = method_family(make_integrator(spec)->info());
+    EXPECT_FALSE(family.empty());
+    EXPECT_NE(std::find(families.begin(), families.end(), family), families.end()) << family;
+    reached.insert(family);
+  }
+  for (const auto& family : families) EXPECT_TRUE(reached.count(family)) << family;
+  const std::vector<std::pair<std::string, std::string>> anchors = {
+      {"stormer_verlet", "explicit_symplectic"},
+      {"odeint_mclachlan4", "explicit_symplectic"},
+      {"composition:scheme=kahan_li8", "explicit_symplectic"},
+      {"rk4", "explicit_rk"},
+      {"hp", "implicit_variational"},
+      {"implicit_euler", "implicit_other"},
+      {"adaptive_verlet", "adaptive_geomint"},
+      {"cvode_bdf", "adaptive_library"},
+      {"gsl_rk8pd", "adaptive_library"},
+      {"odeint_dopri5", "adaptive_library"}};
+  for (const auto& [spec, family] : anchors) {
+    EXPECT_EQ(method_family(make_integrator(spec)->info()), family) << spec;
+  }
+  EXPECT_THROW(method_family(MethodInfo{"flagless", 1, 0, "none"}), std::logic_error);
 }
 
 }  // namespace

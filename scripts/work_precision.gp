@@ -1,7 +1,11 @@
-# Work-precision (issue 5): error_final and energy_err_max against wall time, one figure pair per
-# problem and horizon, every method curve on the same log-log axes (fixed-step methods over dt,
-# adaptive ones over tolerance). Run inside results/work_precision; the data files under wp/ and
-# time_to_error.md are written first by scripts/work_precision_table.sh from summary.csv.
+# Work-precision (issues 5, 29): error_final and energy_err_max against wall time, and error_final
+# against force evaluations and steps, one figure set per problem and horizon, every method curve
+# on the same log-log axes (fixed-step methods over dt, adaptive ones over tolerance). A point is
+# the median of the timed repeats; its horizontal bar runs from the fastest repeat to median + IQR
+# (which bounds the third quartile). Thick translucent lines: the best-of-family fronts (the runs
+# of a family that no cheaper run of that family beats). Run inside results/work_precision (or
+# work_precision_full); the data files under wp/ and time_to_error.md are written first by
+# scripts/work_precision_table.sh from summary.csv.
 load scripts."/common.gp"
 system("bash ".scripts."/work_precision_table.sh summary.csv")
 set datafile separator whitespace
@@ -13,26 +17,55 @@ group_words = "pendulum_(theta0_=_1.5),_100_periods_(t_=_730) pendulum_(theta0_=
 group_index(g) = sum [i=1:words(group_keys)] (word(group_keys, i) eq g ? i : 0)
 underscores_to_spaces(s) = (r = "", sum [i=1:strlen(s)] (r = r.(s[i:i] eq "_" ? " " : s[i:i]), 0), r)
 group_title(g) = group_index(g) > 0 ? underscores_to_spaces(word(group_words, group_index(g))) : g
+# One translucent colour per family (integrators/integrator.cpp method_families()).
+family_keys = "explicit_symplectic explicit_rk implicit_variational implicit_other adaptive_geomint adaptive_library"
+family_index(f) = sum [i=1:words(family_keys)] (word(family_keys, i) eq f ? i : 0)
+set style line 51 lw 7 lc rgb "#a0ff7f0e"  # explicit_symplectic: orange
+set style line 52 lw 7 lc rgb "#a09467bd"  # explicit_rk: purple
+set style line 53 lw 7 lc rgb "#a0e7298a"  # implicit_variational: magenta
+set style line 54 lw 7 lc rgb "#a08c564b"  # implicit_other: brown
+set style line 55 lw 7 lc rgb "#a017becf"  # adaptive_geomint: cyan
+set style line 56 lw 7 lc rgb "#a0393b79"  # adaptive_library: indigo
+fs(f) = 50 + family_index(f)
 
 do for [format in "png pdf"] {
   if (format eq "png") { set term @png_term } else { set term @pdf_term }
   do for [group in groups] {
     curves = system("cat wp/".group.".curves")
+    families = system("cat wp/".group.".families")
     file(c) = "wp/".group."/".c.".dat"
+    front(f, x) = "wp/".group."/front_".f."_".x.".dat"
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     @key_above
-    set xlabel "wall time [s]"
+    set xlabel "wall time [s] (median of the timed repeats; bar: fastest repeat to median + IQR)"
 
     set output "wp_".group."_error.".format
     set title "Final global error against wall time: ".group_title(group) noenhanced
     set ylabel "||(q,p) - exact or reference|| at t_end (problem units)" noenhanced
-    plot for [i=1:words(curves)] file(word(curves,i)) using 1:2 with linespoints ls ms(word(curves,i)) \
-         title word(curves,i)
+    plot for [i=1:words(families)] front(word(families,i), "wall") using 1:2 with lines ls fs(word(families,i)) \
+           title "front: ".word(families,i), \
+         for [i=1:words(curves)] file(word(curves,i)) using 1:2:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
+         for [i=1:words(curves)] file(word(curves,i)) using 1:2 with lines ls ms(word(curves,i)) title word(curves,i)
 
     set output "wp_".group."_energy.".format
     set title "Largest relative energy error against wall time: ".group_title(group) noenhanced
     set ylabel "max |H - H0| / |H0| (dimensionless)"
-    plot for [i=1:words(curves)] file(word(curves,i)) using 1:3 with linespoints ls ms(word(curves,i)) \
-         title word(curves,i)
+    plot for [i=1:words(curves)] file(word(curves,i)) using 1:3:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
+         for [i=1:words(curves)] file(word(curves,i)) using 1:3 with lines ls ms(word(curves,i)) title word(curves,i)
+
+    set output "wp_".group."_work.".format
+    set multiplot layout 1,2 title "Final global error against work (no timing noise): ".group_title(group) noenhanced
+    set key outside top center horizontal maxrows 4 samplen 2 width 0 spacing 1.0 font ",7"
+    set title ""
+    set ylabel "||(q,p) - exact or reference|| at t_end" noenhanced
+    set xlabel "force evaluations"
+    plot for [i=1:words(families)] front(word(families,i), "evals") using 7:2 with lines ls fs(word(families,i)) \
+           title "front: ".word(families,i), \
+         for [i=1:words(curves)] file(word(curves,i)) using 7:2 with linespoints ls ms(word(curves,i)) title word(curves,i)
+    set xlabel "steps (accepted)"
+    plot for [i=1:words(families)] front(word(families,i), "steps") using 8:2 with lines ls fs(word(families,i)) \
+           title "front: ".word(families,i), \
+         for [i=1:words(curves)] file(word(curves,i)) using 8:2 with linespoints ls ms(word(curves,i)) title word(curves,i)
+    unset multiplot
   }
 }

@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
-# Post-processing for results/work_precision (issue 5), run by scripts/work_precision.gp inside
-# the scene folder: reads summary.csv and writes
-#   wp/<group>/<curve>.dat  wall_s error_final energy_err_max step (one file per method curve:
-#                           a fixed-step method over dt, an adaptive one over tolerance),
-#   wp/<group>.curves       the curve names of a group, wp/groups the groups,
-#   time_to_error.md        per group and curve, the least wall time of an ok run with
-#                           error_final <= 1e-3, 1e-6, 1e-9, and the fastest curve per level.
+# Post-processing for results/work_precision and work_precision_full (issues 5, 29), run by
+# scripts/work_precision.gp inside the scene folder: reads summary.csv and writes
+#   wp/<group>/<curve>.dat  one line per ok run of a method curve (a fixed-step method over dt, an
+#                           adaptive one over tolerance), columns:
+#                           1 wall_s (median of the timed repeats)  2 error_final  3 energy_err_max
+#                           4 dt or rtol  5 wall_s_min  6 wall_s + wall_s_iqr (>= the third
+#                           quartile, since Q1 <= median)  7 force_evals  8 steps  9 wall_s_iqr
+#   wp/<group>/front_<family>_<x>.dat  the best-of-family front against x = wall, evals, steps:
+#                           the runs of one family (summary.csv's `family` column) that no faster
+#                           (cheaper) run of the family beats in error_final; same columns.
+#   wp/<group>.curves, wp/<group>.families, wp/groups  the names the figure script iterates.
+#   time_to_error.md        per group and curve, the least median wall time of an ok run with
+#                           error_final <= 1e-2, 1e-4, 1e-6, 1e-8, 1e-10 with that run's IQR;
+#                           the fastest curve per level; and the goal of issue 29 item 5 (best
+#                           geomint method against best library solver at 1e-8 on Kepler 10^2).
 # A group is a label without its last _<part> (kepler_1e2_explicit -> kepler_1e2).
 set -euo pipefail
 summary=${1:-summary.csv}
@@ -24,54 +32,114 @@ function curve_name(spec,    name, rest, parts, n, i, kept) {
   }
   return kept
 }
+# The library wrappers, as integrators/integrator.cpp library_method() names them.
+function library(spec) { return spec ~ /^(cvode_|ida|arkode_|gsl_|odeint_)/ }
 function fmt_time(t) { return t == "" ? "-" : sprintf("%.3g s", t) }
+function fmt_cell(key, l) {
+  if (!((key, l) in best)) return "-"
+  return sprintf("%.3g s (IQR %.2g)", best[key, l], best_iqr[key, l])
+}
+# The least median wall time to error <= X over the runs of one curve, with its spread.
+function consider(key, l, wall, iqr, lo) {
+  if (!((key, l) in best) || wall < best[key, l]) { best[key, l] = wall; best_iqr[key, l] = iqr; best_min[key, l] = lo }
+}
 /^#/ { next }
-header == 0 { n = split_csv($0, h); for (i = 1; i <= n; i++) col[h[i]] = i; header = 1; next }
+header == 0 {
+  n = split_csv($0, h); for (i = 1; i <= n; i++) col[h[i]] = i; header = 1
+  if (!("family" in col) || !("wall_s_iqr" in col)) { print "summary.csv has no family or wall_s_iqr column: rerun the sweep" > "/dev/stderr"; exit 2 }
+  next
+}
 {
   split_csv($0, f)
   label = f[col["label"]]; group = label; sub(/_[^_]*$/, "", group)
   curve = curve_name(f[col["method"]])
   if (!(group in seen_group)) { seen_group[group] = 1; groups[++ngroups] = group }
   key = group SUBSEP curve
-  if (!(key in seen_curve)) { seen_curve[key] = 1; curves[group] = curves[group] " " curve; problem[group] = f[col["problem"]] }
+  if (!(key in seen_curve)) { seen_curve[key] = 1; curves[group] = curves[group] " " curve; problem[group] = f[col["problem"]]; is_library[key] = library(f[col["method"]]) }
   if (f[col["status"]] != "ok" || f[col["wall_s"]] == "" || f[col["error_final"]] == "") next
   step = f[col["dt"]]
   if (step == "") { step = f[col["method"]]; sub(/.*rtol=/, "rtol=", step); sub(/,.*/, "", step) }
   system("mkdir -p " out "/" group)
-  print f[col["wall_s"]], f[col["error_final"]], f[col["energy_err_max"]], step >> (out "/" group "/" curve ".dat")
+  wall = f[col["wall_s"]] + 0; iqr = f[col["wall_s_iqr"]] + 0; lo = f[col["wall_s_min"]] + 0
+  err = f[col["error_final"]] + 0
+  line = sprintf("%s %s %s %s %s %.17g %s %s %s", f[col["wall_s"]], f[col["error_final"]], f[col["energy_err_max"]], step,
+                 f[col["wall_s_min"]], wall + iqr, f[col["force_evals"]] == "" ? "nan" : f[col["force_evals"]], f[col["steps"]], f[col["wall_s_iqr"]])
+  print line >> (out "/" group "/" curve ".dat")
+  family = f[col["family"]]
+  if (!((group, family) in seen_family)) { seen_family[group, family] = 1; print family >> (out "/" group ".families") }
+  print line >> (out "/" group "/family_" family ".pts")
   has_data[key] = 1; group_has_data[group] = 1
-  wall = f[col["wall_s"]] + 0; err = f[col["error_final"]] + 0
-  for (l = 1; l <= 3; l++) {
-    if (err <= level[l] && (!((key, l) in best) || wall < best[key, l])) best[key, l] = wall
-  }
+  for (l = 1; l <= nlevels; l++) if (err <= level[l]) consider(key, l, wall, iqr, lo)
 }
-BEGIN { level[1] = 1e-3; level[2] = 1e-6; level[3] = 1e-9 }
+BEGIN { nlevels = split("1e-2 1e-4 1e-6 1e-8 1e-10", level, " "); for (l = 1; l <= nlevels; l++) level[l] += 0; goal_level = 4 }
 END {
-  print "# Time to reach error X (least wall time of an ok run with error_final <= X)\n"
-  print "Per group (problem and horizon) and method curve; - = not reached by any run in the sweep.\n"
+  print "# Time to reach error X (least median wall time of an ok run with error_final <= X)\n"
+  print "Per group (problem and horizon) and method curve: the median wall time of the timed repeats"
+  print "of the cheapest run that reaches X, with that run's interquartile range (IQR, seconds);"
+  print "- = not reached by any run in the sweep.\n"
   for (g = 1; g <= ngroups; g++) {
     group = groups[g]
     if (group in group_has_data) print group > (out "/groups")
-    printf "## %s (%s)\n\n| method | <= 1e-3 | <= 1e-6 | <= 1e-9 |\n|---|---|---|---|\n", group, problem[group]
+    printf "## %s (%s)\n\n| method |", group, problem[group]
+    for (l = 1; l <= nlevels; l++) printf " <= %g |", level[l]
+    printf "\n|---|"; for (l = 1; l <= nlevels; l++) printf "---|"; printf "\n"
     nc = split(substr(curves[group], 2), names, " ")
     for (c = 1; c <= nc; c++) {
       key = group SUBSEP names[c]
       if (key in has_data) print names[c] > (out "/" group ".curves")
-      printf "| %s | %s | %s | %s |\n", names[c], fmt_time((key, 1) in best ? best[key, 1] : ""),
-             fmt_time((key, 2) in best ? best[key, 2] : ""), fmt_time((key, 3) in best ? best[key, 3] : "")
-      for (l = 1; l <= 3; l++) {
+      printf "| %s |", names[c]
+      for (l = 1; l <= nlevels; l++) printf " %s |", fmt_cell(key, l)
+      printf "\n"
+      for (l = 1; l <= nlevels; l++) {
         if (((key, l) in best) && (!((group, l) in winner_time) || best[key, l] < winner_time[group, l])) {
           winner_time[group, l] = best[key, l]; winner[group, l] = names[c]
+        }
+        side = is_library[key] ? "library" : "geomint"
+        if (((key, l) in best) && (!((group, l, side) in side_time) || best[key, l] < side_time[group, l, side])) {
+          side_time[group, l, side] = best[key, l]; side_iqr[group, l, side] = best_iqr[key, l]
+          side_min[group, l, side] = best_min[key, l]; side_name[group, l, side] = names[c]
         }
       }
     }
     printf "\nFastest: "
-    for (l = 1; l <= 3; l++) {
+    for (l = 1; l <= nlevels; l++) {
       printf "%s<= %g: %s", (l > 1 ? "; " : ""), level[l],
              ((group, l) in winner) ? winner[group, l] " (" fmt_time(winner_time[group, l]) ")" : "none"
     }
     printf "\n\n"
   }
+  # Issue 29 item 5: the best geomint method's time to 1e-8 over the best library solver's.
+  # Range: the extreme ratios the two runs' spreads allow, from (fastest geomint repeat) /
+  # (median + IQR of the library run) to (median + IQR of the geomint run) / (fastest library
+  # repeat).
+  print "## Goal (issue 29, item 5): time to error_final <= 1e-8, geomint / library\n"
+  for (g = 1; g <= ngroups; g++) {
+    group = groups[g]
+    if (group !~ /^(kepler_1e2|solar_1e2)$/) continue
+    G = group SUBSEP goal_level SUBSEP "geomint"; L = group SUBSEP goal_level SUBSEP "library"
+    if (!(G in side_time) || !(L in side_time)) {
+      printf "- %s: not measurable (%s reaches 1e-8 in this sweep).\n", group,
+             !(G in side_time) && !(L in side_time) ? "neither side" : (!(G in side_time) ? "no geomint method" : "no library solver")
+      continue
+    }
+    ratio = side_time[G] / side_time[L]
+    low = side_min[G] / (side_time[L] + side_iqr[L]); high = (side_time[G] + side_iqr[G]) / side_min[L]
+    printf "- %s: best geomint %s %s (IQR %.2g) / best library %s %s (IQR %.2g) = **%.2f×** (range %.2f–%.2f×): goal <= 0.5× %s.\n",
+           group, side_name[G], fmt_time(side_time[G]), side_iqr[G], side_name[L], fmt_time(side_time[L]), side_iqr[L],
+           ratio, low, high, ratio <= 0.5 ? (high <= 0.5 ? "MET" : "met by the medians but not over the whole range") : "NOT met"
+  }
 }
 AWK
 for file in wp/*/*.dat; do sort -g -o "$file" "$file"; done
+# Best-of-family fronts: sort a family's runs by the x column, keep each run whose error is below
+# every cheaper one's.
+for points in wp/*/family_*.pts; do
+  [ -e "$points" ] || continue
+  family=$(basename "$points" .pts); family=${family#family_}
+  for axis in wall:1 evals:7 steps:8; do
+    sort -g -k"${axis#*:}","${axis#*:}" "$points" |
+      awk 'NR == 1 || $2 + 0 < best { print; best = $2 + 0 }' \
+        > "$(dirname "$points")/front_${family}_${axis%:*}.dat"
+  done
+  rm "$points"
+done

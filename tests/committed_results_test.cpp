@@ -86,7 +86,9 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
     const std::string where = committed.at("problem") + " / " + committed.at("method") +
                               " / dt=" + (committed.count("dt") ? committed.at("dt") : "-");
     for (const auto& [column, value] : to_row(rerun.record)) {
-      if (column.find("wall") != std::string::npos) continue;
+      // Timing columns are machine noise; `family` is a label derived from the method's flags
+      // (issue 29) that tables written before it do not have yet.
+      if (column.find("wall") != std::string::npos || column == "family") continue;
       ASSERT_TRUE(committed.count(column))
           << where << ": column " << column << " is not in the committed table; regenerate";
       double committed_number = 0, rerun_number = 0;
