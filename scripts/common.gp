@@ -62,3 +62,11 @@ key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 s
 # Every figure is written twice: PNG (the scenes' README.md) and PDF (reports).
 png_term = "pngcairo noenhanced size 1000,650 font 'DejaVu Sans,11'"
 pdf_term = "pdfcairo noenhanced size 7in,4.5in font 'DejaVu Sans,9'"
+
+# Footer (issue 28, citation kit): every figure names the geomint version and commit that computed
+# its numbers. scripts/reproduce.sh passes the `# geomint:` provenance line of the scene's CSVs as
+# `provenance`; label tag 999 is reserved for it (scripts use small tags and unset only those).
+if (exists("provenance") && strlen(provenance) > 0) {
+  set label 999 sprintf("geomint %s", provenance) at screen 0.995, 0.012 right front \
+      font ",7" textcolor rgb "#707070" noenhanced
+}

@@ -12,6 +12,9 @@ echo "== scaling" >&2
 mkdir -p "$out"
 "$build/bench/bench_scaling" --csv "$out/scaling.csv" --benchmark_min_time=0.1 >&2
 if [ "${PLOTS:-1}" = 1 ]; then
-  (cd "$out" && gnuplot -e "scripts='$root/scripts'" "$root/scripts/scaling.gp")
+  # Footer as in scripts/reproduce.sh: the build that measured scaling.csv.
+  provenance=$(sed -n 's/^# geomint: \([0-9A-Za-z._ ()-]*\)$/\1/p' "$out/scaling.csv" | head -n 1)
+  (cd "$out" && gnuplot -e "scripts='$root/scripts'" -e "provenance='$provenance'" \
+    "$root/scripts/scaling.gp")
 fi
 echo "== scaling: $(( $(date +%s) - start )) s" >&2
