@@ -74,7 +74,8 @@ std::string shorten_number(const std::string& text) {
   return fmt::format("{:.6g}", value);
 }
 
-// Inline Markdown on one paragraph's text: `code`, **bold**, [text](url); the rest escaped.
+// Inline Markdown on one paragraph's text: `code`, **bold**, [text](url), ![alt](image); the rest
+// escaped.
 std::string inline_markdown(const std::string& text,
                             const std::function<std::string(const std::string&)>& link) {
   std::string out;
@@ -93,6 +94,17 @@ std::string inline_markdown(const std::string& text,
       if (close != std::string::npos && close > k + 2) {
         out += "<strong>" + inline_markdown(text.substr(k + 2, close - k - 2), link) + "</strong>";
         k = close + 2;
+        continue;
+      }
+    }
+    if (text.compare(k, 2, "![") == 0) {
+      const size_t close = text.find("](", k + 2);
+      const size_t end = close == std::string::npos ? close : text.find(')', close + 2);
+      if (end != std::string::npos && text.find('\n', k) > end) {
+        const std::string target = text.substr(close + 2, end - close - 2);
+        out += "<img src=\"" + html_escape(link ? link(target) : target) + "\" alt=\"" +
+               html_escape(text.substr(k + 2, close - k - 2)) + "\">";
+        k = end + 1;
         continue;
       }
     }
@@ -122,9 +134,10 @@ std::pair<std::string, std::string> version_and_sha(const std::string& line) {
 
 struct ScenePage {
   std::string name, title, headline;
-  fs::path source;                  // results/<scene>/ (or its quick/ folder)
-  std::vector<CsvTable> tables;     // in page order
-  std::vector<std::string> images;  // file names, copied next to the page
+  fs::path source;                       // results/<scene>/ (or its quick/ folder)
+  std::vector<CsvTable> tables;          // in page order
+  std::vector<std::string> images;       // figures shown on the page (SVG over PNG)
+  std::vector<std::string> image_files;  // every PNG and SVG of the folder, copied next to it
   std::vector<GateOutcome> outcomes;
   std::string narrative_html;
   int passed = 0, failed = 0;
@@ -348,7 +361,19 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
       const int ra = table_rank(a.stem().string()), rb = table_rank(b.stem().string());
       return ra != rb ? ra < rb : a.filename() < b.filename();
     });
+    // A figure drawn as both PNG and SVG is shown once, as SVG (sharp at any zoom; issue 28).
     std::sort(page.images.begin(), page.images.end());
+    page.image_files = page.images;  // README.md may link either form
+    const std::vector<std::string>& all_images = page.image_files;
+    page.images.erase(std::remove_if(page.images.begin(), page.images.end(),
+                                     [&all_images](const std::string& image) {
+                                       const fs::path path(image);
+                                       if (path.extension() != ".png") return false;
+                                       const std::string svg = path.stem().string() + ".svg";
+                                       return std::binary_search(all_images.begin(),
+                                                                 all_images.end(), svg);
+                                     }),
+                      page.images.end());
     for (const auto& csv : csvs) page.tables.push_back(read_csv_file(csv.string()));
   }
   if (!page.tables.empty() && !gates.empty()) {
@@ -564,7 +589,7 @@ ReportSummary write_report(const ReportOptions& given) {
       for (const auto& table : page.tables) {
         fs::copy_file(table.path, dir / fs::path(table.path).filename());
       }
-      for (const auto& image : page.images) fs::copy_file(page.source / image, dir / image);
+      for (const auto& image : page.image_files) fs::copy_file(page.source / image, dir / image);
       ++summary.scenes;
       summary.tables += static_cast<int>(page.tables.size());
       summary.gates_passed += page.passed;

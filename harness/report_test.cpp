@@ -88,6 +88,12 @@ TEST_F(ReportTest, CopiesTablesAndFiguresNextToThePages) {
   for (const char* file : {"style.css", "tiny/summary.csv", "tiny/order.csv", "tiny/energy.png"}) {
     EXPECT_TRUE(fs::exists(dir_ / "site" / file)) << file;
   }
+  // phase is drawn as PNG and SVG: the page shows the SVG only; energy has only its PNG.
+  const std::string page = read_text(dir_ / "site" / "tiny" / "index.html");
+  EXPECT_NE(page.find("src=\"phase.svg\""), std::string::npos);
+  EXPECT_EQ(page.find("src=\"phase.png\""), std::string::npos);
+  EXPECT_NE(page.find("src=\"energy.png\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "site" / "tiny" / "phase.svg"));
   EXPECT_EQ(read_text(dir_ / "site" / "tiny" / "order.csv"),
             read_text(kFixture / "results" / "tiny" / "order.csv"));
 }
@@ -116,6 +122,9 @@ TEST(ReportHtml, RendersTheMarkdownSubset) {
             "<ul>\n<li>x</li>\n<li>y</li>\n</ul>\n");
   EXPECT_EQ(markdown_to_html("```\n<x>\n```\n"), "<pre><code>&lt;x&gt;\n</code></pre>\n");
   EXPECT_EQ(markdown_to_html("2. b\n10. c\n"), "<ol>\n<li>b</li>\n<li>c</li>\n</ol>\n");
+  // An image, not "!" and a link.
+  EXPECT_EQ(markdown_to_html("see ![a<b](f.png) now\n"),
+            "<p>see <img src=\"f.png\" alt=\"a&lt;b\"> now</p>\n");
 }
 
 // --out is replaced whole: a folder the verb did not write is refused and left as it was.

@@ -10,8 +10,8 @@ to_max(col) = (strcol("label") eq "alpha" && hp(strcol("method")) && strcol("sta
 # gnuplot cuts a quoted CSV field at its first comma: strcol("method") is "hp:alpha=0.25".
 order_point(a) = (strcol("method") eq "hp:alpha=".a && strcol("status") eq "ok") ? column("error_final") : NaN
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   @key_above
 

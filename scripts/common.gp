@@ -59,9 +59,11 @@ set style line 48 lw 2 lc rgb "#c9a800" pt 9
 # Legends sit above the plot in rows, so they take neither width nor data area.
 key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 spacing 1.1"
 
-# Every figure is written twice: PNG (the scenes' README.md) and PDF (reports).
+# Every figure is written three times: PNG (the scenes' README.md), PDF (reports) and SVG (the
+# results site, `geomint report`, which shows the SVG where one exists).
 png_term = "pngcairo noenhanced size 1000,650 font 'DejaVu Sans,11'"
 pdf_term = "pdfcairo noenhanced size 7in,4.5in font 'DejaVu Sans,9'"
+svg_term = "svg noenhanced size 1000,650 font 'DejaVu Sans,11' background rgb 'white'"
 
 # Footer (issue 28, citation kit): every figure names the geomint version and commit that computed
 # its numbers. scripts/reproduce.sh passes the `# geomint:` provenance line of the scene's CSVs as

@@ -15,8 +15,8 @@ problem_title(run) = run eq "chain" ? "rod_chain:n=2 (double pendulum, chaotic)"
 # (k constraint_err_max energy_err_max) per step size.
 system("rm -rf curves && mkdir -p curves && awk -f ".scripts."/csv.awk -f ".scripts."/constraints_curves.awk summary.csv")
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
 
   do for [run in "chain pendulum"] {

@@ -21,8 +21,8 @@ stats slot_file(1) using "angular_momentum_0" every ::0::0 nooutput; L0 = STATS_
 # summary.csv rows of the decay block, by canonical method name prefix.
 select(name) = (strcol("label") eq "decay" && strstrt(strcol("method"), name) == 1) ? column("energy_err_max") : NaN
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   set style line 41 lw 4; set style line 47 lw 2 dt (6,4)
   @key_above

@@ -12,8 +12,8 @@ ok(s) = s eq "ok"
 in_map(label, method) = case_x(label) > 0 && method_y(method) > 0
 clip(e) = e < 1e-12 ? -12 : (e > 10 ? 1 : log10(e))
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term pngcairo size 1200,760 font 'DejaVu Sans,10' } else { set term pdfcairo size 8in,5in font 'DejaVu Sans,8' }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term pngcairo size 1200,760 font 'DejaVu Sans,10' } else { if (format eq "pdf") { set term pdfcairo size 8in,5in font 'DejaVu Sans,8' } else { set term @svg_term; set term svg size 1200,760 } }
   set termoption noenhanced
   set output "heatmap.".format
   set title "Final error |(q, p) - exact| (colour, first line) and force evaluations (f) per method and case;\ngrey: failed, with its status and the time reached"

@@ -17,8 +17,8 @@ stats short("explicit_euler") using "q_0":"p_0" nooutput
 phase_extent = 1.05 * (abs(STATS_min_x) > STATS_max_x ? abs(STATS_min_x) : STATS_max_x)
 phase_extent_y = 1.05 * (abs(STATS_min_y) > STATS_max_y ? abs(STATS_min_y) : STATS_max_y)
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   @key_above
 
   set output "theta.".format

@@ -22,8 +22,8 @@ run_title(j, i) = mtitle(word(methods, i)) . \
 # Energies of one method are not methods: they take the family palette, I in black.
 energy_names = "I1 I2 I3"
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term; set term pngcairo size 1100,750 } else { set term @pdf_term; set term pdfcairo size 8in,5.5in }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term; set term pngcairo size 1100,750 } else { if (format eq "pdf") { set term @pdf_term; set term pdfcairo size 8in,5.5in } else { set term @svg_term; set term svg size 1100,750 } }
   set termoption noenhanced
 
   # GNI Fig. 5.1 style: the exchange between the stiff springs at h*omega = 0.5, one panel each.

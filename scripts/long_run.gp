@@ -9,8 +9,8 @@ envelope(f, width) = envelope_at(f, width, H0)
 plain = "composition_scheme_kahan_li8"
 compensated = "composition_scheme_kahan_li8_compensated_true"
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term; set term pngcairo size 1100,500 } else { set term @pdf_term; set term pdfcairo size 8in,3.6in }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term; set term pngcairo size 1100,500 } else { if (format eq "pdf") { set term @pdf_term; set term pdfcairo size 8in,3.6in } else { set term @svg_term; set term svg size 1100,500 } }
   set termoption noenhanced
 
   # Brouwer's law: the plain composition's round-off error grows like sqrt(t) (dashed guide through
@@ -46,7 +46,7 @@ do for [format in "png pdf"] {
 
   # Adaptive steps against structure: the controller's run starts more accurate and then drifts
   # past the fixed step of the same mean size, whose error stays bounded.
-  if (format eq "png") { set term pngcairo size 1000,650 } else { set term pdfcairo size 7in,4.5in }
+  if (format eq "png") { set term pngcairo size 1000,650 } else { if (format eq "pdf") { set term pdfcairo size 7in,4.5in } else { set term @svg_term; set term svg size 1000,650 } }
   set termoption noenhanced
   set output "adaptive.".format
   set title "Kepler e = 0.6: adaptive_verlet (rtol = 1e-4) against Stormer-Verlet at its mean step (h = 0.0075)\nlargest |H - H0|/|H0| per window"

@@ -14,8 +14,8 @@ attempted = '(column("steps") + (strcol("status") eq "ok" ? 0 : 1))'
 its(minimize, good) = (@net && (@is_min) == minimize && (@ok) == good) ? column("newton_iters") / @attempted : NaN
 wall(minimize) = (@net && (@is_min) == minimize && @ok) ? column("wall_s") / column("steps") : NaN
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   set output "solvers.".format
   set multiplot layout 1,2 title "hp:alpha=0.5 on spring_net:stiffness=1e4,model=nonlinear (explicit limit h*omega_max = 1.89)"

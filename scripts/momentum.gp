@@ -13,8 +13,8 @@ do for [i=1:words(files)] {
   stats series(i) using "angular_momentum_0" every ::0::0 nooutput; L0[i] = STATS_min
 }
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   set xlabel "t (dimensionless)"; set logscale y; set format y "1e%T"; @key_above
   set yrange [1e-16:*]

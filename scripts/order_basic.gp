@@ -6,8 +6,8 @@ methods = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b s
 # ("implicit_euler:max_iter=50,tol=1e-12" reads as "implicit_euler:max_iter=50").
 select(label, method) = (strcol("label") eq label && method_index(strcol("method")) == method_index(method) && strcol("status") eq "ok") ? column("error_final") : NaN
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   do for [label in "pendulum kepler"] {
     set output "order_".label.".".format
     set title "Global error at t = 5 against the step size: ".(label eq "pendulum" ? "pendulum, theta0 = 1.5" : "Kepler orbit, e = 0.6")

@@ -9,8 +9,8 @@ titles = "stormer_verlet/spring_chain hp/spring_chain stormer_verlet/elastic_bar
 stats "scaling.csv" using (strcol("series") eq "verlet_chain" ? column("seconds_per_step") / column("dof") : NaN) nooutput
 ref_c = STATS_min / 3
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   set output "scaling.".format
   set title "Cost of one step against problem size (process CPU s; implicit steps at h = 20 x the explicit limit)"

@@ -16,8 +16,8 @@ stats first using "angular_momentum_0" every ::0::0 nooutput; L0x = STATS_min
 stats first using "angular_momentum_1" every ::0::0 nooutput; L0y = STATS_min
 stats first using "angular_momentum_2" every ::0::0 nooutput; L0z = STATS_min
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term; set term pngcairo size 1100,500 } else { set term @pdf_term; set term pdfcairo size 8in,3.6in }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term; set term pngcairo size 1100,500 } else { if (format eq "pdf") { set term @pdf_term; set term pdfcairo size 8in,3.6in } else { set term @svg_term; set term svg size 1100,500 } }
   set termoption noenhanced
 
   # Relative energy error, both step sizes side by side on log-log axes: bounded oscillation for
@@ -52,7 +52,7 @@ do for [format in "png pdf"] {
 
   # Heliocentric orbits projected on the x-y plane (Stormer-Verlet, h = 10 days, 2e5 days); the
   # barycentre drifts because GNI's initial data do not have zero total momentum.
-  if (format eq "png") { set term pngcairo size 800,800 } else { set term pdfcairo size 6in,6in }
+  if (format eq "png") { set term pngcairo size 800,800 } else { if (format eq "pdf") { set term pdfcairo size 6in,6in } else { set term @svg_term; set term svg size 800,800 } }
   set termoption noenhanced
   set output "orbits.".format
   set title "Heliocentric orbits, x-y projection (stormer_verlet, h = 10 days, T = 2e5 days)"

@@ -11,8 +11,8 @@ palette = "#7f7f7f #1f77b4 #2ca02c #d62728 #9467bd #00a087 #b8860b #393b79 #e729
 words_vdpol = "VDPOL (van der Pol, epsilon = 1e-6), t = 2"
 words_rober = "ROBER (Robertson), t = 1e11"
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set output "scd_vs_wall.".format
   set multiplot layout 1,2 title "Significant correct digits against wall time (IVP Test Set references)"
   set logscale x; set format x "1e%T"

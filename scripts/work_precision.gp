@@ -28,8 +28,8 @@ set style line 55 lw 7 lc rgb "#a017becf"  # adaptive_geomint: cyan
 set style line 56 lw 7 lc rgb "#a0393b79"  # adaptive_library: indigo
 fs(f) = 50 + family_index(f)
 
-do for [format in "png pdf"] {
-  if (format eq "png") { set term @png_term } else { set term @pdf_term }
+do for [format in "png pdf svg"] {
+  if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   do for [group in groups] {
     curves = system("cat wp/".group.".curves")
     families = system("cat wp/".group.".families")
