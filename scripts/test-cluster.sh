@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `make test-cluster` (docs/CLUSTER.md "Running on a cluster", issue 16): a real single-node Slurm on this
 # machine runs a committed scene through `geomint slurm --submit` with 8 shards, and the merged,
-# timed tables must equal a single-machine sweep (wall_s and date lines aside); then one shard is
+# timed tables must equal a single-machine sweep (timings and dates aside); then one shard is
 # made to fail, resubmitted alone from merge's message, and the tables are checked again.
 # Needs root (it installs the Debian packages and starts munged, slurmctld and slurmd, every one
 # stopped by PID on exit). Usage: test-cluster.sh [GEOMINT_BINARY] [SCENE_NAME]
@@ -121,33 +121,43 @@ wait_jobs() {
 all_completed() { ! echo "$@" | tr ' ' '\n' | grep -qv ':COMPLETED$'; }
 submitted_ids() { sed -n 's/.* as job \([0-9]*\)$/\1/p' "$1" | tr '\n' ' '; }
 
-# The merged and timed tables against the single-machine ones: equal but for wall_s and date.
+# The merged and timed tables against the single-machine ones: equal but for timings and dates.
 compare_tables() {
   /usr/bin/python3 - "$work/local" "$out" <<'EOF'
 import csv, io, sys
+# Machine-dependent: the timing columns (wall_s and its statistics wall_s_min, wall_s_iqr,
+# wall_s_repeats) and the dates (provenance, and the "How to cite" block of table.md).
+def timing(name): return name.strip().startswith("wall_s")
 def normal(path):
     text = open(path).read()
-    lines = [l for l in text.splitlines() if not l.startswith("# date: ")]
+    lines = [l for l in text.splitlines() if not l.startswith("# date: ")
+             and not l.startswith("| date | ") and not l.startswith("> geomint ")]
     if path.endswith(".md"):
-        out, wall = [], None
+        out, walls = [], []
         for line in lines:
             cells = line.split("|")
-            if line.startswith("|") and " wall_s " in cells: wall = cells.index(" wall_s ")
-            if not line.startswith("|"): wall = None
-            if wall is not None and len(cells) > wall: cells[wall] = ""
+            if line.startswith("|") and any(timing(c) for c in cells):
+                walls = [k for k, c in enumerate(cells) if timing(c)]
+            if not line.startswith("|"): walls = []
+            for k in walls:
+                if k < len(cells): cells[k] = ""
             out.append("|".join(cells))
         return out
     head = [l for l in lines if l.startswith("#")]
     rows = list(csv.reader(io.StringIO("\n".join(l for l in lines if not l.startswith("#")))))
-    if "wall_s" in rows[0]:
-        w = rows[0].index("wall_s")
-        for row in rows[1:]: row[w] = ""
+    walls = [k for k, name in enumerate(rows[0]) if timing(name)]
+    for row in rows[1:]:
+        for k in walls: row[k] = ""
     return head + rows
 bad = []
 for name in ["summary.csv", "table.md"]:
     a, b = normal(f"{sys.argv[1]}/{name}"), normal(f"{sys.argv[2]}/{name}")
-    if a != b: bad.append(name)
-if bad: sys.exit("differ from the single-machine sweep: " + ", ".join(bad))
+    if a != b:
+        first = next((k for k, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
+        show = lambda rows: rows[first] if first < len(rows) else "(no line)"
+        bad.append(f"{name} (first difference, line {first + 1}: local {show(a)!r}, "
+                   f"merged {show(b)!r})")
+if bad: sys.exit("differ from the single-machine sweep: " + "; ".join(bad))
 EOF
 }
 
