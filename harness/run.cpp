@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "harness/map_defect.hpp"
+#include "harness/modified_energy.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference.hpp"
@@ -353,6 +354,10 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (auto map_defect =
           make_map_defect_observer(integrator->spec(), *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(map_defect));
+  }
+  if (auto modified =
+          make_modified_energy_observer(*integrator, *problem, config.dt, config.extra_metrics)) {
+    observers.push_back(std::move(modified));
   }
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());
