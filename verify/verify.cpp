@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "harness/map_defect.hpp"
 #include "harness/order.hpp"
 #include "harness/run.hpp"
 #include "integrators/integrator.hpp"
@@ -97,6 +98,52 @@ CheckResult energy_without_drift(const std::string& method, const std::string& p
   result.passed = result.measured < result.bound && err_max < 0.1;
   result.detail = fmt::format("drift·T/err_max over 1e5 steps of {}; energy_err_max {:.3g} (< 0.1)",
                               dt, err_max);
+  return result;
+}
+
+CheckResult symplectic_map(const std::string& method, const std::string& problem_spec, double h) {
+  CheckResult result = start("symplectic_map", method, problem_spec);
+  result.bound = 1;
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method);
+  if (const std::string why = map_defect_not_applicable(*integrator, *problem, h); !why.empty()) {
+    result.applies = false;
+    result.passed = true;
+    result.detail = why;
+    return result;
+  }
+  // The floor of a symplectic method measured ≤ 3.5e-12 (tests/map_defect_test.cpp); a floor
+  // above 1e-7 means the map is too noisy to be judged, which is a failure, not a pass.
+  constexpr double kMaxFloor = 1e-7;
+  State state = problem->initial_state();
+  integrator->reset(*problem, state, h);
+  double worst_defect = 0, worst_floor = 0;
+  result.measured = 0;
+  for (int k = 0; k <= 20; ++k) {
+    if (k % 10 == 0) {
+      const MapDefect at = symplecticity_defect_map(method, *problem, state, h);
+      if (!(at.defect >= 0)) {
+        result.measured = INFINITY;
+        result.detail =
+            fmt::format("a step of the finite-difference Jacobian failed at step {}", k);
+        return result;
+      }
+      worst_defect = std::max(worst_defect, at.defect);
+      worst_floor = std::max(worst_floor, at.fd_error);
+      result.measured =
+          std::max(result.measured, at.fd_error > 0 ? at.defect / at.fd_error : INFINITY);
+    }
+    if (k < 20 && !integrator->step(*problem, state, h).ok) {
+      result.measured = INFINITY;
+      result.detail = fmt::format("step {} of h = {:g} failed", k + 1, h);
+      return result;
+    }
+  }
+  result.passed = result.measured <= result.bound && worst_floor <= kMaxFloor;
+  result.detail = fmt::format(
+      "‖JᵀΩJ − Ω‖/‖Ω‖ of one computed step of h = {:g} at steps 0, 10, 20: max defect {:.3g}, "
+      "max finite-difference floor {:.3g} (≤ {:g})",
+      h, worst_defect, worst_floor, kMaxFloor);
   return result;
 }
 
@@ -198,8 +245,8 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
 
 std::vector<std::string> check_names() {
   return {"declared_order_pendulum", "declared_order_kepler", "energy_without_drift",
-          "reversible_pendulum",     "reversible_kepler",     "momentum_maps_kept",
-          "constraint_kept"};
+          "symplectic_map",          "reversible_pendulum",   "reversible_kepler",
+          "momentum_maps_kept",      "constraint_kept"};
 }
 
 CheckResult run_check(const std::string& method, const std::string& name,
@@ -223,6 +270,12 @@ CheckResult run_check(const std::string& method, const std::string& name,
   if (name == "energy_without_drift") {
     return (flags & kSymplectic) ? energy_without_drift(method)
                                  : not_declared(name.c_str(), method, "symplectic");
+  }
+  if (name == "symplectic_map") {
+    if (!(flags & kSymplectic)) return not_declared(name.c_str(), method, "symplectic");
+    const CheckResult pendulum = symplectic_map(method, "pendulum:theta0=1.5", 0.1);
+    if (pendulum.applies && !pendulum.passed) return pendulum;
+    return symplectic_map(method, "kepler:e=0.6", 0.01);
   }
   if (name == "reversible_pendulum" || name == "reversible_kepler") {
     if (!(flags & kSymmetric)) return not_declared(name.c_str(), method, "symmetric");

@@ -48,6 +48,14 @@ CheckResult declared_order(const std::string& method, const Ladder& ladder, doub
 CheckResult energy_without_drift(const std::string& method,
                                  const std::string& problem = "pendulum:theta0=1.5");
 
+// Symplectic ⇒ the map the method computes is symplectic: the black-box defect ‖JᵀΩJ − Ω‖_F/‖Ω‖_F
+// of the finite-difference Jacobian of one computed step (harness/map_defect.hpp) stays under its
+// own finite-difference error estimate (the floor) at the start of `problem` and after 10 and 20
+// steps of h, and that floor under 1e-7. Judges what step() computes, not the declared flag: a
+// "Verlet" with a stale force has a defect O(h²) far above the floor. measured = the largest
+// defect / floor ratio (bound 1).
+CheckResult symplectic_map(const std::string& method, const std::string& problem, double h);
+
 // Symmetric ⇒ reversible: `steps` steps of h, then as many of −h, must return to the start
 // (distance relative to |(q₀, p₀)|; +inf when a step fails).
 double reversibility_defect(const std::string& method, const std::string& problem, double h,
@@ -76,7 +84,9 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
                             double steps_per_unit = 20, double units = 50, double bound = 1e-13);
 
 // The checks verify_method runs, by name: declared_order_pendulum, declared_order_kepler
-// (fixed-step methods), energy_without_drift (if symplectic), reversible_pendulum (h 0.1) and
+// (fixed-step methods), energy_without_drift and symplectic_map (pendulum:theta0=1.5 at h 0.1,
+// then kepler:e=0.6 at h 0.01; the first failure is reported) if symplectic, reversible_pendulum
+// (h 0.1) and
 // reversible_kepler (h 0.01, both bound 1e-11; if symmetric), momentum_maps_kept (if variational),
 // constraint_kept on `constrained_problem` (constraints-only methods, which get no other check).
 std::vector<std::string> check_names();

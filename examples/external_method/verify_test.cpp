@@ -1,7 +1,7 @@
 // The user's methods through geomint::verify (docs/VERIFY.md "Verify your own integrator"): the
 // correct position Verlet passes every check its flags call for; the stale-force Verlet must be
-// flagged by the order and energy checks — those tests expect the check to FAIL and pass when it
-// does.
+// flagged by the order, energy and symplectic-map checks — those tests expect the check to FAIL and
+// pass when it does.
 #include <verify/gtest.hpp>
 
 #include "user_extensions.hpp"
@@ -37,13 +37,21 @@ TEST(UserStaleVerletIsFlagged, EnergyCheckFails) {
   EXPECT_FALSE(result.passed) << "the energy drift was not caught: " << describe(result);
 }
 
+// The black-box check: the Jacobian of the map step() computes is not symplectic, whatever the
+// flags say (defect ~5e-3 against a finite-difference floor ~4e-13 on the pendulum at h = 0.1).
+TEST(UserStaleVerletIsFlagged, SymplecticMapCheckFails) {
+  const CheckResult result = geomint::verify::run_check("user_stale_verlet", "symplectic_map");
+  EXPECT_TRUE(result.applies) << describe(result);
+  EXPECT_FALSE(result.passed) << "the non-symplectic map was not caught: " << describe(result);
+}
+
 TEST(UserStaleVerletIsFlagged, EveryCheckOfTheKitThatApplies) {
   int failed = 0;
   for (const CheckResult& result : geomint::verify::verify_method("user_stale_verlet")) {
     std::printf("%s\n", describe(result).c_str());
     if (result.applies && !result.passed) ++failed;
   }
-  EXPECT_GE(failed, 3);  // both order ladders and the energy check at least
+  EXPECT_GE(failed, 4);  // both order ladders, the energy check and the map check at least
 }
 
 }  // namespace
