@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <vector>
 
 #include "harness/map_defect.hpp"
 #include "harness/order.hpp"
@@ -79,13 +80,14 @@ CheckResult declared_order(const std::string& method, const Ladder& ladder, doub
   return result;
 }
 
-CheckResult energy_without_drift(const std::string& method, const std::string& problem) {
+CheckResult energy_without_drift(const std::string& method, const std::string& problem,
+                                 double steps) {
   CheckResult result = start("energy_without_drift", method, problem);
   result.bound = 0.1;
   // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
   // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
   const double dt = make_integrator(method)->info().order >= 6 ? 0.2 : 0.05;
-  const double t_end = 1e5 * dt;
+  const double t_end = steps * dt;
   const RunResult run = run_untimed(problem, method, dt, t_end);
   if (!run.ok) {
     result.measured = INFINITY;
@@ -96,8 +98,8 @@ CheckResult energy_without_drift(const std::string& method, const std::string& p
   const double err_max = run.record.metrics.at("energy_err_max");
   result.measured = std::abs(drift) * t_end / err_max;
   result.passed = result.measured < result.bound && err_max < 0.1;
-  result.detail = fmt::format("drift·T/err_max over 1e5 steps of {}; energy_err_max {:.3g} (< 0.1)",
-                              dt, err_max);
+  result.detail = fmt::format(
+      "drift·T/err_max over {:g} steps of {}; energy_err_max {:.3g} (< 0.1)", steps, dt, err_max);
   return result;
 }
 
@@ -243,16 +245,100 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
   return result;
 }
 
+double conserved_momentum_error(const std::string& method, const std::string& problem_spec,
+                                double h, int steps) {
+  const auto problem = make_problem(problem_spec);
+  auto integrator = make_integrator(method);
+  State state = problem->initial_state();
+  std::vector<Vec (Problem::*)(const Vec&, const Vec&) const> maps;
+  if (problem->has(kLinearMomentum)) maps.push_back(&Problem::linear_momentum);
+  if (problem->has(kAngularMomentum)) maps.push_back(&Problem::angular_momentum);
+  std::vector<Vec> initial;
+  for (auto map : maps) initial.push_back((*problem.*map)(state.q, state.p));
+  double error = 0;
+  integrator->reset(*problem, state, h);
+  for (int k = 0; k < steps; ++k) {
+    if (!integrator->step(*problem, state, h).ok) return INFINITY;
+    for (size_t i = 0; i < maps.size(); ++i) {
+      error = std::max(
+          error, ((*problem.*maps[i])(state.q, state.p) - initial[i]).norm() / initial[i].norm());
+    }
+  }
+  return error;
+}
+
+namespace {
+
+const char* const kPolarKepler = "kepler:e=0.6,coordinates=polar";
+const char* const kDoublePendulum = "double_pendulum:theta1=0.3,theta2=-0.2";
+const char* const kChargedParticle = "charged_particle";
+
+}  // namespace
+
+CheckResult general_check(const std::string& method, const std::string& name) {
+  const unsigned flags = make_integrator(method)->info().flags;
+  if (!(flags & kGeneralLagrangian))
+    return not_declared(name.c_str(), method, "general-Lagrangian");
+  if (name == "declared_order_general") {
+    if (flags & kAdaptive) return not_declared(name.c_str(), method, "fixed-step");
+    CheckResult result = declared_order(method, {kPolarKepler, 0.02, 6, 5.0});
+    result.check = name;
+    return result;
+  }
+  if (name == "energy_without_drift_general") {
+    if (!(flags & kSymplectic)) return not_declared(name.c_str(), method, "symplectic");
+    CheckResult result = energy_without_drift(method, kDoublePendulum, 1e4);
+    result.check = name;
+    return result;
+  }
+  if (name == "reversible_general") {
+    if (!(flags & kSymmetric)) return not_declared(name.c_str(), method, "symmetric");
+    const CheckResult pendulum = reversible(method, kDoublePendulum, 0.05, 1e-11);
+    CheckResult result =
+        pendulum.passed ? reversible(method, kChargedParticle, 0.1, 1e-11) : pendulum;
+    if (pendulum.passed) {
+      result.detail +=
+          fmt::format(" (and {:.3g} on {} at h 0.05)", pendulum.measured, kDoublePendulum);
+    }
+    result.check = name;
+    return result;
+  }
+  if (name == "momentum_maps_kept_general") {
+    if (!(flags & kVariational)) return not_declared(name.c_str(), method, "variational");
+    CheckResult result = start("momentum_maps_kept_general", method,
+                               fmt::format("{}, {}", kPolarKepler, kChargedParticle));
+    result.bound = 1e-12;
+    const double kepler = conserved_momentum_error(method, kPolarKepler, 0.01, 10000);
+    const double charged = conserved_momentum_error(method, kChargedParticle, 0.05, 10000);
+    result.measured = std::max(kepler, charged);
+    result.passed = result.measured <= result.bound;
+    result.detail = fmt::format(
+        "1e4 steps: max |Δp_φ|/|p_φ| {:.3g} (Kepler in polar coordinates, h 0.01), max |ΔJ|/|J₀| "
+        "{:.3g} (charged particle in a uniform B, h 0.05)",
+        kepler, charged);
+    return result;
+  }
+  throw InputError(fmt::format("verify: unknown general check '{}'", name));
+}
+
 std::vector<std::string> check_names() {
-  return {"declared_order_pendulum", "declared_order_kepler", "energy_without_drift",
-          "symplectic_map",          "reversible_pendulum",   "reversible_kepler",
-          "momentum_maps_kept",      "constraint_kept"};
+  return {"declared_order_pendulum", "declared_order_kepler",
+          "energy_without_drift",    "symplectic_map",
+          "reversible_pendulum",     "reversible_kepler",
+          "momentum_maps_kept",      "constraint_kept",
+          "declared_order_general",  "energy_without_drift_general",
+          "reversible_general",      "momentum_maps_kept_general"};
 }
 
 CheckResult run_check(const std::string& method, const std::string& name,
                       const std::string& constrained_problem) {
   const unsigned flags = make_integrator(method)->info().flags;
   const bool constraints_only = flags & kConstraintsOnly;
+  const std::vector<std::string> names = check_names();
+  if (name.size() > 8 && name.compare(name.size() - 8, 8, "_general") == 0 &&
+      std::find(names.begin(), names.end(), name) != names.end()) {
+    return general_check(method, name);
+  }
   if (name == "constraint_kept") {
     return constraints_only ? constraint_kept(method, constrained_problem)
                             : not_declared("constraint_kept", method, "constraints-only");

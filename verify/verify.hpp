@@ -41,12 +41,13 @@ Ladder kepler_ladder();    // kepler:e=0.6, dt0 0.02, 7 levels, t_end 5
 // starts ×4 larger from order 4 and ×16 from order 8, and orders >= 6 use two levels fewer.
 CheckResult declared_order(const std::string& method, const Ladder& ladder, double tolerance = 0.3);
 
-// Symplectic ⇒ bounded energy error without drift: over 1e5 steps on `problem` (dt 0.05, or 0.2
-// from order 6 where round-off would look like drift), |trend of the per-window maxima| × T must
-// stay below 10% of the maximum error, and that below 0.1. A drifting method (RK4, explicit
+// Symplectic ⇒ bounded energy error without drift: over `steps` (1e5) steps on `problem` (dt 0.05,
+// or 0.2 from order 6 where round-off would look like drift), |trend of the per-window maxima| × T
+// must stay below 10% of the maximum error, and that below 0.1. A drifting method (RK4, explicit
 // Euler, a non-symplectic "Verlet") has trend × T ≈ err_max. measured = drift·T / err_max.
 CheckResult energy_without_drift(const std::string& method,
-                                 const std::string& problem = "pendulum:theta0=1.5");
+                                 const std::string& problem = "pendulum:theta0=1.5",
+                                 double steps = 1e5);
 
 // Symplectic ⇒ the map the method computes is symplectic: the black-box defect ‖JᵀΩJ − Ω‖_F/‖Ω‖_F
 // of the finite-difference Jacobian of one computed step (harness/map_defect.hpp) stays under its
@@ -83,12 +84,34 @@ CheckResult momentum_maps_kept(const std::string& method,
 CheckResult constraint_kept(const std::string& method, const std::string& problem,
                             double steps_per_unit = 20, double units = 50, double bound = 1e-13);
 
+// max_k |J(q_k, p_k) − J₀| / |J₀| over the conserved momentum maps `problem` offers (linear
+// and/or angular; p_φ of polar Kepler, the canonical angular momentum of a charged particle about
+// B), over `steps` steps of h; +inf when a step fails.
+double conserved_momentum_error(const std::string& method, const std::string& problem, double h,
+                                int steps);
+
+// The general Lagrangian kind (docs/MECHANICS_GENERAL.md; issue 25, item 5): for a method flagged
+// kGeneralLagrangian the same properties on problems whose mass depends on q or whose Lagrangian
+// has a term linear in v, kept cheap (a few 1e4 steps each):
+//   declared_order_general       the Kepler ladder in polar coordinates (kepler:e=0.6,
+//                                coordinates=polar, exact solution), fixed-step methods;
+//   energy_without_drift_general double_pendulum (theta1 0.3, theta2 −0.2), 1e4 steps of 0.05,
+//                                if symplectic;
+//   reversible_general           double_pendulum (h 0.05) and charged_particle (h 0.1), bound
+//                                1e-11, if symmetric;
+//   momentum_maps_kept_general   p_φ of kepler:e=0.6,coordinates=polar (a cyclic coordinate) and
+//                                the canonical angular momentum of charged_particle about B, 1e4
+//                                steps, bound 1e-12, if variational.
+// A method without the flag is not run there (applies = false: "not declared general-Lagrangian").
+CheckResult general_check(const std::string& method, const std::string& name);
+
 // The checks verify_method runs, by name: declared_order_pendulum, declared_order_kepler
 // (fixed-step methods), energy_without_drift and symplectic_map (pendulum:theta0=1.5 at h 0.1,
 // then kepler:e=0.6 at h 0.01; the first failure is reported) if symplectic, reversible_pendulum
 // (h 0.1) and
 // reversible_kepler (h 0.01, both bound 1e-11; if symmetric), momentum_maps_kept (if variational),
-// constraint_kept on `constrained_problem` (constraints-only methods, which get no other check).
+// constraint_kept on `constrained_problem` (constraints-only methods, which get no other check),
+// then the four *_general checks of general_check().
 std::vector<std::string> check_names();
 // One named check, or applies = false when the method's flags do not call for it. InputError for
 // an unknown name.

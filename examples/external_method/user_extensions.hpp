@@ -3,7 +3,7 @@
 #pragma once
 
 namespace user {
-void register_methods();   // user_position_verlet, user_stale_verlet (user_methods.cpp)
+void register_methods();   // user_position_verlet, user_stale_verlet, user_general_midpoint
 void register_problems();  // user_quartic (quartic_oscillator.cpp)
 inline void register_all() {
   register_methods();

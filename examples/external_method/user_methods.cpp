@@ -1,10 +1,13 @@
 // A user's integrators, written outside the geomint tree against its installed headers
 // (docs/VERIFY.md "Verify your own integrator"): a drift–kick–drift position Verlet from scratch
-// (GNI §I.3.1), and a deliberately broken velocity Verlet that reuses the stale force in its second
-// kick.
+// (GNI §I.3.1), a deliberately broken velocity Verlet that reuses the stale force in its second
+// kick, and an implicit midpoint rule that claims the general Lagrangian kind
+// (docs/MECHANICS_GENERAL.md §3).
 #include <memory>
 
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/lagrangian.hpp"
 #include "user_extensions.hpp"
 
 namespace user {
@@ -60,11 +63,39 @@ class StaleVerlet final : public Integrator {
   Vec gradient_;
 };
 
+// The implicit midpoint rule z₁ = z₀ + h f((z₀ + z₁)/2) on the Hamiltonian view of any
+// L = ½vᵀM(q)v + a(q)ᵀv − V(q), through geomint's general step (dense Newton, tolerance 1e-12):
+// it claims kGeneralLagrangian, so the verify kit also checks it on polar Kepler, the double
+// pendulum and the charged particle. On constant-mass problems lagrangian_view() adapts them.
+class GeneralMidpoint final : public Integrator {
+ public:
+  MethodInfo info() const override {
+    return {"user_general_midpoint", 2,
+            geomint::kImplicit | geomint::kSymplectic | geomint::kSymmetric |
+                geomint::kVariational | geomint::kGeneralLagrangian,
+            "implicit midpoint on the Hamiltonian view of a general L (user wrapper)"};
+  }
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    system_ = geomint::lagrangian_view(problem);
+  }
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    if (!system_) system_ = geomint::lagrangian_view(problem);
+    return geomint::general_implicit_midpoint_step(*system_, state, h, {}, counters_);
+  }
+
+ private:
+  std::shared_ptr<const geomint::LagrangianSystem> system_;
+};
+
 std::unique_ptr<Integrator> make_position_verlet(geomint::Params&) {
   return std::make_unique<PositionVerlet>();
 }
 std::unique_ptr<Integrator> make_stale_verlet(geomint::Params&) {
   return std::make_unique<StaleVerlet>();
+}
+std::unique_ptr<Integrator> make_general_midpoint(geomint::Params&) {
+  return std::make_unique<GeneralMidpoint>();
 }
 
 }  // namespace
@@ -77,6 +108,10 @@ void register_methods() {
   geomint::register_method({"user_stale_verlet",
                             "velocity Verlet with a stale force (broken on purpose)",
                             &make_stale_verlet,
+                            {}});
+  geomint::register_method({"user_general_midpoint",
+                            "implicit midpoint on general Lagrangians (user wrapper)",
+                            &make_general_midpoint,
                             {}});
 }
 

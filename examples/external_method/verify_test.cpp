@@ -18,6 +18,10 @@ const bool kRegistered = (user::register_all(), true);
 // reversibility, momentum maps of a spring network.
 GEOMINT_VERIFY_METHOD(UserPositionVerlet, "user_position_verlet");
 
+// A method that claims the general Lagrangian kind: every check, the four *_general ones on polar
+// Kepler, the double pendulum and the charged particle included (issue 25, item 5).
+GEOMINT_VERIFY_METHOD(UserGeneralMidpoint, "user_general_midpoint");
+
 TEST(UserPositionVerlet, SecondOrderOnTheUserProblem) {
   ASSERT_TRUE(kRegistered);
   GEOMINT_VERIFY_EXPECT_PASSED(

@@ -68,5 +68,40 @@ TEST(SymplecticMapCheck, SkippedWhenNotDeclared) {
   EXPECT_FALSE(verify::run_check("rk4", "symplectic_map").applies);
 }
 
+// Issue 25, item 5: a method flagged kGeneralLagrangian is also checked on the general kind
+// (polar Kepler, the double pendulum, the charged particle); one without the flag is not run there.
+TEST(GeneralChecks, ImplicitMidpointPassesEveryGeneralCheck) {
+  for (const char* name : {"declared_order_general", "energy_without_drift_general",
+                           "reversible_general", "momentum_maps_kept_general"}) {
+    const verify::CheckResult result = verify::run_check("implicit_midpoint", name);
+    std::printf("%s\n", verify::describe(result).c_str());
+    EXPECT_TRUE(result.applies && result.passed) << verify::describe(result);
+  }
+}
+
+TEST(GeneralChecks, Rk4HasItsOrderAndNoMoreThere) {
+  const verify::CheckResult order = verify::run_check("rk4", "declared_order_general");
+  std::printf("%s\n", verify::describe(order).c_str());
+  EXPECT_TRUE(order.applies && order.passed) << verify::describe(order);
+  EXPECT_FALSE(verify::run_check("rk4", "energy_without_drift_general").applies);
+  EXPECT_FALSE(verify::general_check("rk4", "momentum_maps_kept_general").applies);
+  // Negative control of the momentum check: RK4 does not keep the charged particle's canonical
+  // angular momentum (measured 2.2e-6 where implicit_midpoint keeps 6.8e-15), so a method that
+  // claimed variational with RK4's step would fail the 1e-12 bound.
+  EXPECT_GT(verify::conserved_momentum_error("rk4", "charged_particle", 0.05, 10000), 1e-9);
+  // Negative control of the reversibility check on the general kind: RK4 is not symmetric, and
+  // on the double pendulum 20 steps forth and back miss the start by far more than the bound.
+  EXPECT_GT(verify::reversibility_defect("rk4", "double_pendulum:theta1=0.3,theta2=-0.2", 0.05),
+            1e-9);
+}
+
+TEST(GeneralChecks, SeparableOnlyMethodsAreNotRunOnTheGeneralKind) {
+  for (const char* name : {"declared_order_general", "reversible_general"}) {
+    const verify::CheckResult result = verify::run_check("stormer_verlet", name);
+    EXPECT_FALSE(result.applies) << verify::describe(result);
+    EXPECT_NE(result.detail.find("general"), std::string::npos) << result.detail;
+  }
+}
+
 }  // namespace
 }  // namespace geomint
