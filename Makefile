@@ -12,7 +12,7 @@ FIGURE_SCENES = $(filter-out $(LONG_SCENES),$(SCENES))
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-all reproduce-quick gates gate-quick bench \
         format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables \
         report report-quick \
-        test-cluster test-external
+        test-cluster test-external perf
 
 all: build
 
@@ -160,6 +160,16 @@ readme-tables: build
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
+
+# Benchmarks as regression data (docs/PERF.md): PERF_REPS repetitions of the benchmarks matching
+# PERF_FILTER, one Google Benchmark JSON per program in PERF_OUT with the commit, compiler, CPU
+# model and thread count in its context; compare two such folders with `geomint perf-compare`.
+PERF_OUT ?= $(BUILD_DIR)/perf
+PERF_REPS ?= 10
+PERF_MIN_TIME ?= 0.05
+PERF_FILTER ?= ^(BM_InterfaceKepler|BM_HandLoopKepler|BM_StepCallKepler|BM_(Gradient|Hessian)/[a-z]+/[01]|(Factorise|Solve|ConjugateGradient)/[a-z_]+/0|BM_ImplicitStep/[a-z_]+/0/.*)$$
+perf: build
+	@bash scripts/perf.sh $(BUILD_DIR) '$(PERF_OUT)' '$(PERF_REPS)' '$(PERF_MIN_TIME)' '$(PERF_FILTER)'
 
 format:
 	@clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -8,7 +8,7 @@ set -euo pipefail
 PACKAGES=(
   g++ cmake make pkg-config
   libeigen3-dev libsundials-dev libgsl-dev libboost-dev
-  gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev
+  gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev
   clang libclang-rt-14-dev python3

@@ -69,6 +69,19 @@ std::set<std::string> tree(const fs::path& root) {
   return out;
 }
 
+// A Google Benchmark JSON document with one benchmark measured once per value (microseconds).
+std::string bench_json(const std::vector<double>& times_us) {
+  std::string rows;
+  for (std::size_t i = 0; i < times_us.size(); ++i) {
+    rows += (i ? ",\n" : "") + std::string("{\"name\": \"BM_Step\", \"run_name\": \"BM_Step\", ") +
+            "\"run_type\": \"iteration\", \"repetitions\": " + std::to_string(times_us.size()) +
+            ", \"iterations\": 100, \"real_time\": " + std::to_string(times_us[i]) +
+            ", \"cpu_time\": " + std::to_string(times_us[i]) + ", \"time_unit\": \"us\"}";
+  }
+  return "{\"context\": {\"commit\": \"abc\"},\n\"benchmarks\": [\n" + rows + "\n]}\n";
+}
+const std::string kBenchJson = bench_json({10, 11, 12, 10.5, 11.5, 10.2});
+
 const std::vector<Case>& cases() {
   static const std::vector<Case> all = {
       // --- specs and run options (the original cli_test cases) ---
@@ -1017,6 +1030,51 @@ const std::vector<Case>& cases() {
        "run --problem pendulum:theta0=2.5 --method composition:base=implicit_midpoint,max_iter=1 "
        "--dt 0.2 --t-end 2 --timing-repeats 0",
        1, "newton_max_iter"},
+      // --- perf-compare (harness/perf_compare.*, docs/PERF.md): every input validated whole ---
+      {"PerfCompareTruncatedJson",
+       "perf-compare {dir}/a.json {dir}/b.json",
+       2,
+       "truncated",
+       {{"a.json", kBenchJson}, {"b.json", kBenchJson.substr(0, kBenchJson.size() / 2)}},
+       {"a.json", "b.json"}},
+      {"PerfCompareNotGoogleBenchmark",
+       "perf-compare {dir}/a.json {dir}/b.json",
+       2,
+       "\"benchmarks\"",
+       {{"a.json", kBenchJson}, {"b.json", "{\"rows\": []}"}},
+       {"a.json", "b.json"}},
+      {"PerfCompareFailedBenchmark",
+       "perf-compare {dir}/a.json {dir}/b.json",
+       2,
+       "reported an error",
+       {{"a.json", kBenchJson},
+        {"b.json",
+         replace_all(kBenchJson, "\"iterations\"", "\"error_occurred\": true, \"iterations\"")}},
+       {"a.json", "b.json"}},
+      {"PerfCompareTooFewRepetitions",
+       "perf-compare {dir}/a.json {dir}/a.json",
+       2,
+       "at least 5",
+       {{"a.json", bench_json({1.0, 2.0, 3.0})}},
+       {"a.json"}},
+      {"PerfCompareAlphaOutOfRange",
+       "perf-compare {dir}/a.json {dir}/a.json --alpha 1.5",
+       2,
+       "--alpha",
+       {{"a.json", kBenchJson}},
+       {"a.json"}},
+      {"PerfCompareEmptyFolder",
+       "perf-compare {dir}/a.json {dir}/empty",
+       2,
+       "no *.json",
+       {{"a.json", kBenchJson}, {"empty/", ""}},
+       {"a.json", "empty"}},
+      {"PerfCompareMissingFile",
+       "perf-compare {dir}/a.json {dir}/nosuch.json",
+       2,
+       "nosuch.json",
+       {{"a.json", kBenchJson}},
+       {"a.json"}},
       // Errors of 10^3-10^4 on an orbit of size 1 once fitted "order 0.999".
       {"OrderFromErrorsAboveTheSolutionIsNoFit",
        "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,

@@ -17,5 +17,6 @@ Verb add_reference(CLI::App& app);
 Verb add_modes(CLI::App& app);
 Verb add_gate(CLI::App& app);
 Verb add_report(CLI::App& app);
+Verb add_perf_compare(CLI::App& app);
 
 }  // namespace geomint::cli
