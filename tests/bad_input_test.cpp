@@ -123,7 +123,14 @@ const std::vector<Case>& cases() {
        "run --problem double_pendulum --method rattle --dt 0.01 --t-end 1", 2, "non-separable"},
       {"HpMinimizeOnNonSeparableProblem",
        "run --problem double_pendulum --method hp:solver=minimize --dt 0.01 --t-end 1", 2,
-       "methods that apply: "},
+       "needs the step to be the minimiser of a scalar E_k(v)"},
+      {"HpMinimizeOnPolarKepler",
+       "run --problem kepler:coordinates=polar --method hp:alpha=0.25,solver=minimize --dt 0.01 "
+       "--t-end 1",
+       2, "on a general L(q, v) it is not"},
+      {"HpLeftRuleOnNonSeparableProblem",
+       "run --problem double_pendulum --method hp:alpha=0,solver=newton --dt 0.01 --t-end 1", 2,
+       "assumes a separable Lagrangian"},
       // --- the charged particle and the Boris pusher (issue 25) ---
       {"BorisOnAnotherProblem", "run --problem double_pendulum --method boris --dt 0.01 --t-end 1",
        2, "integrates charged particles only"},
