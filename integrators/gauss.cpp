@@ -18,7 +18,8 @@ std::unique_ptr<Integrator> make_gauss(Params& params) {
                                                     : stages == 2 ? coefficients::kGauss2
                                                                   : coefficients::kGauss3;
   MethodInfo info{
-      "gauss", tableau.order, kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
+      "gauss", tableau.order,
+      kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian | kGeneralLagrangian,
       fmt::format("{}, order {}; Butcher 1964; GNI §II.1.3, §VI.4", tableau.source, tableau.order)};
   return make_partitioned_rk(tableau, std::move(info), params);
 }

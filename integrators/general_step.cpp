@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace geomint {
 namespace {
@@ -146,6 +147,104 @@ StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State&
   state.t += h;
   ++counters.steps;
   if (!finite(z1)) return StepStatus::failure("nan", "general implicit midpoint: non-finite state");
+  return StepStatus::success();
+}
+
+StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& state, double h,
+                                       const DenseMatrix& a, const DenseMatrix& a_hat, const Vec& b,
+                                       const GeneralNewtonSettings& newton, Counters& counters) {
+  const long n = state.q.size();
+  const long s = b.size();
+  const Vec q0 = state.q;
+  const Vec p0 = state.p;
+  // Stage i's unknowns are z.segment(2ni, 2n) = (Q_i, P_i), all started at (q₀, p₀).
+  Vec z(2 * n * s);
+  for (long i = 0; i < s; ++i) z.segment(2 * n * i, 2 * n) << q0, p0;
+  std::vector<Vec> velocities(s), forces(s);  // v(Q_j, P_j) and L_q(Q_j, v_j)
+  Vec residual(2 * n * s);
+  DenseMatrix field_jacobian, jacobian(2 * n * s, 2 * n * s);
+  double q_scale = 0, p_scale = 0;
+  const auto evaluate = [&](const Vec& stages) {
+    double largest_v = 0, largest_force = 0;
+    for (long j = 0; j < s; ++j) {
+      const Vec Q = stages.segment(2 * n * j, n);
+      velocities[j] = system.velocity(Q, stages.segment(2 * n * j + n, n));
+      system.lagrangian_q(Q, velocities[j], forces[j]);
+      ++counters.force_evals;
+      largest_v = std::max(largest_v, inf_norm(velocities[j]));
+      largest_force = std::max(largest_force, inf_norm(forces[j]));
+    }
+    for (long i = 0; i < s; ++i) {
+      Vec q_row = stages.segment(2 * n * i, n) - q0;
+      Vec p_row = stages.segment(2 * n * i + n, n) - p0;
+      for (long j = 0; j < s; ++j) {
+        q_row -= (h * a(i, j)) * velocities[j];
+        p_row -= (h * a_hat(i, j)) * forces[j];
+      }
+      residual.segment(2 * n * i, 2 * n) << q_row, p_row;
+    }
+    q_scale = inf_norm(q0) + std::abs(h) * largest_v;
+    p_scale = inf_norm(p0) + std::abs(h) * largest_force;
+  };
+  const auto converged = [&](double floor) {
+    for (long i = 0; i < s; ++i) {
+      if (inf_norm(residual.segment(2 * n * i, n)) > floor * q_scale) return false;
+      if (inf_norm(residual.segment(2 * n * i + n, n)) > floor * p_scale) return false;
+    }
+    return true;
+  };
+  // ∂R_i/∂(Q_j, P_j) = δ_ij I − h diag(a_ij I, â_ij I) J_j, J_j the field Jacobian at stage j.
+  const auto factorise = [&](const Vec& stages) {
+    jacobian.setIdentity();
+    for (long j = 0; j < s; ++j) {
+      system.hamiltonian_vector_field_jacobian(stages.segment(2 * n * j, n),
+                                               stages.segment(2 * n * j + n, n), field_jacobian);
+      for (long i = 0; i < s; ++i) {
+        jacobian.block(2 * n * i, 2 * n * j, n, 2 * n) -= (h * a(i, j)) * field_jacobian.topRows(n);
+        jacobian.block(2 * n * i + n, 2 * n * j, n, 2 * n) -=
+            (h * a_hat(i, j)) * field_jacobian.bottomRows(n);
+      }
+    }
+    ++counters.factorizations;
+    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
+  };
+  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
+  for (int iteration = 0;; ++iteration) {
+    evaluate(z);
+    if (!finite(residual)) {
+      return StepStatus::failure("nan", "general partitioned RK: non-finite residual");
+    }
+    if (converged(floor)) {
+      const Vec before = residual;
+      const Vec polished = z - factorise(z).solve(residual);
+      ++counters.linear_solves;
+      evaluate(polished);
+      if (finite(residual) && inf_norm(residual) < inf_norm(before)) {
+        z = polished;
+      } else {
+        evaluate(z);  // the stage velocities and forces of the accepted z
+      }
+      break;
+    }
+    if (iteration == newton.max_iterations) {
+      return StepStatus::failure(
+          "newton_max_iter",
+          fmt::format("general partitioned RK: |R| = {:.3g} after {} Newton iterations",
+                      inf_norm(residual), iteration));
+    }
+    z -= factorise(z).solve(residual);
+    ++counters.linear_solves;
+    ++counters.newton_iters;
+  }
+  for (long j = 0; j < s; ++j) {
+    state.q += (h * b[j]) * velocities[j];
+    state.p += (h * b[j]) * forces[j];
+  }
+  state.t += h;
+  ++counters.steps;
+  if (!finite(state.q) || !finite(state.p)) {
+    return StepStatus::failure("nan", "general partitioned RK: non-finite state");
+  }
   return StepStatus::success();
 }
 

@@ -15,6 +15,15 @@ namespace geomint {
 // separable constant-mass form (its step uses M⁻¹p and ∇V: Verlet, symplectic Euler, Newmark,
 // RATTLE, hp's minimisation form), and applicable() refuses it on is_non_separable problems.
 
+// A method without kGeneralLagrangian that knows a more specific reason than "assumes a separable
+// Lagrangian" for refusing a non-separable problem derives from this too (hp:solver=minimize: its
+// general step has no scalar objective); applicable() reports the reason when it is not empty.
+class ExplainsGeneralRefusal {
+ public:
+  virtual ~ExplainsGeneralRefusal() = default;
+  virtual std::string general_lagrangian_refusal() const = 0;
+};
+
 // The registry's test specs flagged kGeneralLagrangian (for refusal messages and tests).
 std::vector<std::string> general_lagrangian_methods();
 
@@ -34,5 +43,20 @@ StepStatus general_del_step(const LagrangianSystem& system, State& state, double
 // f = (v(q, p), L_q(q, v(q, p))) (symplectic for any H).
 StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State& state, double h,
                                           const GeneralNewtonSettings& newton, Counters& counters);
+
+// The generalized leapfrog on the Hamiltonian view (GNI §VI.3, (3.4)–(3.6)),
+// integrators/generalized_leapfrog.cpp: p½ = p₀ − (h/2)H_q(q₀, p½), q₁ = q₀ + (h/2)[H_p(q₀, p½) +
+// H_p(q₁, p½)], p₁ = p½ − (h/2)H_q(q₁, p½), each implicit equation by dense Newton.
+StepStatus general_leapfrog_step(const LagrangianSystem& system, State& state, double h,
+                                 const GeneralNewtonSettings& newton, Counters& counters);
+
+// A partitioned Runge–Kutta method on the Hamiltonian view, q̇ = H_p = v(q, p),
+// ṗ = −H_q = L_q(q, v(q, p)) (GNI §II.2.2): Q_i = q₀ + hΣ_j a_ij v(Q_j, P_j),
+// P_i = p₀ + hΣ_j â_ij L_q(Q_j, v_j), q₁ = q₀ + hΣ b_j v_j, p₁ = p₀ + hΣ b_j L_q,j. Newton on all
+// stage values (Q, P) at once with the dense LU of I − h(A ⊗ field Jacobian); Gauss (â = a) and
+// Lobatto IIIA–IIIB are symplectic for any H. `a`, `a_hat` are s × s, `b` has s entries.
+StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& state, double h,
+                                       const DenseMatrix& a, const DenseMatrix& a_hat, const Vec& b,
+                                       const GeneralNewtonSettings& newton, Counters& counters);
 
 }  // namespace geomint

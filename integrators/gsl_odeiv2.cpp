@@ -44,7 +44,8 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
   MethodInfo info() const override {
     switch (method_) {
       case GslMethod::kRk8pd:
-        return {"gsl_rk8pd", 8, kExplicit | kAdaptive | kFirstOrderCapable,
+        // Sees only first_order_rhs: runs the general kind too (Hamilton's equations of its L).
+        return {"gsl_rk8pd", 8, kExplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
                 "GSL odeiv2 rk8pd: embedded Runge-Kutta Prince-Dormand (8, 9)"};
       case GslMethod::kMsbdf:
         // Variable order 1..5: the declared order is the maximum.

@@ -10,6 +10,7 @@
 
 #include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
@@ -56,13 +57,27 @@ namespace {
 // a case: on a forced problem minimize is a line-searched Newton on R; force_at=node keeps the
 // exact objective.
 //
+// The general Lagrangian kind (L = ½vᵀM(q)v + a(q)ᵀv − V, ../shared/MECHANICS.md §3): the step
+// solves L_v(q^α, v) = p_k + (1−α)h L_q(q^α, v), then q_{k+1} = q_k + hv, p_{k+1} = p_k + hL_q —
+// the α-rule DEL step in position–momentum form, so general_del_step (dense Newton with a
+// partially pivoted LU on the non-symmetric Jacobian) solves it. That Jacobian is the Hessian of
+// no scalar E_k unless L_vq is symmetric, so the minimiser does not exist there: `solver=minimize`
+// written out is refused on non-separable problems (general_lagrangian_refusal), while the default
+// (solver not given) runs the Newton step; 0 < α < 1 only, as for del (α = 0, 1 are declared
+// explicit, which they are not when M depends on q).
+//
 // Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
 // G(q_k)ᵀΛ and g(q_k + hv) = 0, solved by integrators/constrained_step.hpp, then p_{k+1}
 // projected onto the tangent space at q_{k+1}.
-class HamiltonPontryagin final : public Integrator {
+class HamiltonPontryagin final : public Integrator, public ExplainsGeneralRefusal {
  public:
-  HamiltonPontryagin(double alpha, bool minimize, Forcing forcing, const NewtonOptions& newton)
-      : alpha_(alpha), minimize_(minimize), forcing_(forcing), newton_(newton) {
+  HamiltonPontryagin(double alpha, bool minimize, bool minimize_written, Forcing forcing,
+                     const NewtonOptions& newton)
+      : alpha_(alpha),
+        minimize_(minimize),
+        minimize_written_(minimize_written),
+        forcing_(forcing),
+        newton_(newton) {
     NewtonOptions& options = newton_.options();
     options.polish = true;  // momentum maps to round-off, not to the tolerance
     options.line_search = minimize;
@@ -72,6 +87,7 @@ class HamiltonPontryagin final : public Integrator {
     unsigned flags = kSymplectic | kVariational;
     flags |= (alpha_ == 0.0 || alpha_ == 1.0) ? kExplicit : (kImplicit | kNeedsHessian);
     if (alpha_ == 0.5) flags |= kSymmetric | kConstrained | kRheonomic;
+    if (alpha_ > 0.0 && alpha_ < 1.0 && !minimize_written_) flags |= kGeneralLagrangian;
     return {"hp", alpha_ == 0.5 ? 2 : 1, flags,
             "discrete Hamilton-Pontryagin, update as minimisation of E_k, Kharevych et al. 2006 "
             "§4; docs/METHOD.md §4"};
@@ -81,12 +97,21 @@ class HamiltonPontryagin final : public Integrator {
     return alpha_rule_stability(alpha_);
   }
 
+  std::string general_lagrangian_refusal() const override {
+    if (!minimize_written_ || alpha_ == 0.0 || alpha_ == 1.0) return {};
+    return "hp:solver=minimize needs the step to be the minimiser of a scalar E_k(v), and on a "
+           "general L(q, v) it is not (its Jacobian L_vv + h(alpha L_vq - (1-alpha) L_qv) - "
+           "alpha(1-alpha)h^2 L_qq is not symmetric); hp:solver=newton or hp without solver= "
+           "runs it";
+  }
+
   void reset(const Problem& problem, const State& state, double h) override {
     Integrator::reset(problem, state, h);
     newton_.forget_pattern();
     damping_symmetric_.reset();
     dissipation_potential_.reset();
-    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    velocity_ = is_non_separable(problem) ? general_lagrangian(problem)->velocity(state.q, state.p)
+                                          : Vec(problem.inverse_mass().cwiseProduct(state.p));
   }
 
   // The HP velocity v_{k+1} = (q_{k+1} − q_k)/h of the last step (p_{k+1} ≠ M v_{k+1} unless α =
@@ -95,6 +120,7 @@ class HamiltonPontryagin final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
+    if (is_non_separable(problem)) return general_step(problem, state, h);
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -160,6 +186,19 @@ class HamiltonPontryagin final : public Integrator {
   }
 
  private:
+  StepStatus general_step(const Problem& problem, State& state, double h) {
+    const Vec q0 = state.q;
+    const StepStatus status = general_del_step(
+        *general_lagrangian(problem), state, h, alpha_,
+        {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
+    if (!status.ok) {
+      return StepStatus::failure(
+          status.reason, fmt::format("hp:alpha={}: {}", format_number(alpha_), status.message));
+    }
+    velocity_ = (state.q - q0) / h;
+    return status;
+  }
+
   StepStatus solve(const Problem& problem, const State& state, bool coupled, Vec& v) {
     const Vec& mass = problem.mass();
     if (minus_ > 0.0) {
@@ -334,6 +373,7 @@ class HamiltonPontryagin final : public Integrator {
 
   double alpha_;
   bool minimize_;
+  bool minimize_written_;  // solver=minimize given explicitly: refused on non-separable problems
   Forcing forcing_;
   NewtonSolver newton_;
   Vec velocity_;  // HP velocity v_{k+1}
@@ -366,9 +406,11 @@ std::unique_ptr<Integrator> make_hp(Params& params) {
   const std::string solver = params.choice(
       "solver", "minimize", {"minimize", "newton"},
       "minimise E_k with line search and SPD safeguard, or plain Newton on the residual");
+  const bool minimize_written = params.given("solver") && solver == "minimize";
   const Forcing forcing = read_forcing(params);
   const NewtonOptions newton = read_newton_options(params, "|p| + h|grad V| + |F_d-|");
-  return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", forcing, newton);
+  return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", minimize_written,
+                                              forcing, newton);
 }
 
 }  // namespace geomint

@@ -211,6 +211,15 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                                method.spec(), problem.name())};
   }
   if (is_non_separable(problem) && !(info.flags & kGeneralLagrangian)) {
+    const auto* explains = dynamic_cast<const ExplainsGeneralRefusal*>(&method);
+    const std::string specific = explains ? explains->general_lagrangian_refusal() : "";
+    if (!specific.empty()) {
+      return {false, fmt::format("method '{}' does not run problem '{}', which is non-separable "
+                                 "(a position-dependent mass M(q) or a gyroscopic term): {}; "
+                                 "methods that apply: {}",
+                                 method.spec(), problem.spec(), specific,
+                                 fmt::join(general_lagrangian_methods(), ", "))};
+    }
     return {
         false,
         fmt::format("method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "

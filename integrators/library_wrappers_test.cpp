@@ -671,18 +671,19 @@ TEST(Registry, LibraryWrappersDeclareOrderAndFlags) {
   const unsigned implicit_adaptive = kImplicit | kAdaptive | kFirstOrderCapable;
   const unsigned explicit_adaptive = kExplicit | kAdaptive | kFirstOrderCapable;
   for (const Expected& e : {
-           // CVODE sees only first_order_rhs/_jacobian: it also runs the general Lagrangian kind.
+           // CVODE, ARKODE ERK, GSL rk8pd and odeint dopri5 see only first_order_rhs(/_jacobian):
+           // they also run the general Lagrangian kind.
            Expected{"cvode_bdf", 5, implicit_adaptive | kGeneralLagrangian},
            Expected{"cvode_bdf:max_order=3", 3, implicit_adaptive | kGeneralLagrangian},
            Expected{"cvode_adams", 12, implicit_adaptive | kGeneralLagrangian},
            Expected{"ida", 5, implicit_adaptive},
-           Expected{"arkode_erk", 5, explicit_adaptive},
-           Expected{"arkode_erk:table=verner_8_5_6", 6, explicit_adaptive},
-           Expected{"arkode_erk:table=fehlberg_13_7_8", 8, explicit_adaptive},
-           Expected{"gsl_rk8pd", 8, explicit_adaptive},
+           Expected{"arkode_erk", 5, explicit_adaptive | kGeneralLagrangian},
+           Expected{"arkode_erk:table=verner_8_5_6", 6, explicit_adaptive | kGeneralLagrangian},
+           Expected{"arkode_erk:table=fehlberg_13_7_8", 8, explicit_adaptive | kGeneralLagrangian},
+           Expected{"gsl_rk8pd", 8, explicit_adaptive | kGeneralLagrangian},
            Expected{"gsl_msbdf", 5, implicit_adaptive | kNeedsHessian},
            Expected{"gsl_rk4imp", 4, implicit_adaptive | kNeedsHessian},
-           Expected{"odeint_dopri5", 5, explicit_adaptive},
+           Expected{"odeint_dopri5", 5, explicit_adaptive | kGeneralLagrangian},
            Expected{"odeint_rosenbrock4", 4, implicit_adaptive | kNeedsHessian},
            Expected{"odeint_velocity_verlet", 2,
                     kExplicit | kSymplectic | kSymmetric | kConservativeOnly},

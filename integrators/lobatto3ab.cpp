@@ -18,7 +18,7 @@ std::unique_ptr<Integrator> make_lobatto3ab(Params& params) {
                                                                   : coefficients::kLobatto4;
   MethodInfo info{
       "lobatto3ab", tableau.order,
-      kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian,
+      kImplicit | kSymplectic | kSymmetric | kVariational | kNeedsHessian | kGeneralLagrangian,
       fmt::format("{}, order {}; GNI §II.2.2, §VI.4; Jay 1996", tableau.source, tableau.order)};
   return make_partitioned_rk(tableau, std::move(info), params);
 }

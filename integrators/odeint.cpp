@@ -139,7 +139,8 @@ class OdeintDopri5 final : public OdeintAdaptive {
   explicit OdeintDopri5(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
-    return {"odeint_dopri5", 5, kExplicit | kAdaptive | kFirstOrderCapable,
+    // Sees only first_order_rhs: runs the general kind too (Hamilton's equations of its L).
+    return {"odeint_dopri5", 5, kExplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
             "Boost.Odeint runge_kutta_dopri5, controlled (Dormand & Prince 1980)"};
   }
 

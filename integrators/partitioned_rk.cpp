@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
 
@@ -72,6 +73,12 @@ class ImplicitPartitionedRk final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
+    if (is_non_separable(problem)) {
+      // On (q, p) of the Hamiltonian view (../shared/MECHANICS.md §4).
+      return general_partitioned_rk_step(
+          *general_lagrangian(problem), state, h, a_, a_hat_, b_,
+          {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
+    }
     const int n = problem.dof();
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();

@@ -775,8 +775,10 @@ class ArkodeErk final : public SundialsIntegrator {
         api_(is_fsal(erk_tables().at(table_name_).id) ? &kErkStep : &kArkStepExplicit) {}
 
   MethodInfo info() const override {
+    // kGeneralLagrangian: like CVODE, ARKODE sees only first_order_rhs (Hamilton's equations of a
+    // non-separable problem's L).
     return {"arkode_erk", erk_tables().at(table_name_).order,
-            kExplicit | kAdaptive | kFirstOrderCapable,
+            kExplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
             fmt::format("SUNDIALS ARKODE {}, table {} (ARKODE user guide v5.4.1, §8.1)", api_->name,
                         table_name_)};
   }

@@ -531,8 +531,11 @@ TEST(Declared, OrdersAndFlagsFollowTheRule) {
       {"del:rule=alpha,alpha=0", 1, vi | kExplicit},
       {"del:rule=symmetric_alpha,alpha=0.25", 2, vi | implicit | kSymmetric},
       {"del:rule=symmetric_alpha,alpha=1", 2, vi | kExplicit | kSymmetric},
-      {"hp", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic},
-      {"hp:alpha=0.25,solver=newton", 1, vi | implicit},
+      // hp runs the general kind unless solver=minimize is written out (no scalar objective).
+      {"hp", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic | general},
+      {"hp:solver=minimize", 2, vi | implicit | kSymmetric | kConstrained | kRheonomic},
+      {"hp:alpha=0.25,solver=newton", 1, vi | implicit | general},
+      {"hp:alpha=0.25,solver=minimize", 1, vi | implicit},
       {"hp:alpha=0", 1, vi | kExplicit},
       {"hp:alpha=1", 1, vi | kExplicit},
       {"newmark", 2, implicit | kSymmetric},

@@ -240,6 +240,7 @@ const std::map<std::string, std::string> kNoIterationLimit = {
 // nothing.
 const std::map<std::string, std::string> kSolvedInOneIteration = {
     {"lobatto3ab:s=2", "Stormer-Verlet: its stage equations are linear in the unknowns"},
+    {"generalized_leapfrog", "Stormer-Verlet on a separable problem: explicit, nothing to iterate"},
 };
 
 std::vector<std::string> implicit_methods() {
