@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "harness/chaos_metrics.hpp"
 #include "harness/map_defect.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
@@ -354,11 +355,22 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
           make_map_defect_observer(integrator->spec(), *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(map_defect));
   }
+  if (auto chaos = make_chaos_observer(integrator->spec(), *problem, config.extra_metrics)) {
+    observers.push_back(std::move(chaos));
+  }
+  if (problem->has(kExact)) {
+    if (auto valid = make_valid_time_observer(*problem, nullptr, config.extra_metrics)) {
+      observers.push_back(std::move(valid));
+    }
+  }
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());
     if (std::filesystem::exists(path)) {
       auto reference = load_reference(path, *problem);  // InputError when malformed
       if (reference->row_at(problem->initial_state().t + config.t_end) >= 0) {
+        if (auto valid = make_valid_time_observer(*problem, reference, config.extra_metrics)) {
+          observers.push_back(std::move(valid));
+        }
         observers.push_back(make_reference_observer(std::move(reference)));
         record.reference = std::filesystem::path(path).filename().string();
       }

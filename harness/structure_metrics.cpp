@@ -114,9 +114,15 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 const std::vector<std::string>& optional_metric_names() {
-  static const std::vector<std::string> names = {
-      "symplecticity_defect", "period_measured",  "energy_growth_exponent",
-      "mode_freq_err_max",    "mode_damping_max", "symplecticity_defect_map"};
+  static const std::vector<std::string> names = {"symplecticity_defect",
+                                                 "period_measured",
+                                                 "energy_growth_exponent",
+                                                 "mode_freq_err_max",
+                                                 "mode_damping_max",
+                                                 "symplecticity_defect_map",
+                                                 "lyapunov_max",
+                                                 "megno",
+                                                 "valid_time"};
   return names;
 }
 
