@@ -6,6 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
 
 #include "harness/run.hpp"
 #include "problems/problem.hpp"
@@ -151,6 +155,46 @@ TEST(ValidTime, RelativeErrorThresholdAtAnyScale) {
       chaos_run("harmonic:omega=3,mass=2,q0=0.5,v0=-1", "stormer_verlet", 0.001, 5, {"valid_time"});
   EXPECT_EQ(fine.at("valid_time_reached"), 0);
   EXPECT_NEAR(fine.at("valid_time"), 5, 1e-9);
+}
+
+// The Poincaré section series (RunConfig::series_section): on the harmonic oscillator
+// q(t) = A cos(ωt − φ) the upward crossings of q = 0 fall at ωt − φ = 3π/2 + 2πk, and at
+// h = 0.05 (ωh = 0.15) the cubic Hermite interpolation puts them there to 1e-4 of a period.
+TEST(PoincareSection, CrossingsLieOnTheSectionAtTheExactTimes) {
+  const double omega = 3, q0 = 0.5, v0 = -1;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "geomint_chaos_section_test.csv").string();
+  RunConfig config;
+  config.dt = 0.05;
+  config.t_end = 20;
+  config.timing_repeats = 0;
+  config.series_path = path;
+  config.series_section = 0;
+  const RunResult result = run_one("harmonic:omega=3,mass=2,q0=0.5,v0=-1", "rk4", config);
+  ASSERT_TRUE(result.ok);
+  std::ifstream in(path);
+  std::string line;
+  const double phase = std::atan2(v0 / omega, q0);  // q = A cos(ωt − phase)
+  int crossings = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+    std::vector<double> values;
+    std::stringstream fields(line);
+    for (std::string field; std::getline(fields, field, ',');) values.push_back(std::stod(field));
+    ASSERT_EQ(values.size(), 4u);  // t, energy, q_0, p_0
+    const double t = values[0];
+    double angle = std::fmod(omega * t - phase - 1.5 * std::numbers::pi, 2 * std::numbers::pi);
+    if (angle > std::numbers::pi) angle -= 2 * std::numbers::pi;
+    if (angle < -std::numbers::pi) angle += 2 * std::numbers::pi;
+    EXPECT_LT(std::abs(angle), 2 * std::numbers::pi * 1e-4) << "t = " << t;
+    EXPECT_LT(std::abs(values[2]), 1e-12);
+    EXPECT_GT(values[3], 0);
+    ++crossings;
+  }
+  // ωT/2π = 9.5 periods.
+  EXPECT_GE(crossings, 9);
+  EXPECT_LE(crossings, 10);
+  std::filesystem::remove(path);
 }
 
 }  // namespace
