@@ -10,12 +10,14 @@
 #include <optional>
 #include <stdexcept>
 
+#include "harness/chaos_metrics.hpp"
 #include "harness/map_defect.hpp"
 #include "harness/modified_energy.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference.hpp"
 #include "harness/structure_metrics.hpp"
+#include "problems/lagrangian.hpp"
 
 namespace geomint {
 namespace {
@@ -76,7 +78,59 @@ class SeriesWriter {
   }
 
   void observe(const Problem& problem, const State& state, bool last) {
+    if (config_.series_section >= 0) {
+      observe_section(problem, state);
+      return;
+    }
     if (count_++ % config_.series_every != 0 && !last) return;
+    write_row(problem, state);
+  }
+
+  void commit() { file_.commit(); }
+
+ private:
+  // The Poincaré section q_i = 0, q̇_i > 0: a crossing between the previous step point and this
+  // one is located on the cubic Hermite interpolant of q_i (bisection, to round-off) and the
+  // whole state written there, interpolated the same way.
+  void observe_section(const Problem& problem, const State& state) {
+    const auto i = static_cast<Eigen::Index>(config_.series_section);
+    Vec q_rate, p_rate;
+    rates(problem, state, q_rate, p_rate);
+    if (has_previous_ && previous_.q[i] < 0 && state.q[i] >= 0) {
+      const double h = state.t - previous_.t;
+      auto hermite = [&](double a0, double a1, double d0, double d1, double s) {
+        const double s2 = s * s, s3 = s2 * s;
+        return (2 * s3 - 3 * s2 + 1) * a0 + (s3 - 2 * s2 + s) * h * d0 + (-2 * s3 + 3 * s2) * a1 +
+               (s3 - s2) * h * d1;
+      };
+      auto q_i = [&](double s) {
+        return hermite(previous_.q[i], state.q[i], previous_q_rate_[i], q_rate[i], s);
+      };
+      double lo = 0, hi = 1;
+      for (int k = 0; k < 60 && hi - lo > 1e-16; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (q_i(mid) < 0 ? lo : hi) = mid;
+      }
+      const double s = 0.5 * (lo + hi);
+      State crossing{previous_.t + s * h, Vec(state.q.size()), Vec(state.p.size())};
+      for (Eigen::Index k = 0; k < state.q.size(); ++k) {
+        crossing.q[k] = hermite(previous_.q[k], state.q[k], previous_q_rate_[k], q_rate[k], s);
+        crossing.p[k] = hermite(previous_.p[k], state.p[k], previous_p_rate_[k], p_rate[k], s);
+      }
+      write_row(problem, crossing);
+    }
+    previous_ = state;
+    previous_q_rate_ = q_rate;
+    previous_p_rate_ = p_rate;
+    has_previous_ = true;
+  }
+  static void rates(const Problem& problem, const State& state, Vec& q_rate, Vec& p_rate) {
+    q_rate = problem.inverse_mass().cwiseProduct(state.p);
+    problem.gradient(state.q, p_rate);
+    p_rate = -p_rate;
+  }
+
+  void write_row(const Problem& problem, const State& state) {
     line_ = format_number(state.t);
     if (!first_order_) line_ += "," + format_number(problem.energy(state.q, state.p));
     auto append = [this](const Vec& values) {
@@ -99,9 +153,6 @@ class SeriesWriter {
     out_ << line_;
   }
 
-  void commit() { file_.commit(); }
-
- private:
   const RunConfig& config_;
   AtomicFileWriter file_;
   std::ostream& out_;
@@ -110,6 +161,9 @@ class SeriesWriter {
   long count_ = 0;
   std::string line_;
   std::vector<double> extras_;
+  State previous_;
+  Vec previous_q_rate_, previous_p_rate_;
+  bool has_previous_ = false;
 };
 
 // [[nodiscard]] as StepStatus: the metric pass and the timing pass both read the status.
@@ -236,6 +290,18 @@ void validate_run_config(const RunConfig& config, bool adaptive) {
   }
 }
 
+void check_series_section(const Problem& problem, long section) {
+  if (section < 0) return;
+  // The crossing is interpolated with q̇ = M⁻¹p and ṗ = −∇V: canonical separable problems only.
+  if (section >= problem.dof() || problem.has(kFirstOrderOnly) || problem.has(kForce) ||
+      problem.has(kConstraints) || is_non_separable(problem)) {
+    throw InputError(fmt::format(
+        "series_section = {}: a Poincare section needs a coordinate index in 0..{} of an "
+        "unforced, unconstrained, separable problem (H = p^T M^-1 p/2 + V(q)); '{}' is not",
+        section, problem.dof() - 1, problem.spec()));
+  }
+}
+
 void check_run_outputs(const RunConfig& config) {
   if (!config.series_path.empty()) check_output_file(config.series_path, "--series");
 }
@@ -337,6 +403,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (const Applicability fit = applicable(*integrator, *problem); !fit.ok) {
     throw InputError(fit.reason);
   }
+  if (!config.series_path.empty()) check_series_section(*problem, config.series_section);
 
   RunResult result;
   RunRecord& record = result.record;
@@ -359,11 +426,22 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
           make_modified_energy_observer(*integrator, *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(modified));
   }
+  if (auto chaos = make_chaos_observer(integrator->spec(), *problem, config.extra_metrics)) {
+    observers.push_back(std::move(chaos));
+  }
+  if (problem->has(kExact)) {
+    if (auto valid = make_valid_time_observer(*problem, nullptr, config.extra_metrics)) {
+      observers.push_back(std::move(valid));
+    }
+  }
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());
     if (std::filesystem::exists(path)) {
       auto reference = load_reference(path, *problem);  // InputError when malformed
       if (reference->row_at(problem->initial_state().t + config.t_end) >= 0) {
+        if (auto valid = make_valid_time_observer(*problem, reference, config.extra_metrics)) {
+          observers.push_back(std::move(valid));
+        }
         observers.push_back(make_reference_observer(std::move(reference)));
         record.reference = std::filesystem::path(path).filename().string();
       }

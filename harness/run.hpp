@@ -38,7 +38,11 @@ struct RunConfig {
   std::string series_path;    // time series CSV, empty = none
   long series_every = 1;      // write every N-th step point (the last point always)
   bool series_state = false;  // force q, p columns for problems with > 64 dof
-  int timing_repeats = 3;     // separate timed runs without observers (0..kMaxTimingRepeats)
+  // ≥ 0: a Poincaré section instead: only the points where q_i (i = series_section) crosses 0
+  // upwards (q̇_i > 0), each interpolated between its two step points (cubic Hermite in time, with
+  // q̇ = M⁻¹p and ṗ = −∇V; scene key `series_section`). -1: every series_every-th step point.
+  long series_section = -1;
+  int timing_repeats = 3;  // separate timed runs without observers (0..kMaxTimingRepeats)
   double timing_budget_s = kDefaultTimingBudgetSeconds;  // see kDefaultTimingBudgetSeconds
   double diverge_factor = kDefaultDivergeFactor;         // see kDefaultDivergeFactor; 0/inf = off
   long max_steps = kDefaultMaxSteps;  // fixed-step runs: grid steps allowed (1..kMaxFixedSteps)
@@ -56,6 +60,10 @@ struct RunConfig {
 // that passed the checks: the state the metrics end with. The run failed in the step after it
 // (fixed-step methods: the step ending at t_reached + dt, named in the message; adaptive ones:
 // the solver's next internal step).
+// InputError unless the Poincaré section q_i = 0 (i = `section`; −1 = none) can be written for
+// `problem` (RunConfig::series_section).
+void check_series_section(const Problem& problem, long section);
+
 struct RunResult {
   RunRecord record;  // identifiers, status, metrics, counters, wall_s
   bool ok = true;

@@ -154,6 +154,7 @@ Scene load_scene(const std::string& path, bool quick) {
     block.t_end = reader.number("t_end", true);
     block.series_every = reader.integer("series_every", false, 0, 0, 1000000000000L);
     block.series_state = reader.boolean("series_state", false);
+    block.series_section = reader.integer("series_section", false, -1, -1, 1000000000L);
     block.timing_repeats =
         static_cast<int>(reader.integer("timing_repeats", false, 5, 0, kMaxTimingRepeats));
     block.timing_budget_s = reader.number("timing_budget_s", false, kDefaultTimingBudgetSeconds);

@@ -18,7 +18,8 @@ struct RunBlock {
   double t_end = 0;
   long series_every = 0;  // 0 = no series
   bool series_state = false;
-  int timing_repeats = 5;                                // 0 = no timing pass
+  long series_section = -1;  // RunConfig::series_section; -1 = every series_every-th step point
+  int timing_repeats = 5;    // 0 = no timing pass
   double timing_budget_s = kDefaultTimingBudgetSeconds;  // RunConfig::timing_budget_s
   double diverge_factor = kDefaultDivergeFactor;  // RunConfig::diverge_factor; 0 or inf = off
   long max_steps = kDefaultMaxSteps;              // RunConfig::max_steps

@@ -114,10 +114,16 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 const std::vector<std::string>& optional_metric_names() {
-  static const std::vector<std::string> names = {
-      "symplecticity_defect",   "period_measured",  "energy_growth_exponent",
-      "mode_freq_err_max",      "mode_damping_max", "symplecticity_defect_map",
-      "modified_energy_err_max"};
+  static const std::vector<std::string> names = {"symplecticity_defect",
+                                                 "period_measured",
+                                                 "energy_growth_exponent",
+                                                 "mode_freq_err_max",
+                                                 "mode_damping_max",
+                                                 "symplecticity_defect_map",
+                                                 "lyapunov_max",
+                                                 "megno",
+                                                 "valid_time",
+                                                 "modified_energy_err_max"};
   return names;
 }
 

@@ -277,6 +277,14 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
           if (block.series_every > 0) {
             job.config.series_every = block.series_every;
             job.config.series_state = block.series_state;
+            job.config.series_section = block.series_section;
+            if (block.series_section >= 0) {
+              try {
+                check_series_section(*make_problem(problem), block.series_section);
+              } catch (const InputError& error) {
+                throw InputError(fmt::format("[[runs]] '{}': {}", block.label, error.what()));
+              }
+            }
             // Labels are plain names (load_scene) and series names sanitized specs, so the
             // path stays inside out_dir; checked again here, with duplicates.
             const fs::path relative =

@@ -96,7 +96,9 @@ Verb add_run(CLI::App& app) {
                       "also compute an optional metric (repeatable): symplecticity_defect, "
                       "period_measured (with period_err_rel), energy_growth_exponent, "
                       "mode_freq_err_max, mode_damping_max, symplecticity_defect_map (with "
-                      "symplecticity_defect_map_fd_err and symplecticity_defect_map_slope)");
+                      "symplecticity_defect_map_fd_err and symplecticity_defect_map_slope), "
+                      "lyapunov_max, megno (with megno_final and chaos_tangent_fd), valid_time "
+                      "(with valid_time_reached)");
   command->add_option("--initial", options->initial_path, kInitialStateHelp);
   return {"run", command, [options, command](const Context& context) {
             RunOptions given = *options;
