@@ -145,9 +145,7 @@ class RodChainJoint final : public Problem, public LagrangianSystem {
       }
     }
   }
-  double potential(const Vec& q) const override {
-    return -weight_.dot(q.array().cos().matrix());
-  }
+  double potential(const Vec& q) const override { return -weight_.dot(q.array().cos().matrix()); }
   void gradient(const Vec& q, Vec& g) const override {
     g = weight_.cwiseProduct(q.array().sin().matrix());
   }

@@ -195,10 +195,10 @@ std::unique_ptr<Problem> make_spherical_pendulum(Params& params) {
       "initial azimuthal angular velocity (default: the conical rate sqrt(g/(L cos theta0)) "
       "when 0 < |theta0| < pi/2, with the exact solution and period; else 0)");
   P.conical = can_be_conical && P.theta_dot0 == 0 && P.phi_dot0 == conical_rate;
-  const std::string coordinates = params.choice(
-      "coordinates", "cartesian", {"cartesian", "angles"},
-      "q = (x, y, z) with the length constraint, or q = (theta, phi) with the mass "
-      "m L^2 diag(1, sin^2 theta) (non_separable; singular at the poles)");
+  const std::string coordinates =
+      params.choice("coordinates", "cartesian", {"cartesian", "angles"},
+                    "q = (x, y, z) with the length constraint, or q = (theta, phi) with the mass "
+                    "m L^2 diag(1, sin^2 theta) (non_separable; singular at the poles)");
   // Every Cartesian spec (and committed result) stays as it was.
   params.omit_default_from_canonical("coordinates");
   if (coordinates == "cartesian") return std::make_unique<SphericalPendulum>(P);

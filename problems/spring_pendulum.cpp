@@ -95,14 +95,14 @@ std::unique_ptr<Problem> make_spring_pendulum(Params& params) {
   P.stiffness = params.real("k", 40.0, "spring stiffness", positive, "> 0");
   P.rest_length = params.real("l0", 1.0, "spring rest length", positive, "> 0");
   P.gravity = params.real("g", 9.81, "gravitational acceleration", positive, "> 0");
-  P.r0 = params.real("r0", 1.4,
-                     "initial spring length (the mass m diag(1, r^2) is singular at r = 0)",
-                     positive, "> 0");
+  P.r0 =
+      params.real("r0", 1.4, "initial spring length (the mass m diag(1, r^2) is singular at r = 0)",
+                  positive, "> 0");
   P.phi0 = params.real("phi0", 0.5, "initial angle from the downward vertical (rad)", angle,
                        "|phi0| <= 1000");
   P.rdot0 = params.real("rdot0", 0.0, "initial rate of r", rate, "|rdot0| <= 1e6");
-  P.phidot0 = params.real("phidot0", 0.0, "initial rate of phi (rad per time)", rate,
-                          "|phidot0| <= 1e6");
+  P.phidot0 =
+      params.real("phidot0", 0.0, "initial rate of phi (rad per time)", rate, "|phidot0| <= 1e6");
   return std::make_unique<SpringPendulum>(P);
 }
 
