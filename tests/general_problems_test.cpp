@@ -163,9 +163,9 @@ TEST(MagneticMoment, MetricIsTheSeriesColumnsLargestRelativeChange) {
   config.t_end = 50;
   config.timing_repeats = 0;
   config.series_path = (dir / "series.csv").string();
-  const RunResult result = run_one(
-      "charged_particle:field=bottle,mass=1.3,charge=0.8,B=2,length=1.5,vx=1,vz=0.5,z0=0.1",
-      "boris", config);
+  const RunResult result =
+      run_one("charged_particle:field=bottle,mass=1.3,charge=0.8,B=2,length=1.5,vx=1,vz=0.5,z0=0.1",
+              "boris", config);
   ASSERT_TRUE(result.ok) << result.record.status;
   const CsvTable table = read_csv_file(config.series_path);
   ASSERT_GE(table.rows.size(), 100u);
