@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "integrators/newton.hpp"
+#include "problems/charged_particle.hpp"
 #include "problems/rigid_body.hpp"
 
 namespace geomint {
@@ -122,6 +123,42 @@ class OrthogonalityObserver : public Observer {
 
  private:
   double err_max_ = 0;
+};
+
+// magnetic_moment_err_max = max_k |μ_k − μ₀|/|μ₀| for a charged particle, μ = m v⊥²/(2|B|) with
+// v = (p − qA(x))/m and v⊥ across the local B (../shared/MECHANICS.md §5): the adiabatic
+// invariant of the magnetic bottle (exact in a uniform field), relative because μ carries the
+// problem's units (an electron's is 1e-18 J/T). Absolute when μ₀ = 0 (motion along B).
+class MagneticMomentObserver : public Observer {
+ public:
+  explicit MagneticMomentObserver(const ChargedParticleStructure& particle) : particle_(particle) {}
+  void begin(const Problem&, const State& state, double) override {
+    initial_ = magnetic_moment(state);
+  }
+  void observe(const Problem&, const State& state) override {
+    const double scale = initial_ != 0 ? std::abs(initial_) : 1.0;
+    err_max_ = std::max(err_max_, std::abs(magnetic_moment(state) - initial_) / scale);
+  }
+  void finish(std::map<std::string, double>& metrics) const override {
+    metrics["magnetic_moment_err_max"] = err_max_;
+  }
+
+ private:
+  double magnetic_moment(const State& state) const {
+    const Eigen::Vector3d x = state.q.head<3>();
+    const double m = particle_.particle_mass();
+    const Eigen::Vector3d v = (Eigen::Vector3d(state.p.head<3>()) -
+                               particle_.particle_charge() * particle_.vector_potential(x)) /
+                              m;
+    Eigen::Vector3d E, B;
+    particle_.fields(x, E, B);
+    const double field = B.norm();
+    const double along = v.dot(B) / field;
+    return m * (v.squaredNorm() - along * along) / (2 * field);
+  }
+
+  const ChargedParticleStructure& particle_;
+  double initial_ = 0, err_max_ = 0;
 };
 
 // constraint_err_max = max_k ‖g(q_k)‖∞ and constraint_vel_err_max = max_k ‖G(q_k) M⁻¹p_k‖∞ on
@@ -392,6 +429,9 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
   if (attitude_problem(problem) != nullptr) {
     observers.push_back(std::make_unique<OrthogonalityObserver>());
+  }
+  if (const auto* particle = charged_particle_structure(problem)) {
+    observers.push_back(std::make_unique<MagneticMomentObserver>(*particle));
   }
   if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
   if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());

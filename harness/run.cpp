@@ -199,7 +199,15 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
     }
     if (!divergence) return true;
     if (conservative) {
-      if (std::abs(problem.energy(s.q, s.p) - energy0) > config.diverge_factor * energy_scale) {
+      const double energy = problem.energy(s.q, s.p);
+      // A finite state can still have no energy: a position-dependent mass that is singular
+      // there (the spherical pendulum in angles on a pole) gives 0/0, which no comparison flags.
+      if (!std::isfinite(energy)) {
+        outcome.status = StepStatus::failure(
+            "nan", fmt::format("non-finite energy at t={} (the mass is singular there)", s.t));
+        return false;
+      }
+      if (std::abs(energy - energy0) > config.diverge_factor * energy_scale) {
         outcome.status = StepStatus::failure(
             "diverged", fmt::format("relative energy error above {:g} at t={:.6g}",
                                     config.diverge_factor, s.t));

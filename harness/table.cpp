@@ -115,6 +115,7 @@ const std::vector<std::string>& standard_columns() {
                                                    "constraint_err_max",
                                                    "constraint_vel_err_max",
                                                    "orthogonality_err_max",
+                                                   "magnetic_moment_err_max",
                                                    "symplecticity_defect",
                                                    "symplecticity_defect_map",
                                                    "symplecticity_defect_map_fd_err",

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -140,6 +141,14 @@ std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> proble
     throw InputError(
         fmt::format("initial state: problem '{}' is a first-order ODE y' = f(t, y); "
                     "initial= (q,p rows) applies to Lagrangian problems only",
+                    problem->name()));
+  }
+  // The forwarding wrapper has no LagrangianSystem: a non-separable problem would silently run
+  // with its placeholder unit mass.
+  if (is_non_separable(*problem)) {
+    throw InputError(
+        fmt::format("initial state: problem '{}' has a position-dependent mass M(q) "
+                    "(non_separable); initial= applies to constant-mass problems only",
                     problem->name()));
   }
   State initial = read_initial_state(*problem, path);

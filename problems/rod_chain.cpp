@@ -1,10 +1,15 @@
 // A planar chain of n rigid rods hanging from a fixed pivot under gravity (−y), in Cartesian node
 // coordinates x_1 … x_n (2n dof) with one length constraint per rod (docs/METHOD.md §3;
 // problems/rods.hpp): n = 1 is the Cartesian pendulum, n = 2 the (chaotic) double pendulum.
+// `coordinates=joint`: the same chain in its absolute rod angles θ (n dof), mass
+// M(θ)_ij = μ_ij l_i l_j cos(θ_i − θ_j), μ_ij = Σ_{k ≥ max(i,j)} m_k (../shared/MECHANICS.md §5).
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <string>
 
+#include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 #include "problems/rods.hpp"
 
@@ -56,6 +61,104 @@ class RodChain final : public rods::RodProblem {
   State initial_;
 };
 
+// The chain in joint (absolute) angles, θ_i from the downward vertical. Node i sits at
+// Σ_{k ≤ i} l_k (sin θ_k, −cos θ_k), so T = ½ Σ_ij C_ij cos(θ_i − θ_j) θ̇_iθ̇_j with
+// C_ij = μ_ij l_i l_j, and V = −g Σ_i μ_ii l_i cos θ_i (μ_ii: the mass at and below node i).
+class RodChainJoint final : public Problem, public LagrangianSystem {
+ public:
+  RodChainJoint(const Vec& node_mass, const Vec& length, double gravity, Vec theta, Vec omega)
+      : theta_(std::move(theta)), omega_(std::move(omega)) {
+    const int n = static_cast<int>(node_mass.size());
+    Vec tail_mass(n);  // μ_ii = Σ_{k ≥ i} m_k
+    double sum = 0;
+    for (int i = n - 1; i >= 0; --i) tail_mass[i] = sum += node_mass[i];
+    coupling_.resize(n, n);
+    // Filled as a symmetric matrix (l_i l_j and l_j l_i round differently).
+    for (int i = 0; i < n; ++i) {
+      for (int j = i; j < n; ++j) {
+        coupling_(i, j) = coupling_(j, i) = tail_mass[j] * length[i] * length[j];
+      }
+    }
+    weight_ = gravity * tail_mass.cwiseProduct(length);
+    set_mass(Vec::Ones(n));  // placeholder for dof(): the mass is M(θ) (is_non_separable)
+    set_capabilities(kOmegaMax);
+    const double time_unit = std::sqrt(length.sum() / gravity);
+    set_defaults(0.01 * time_unit, 100.0 * time_unit);
+  }
+
+  State initial_state() const override {
+    return {0.0, theta_, static_cast<const LagrangianSystem&>(*this).momentum(theta_, omega_)};
+  }
+
+  // The fastest small-oscillation mode about the hanging chain, K v = ω²M(0)v (as
+  // double_pendulum).
+  double omega_max(const Vec&) const override {
+    DenseMatrix M, K;
+    const Vec hanging = Vec::Zero(dof());
+    mass_matrix(hanging, M);
+    potential_hessian(hanging, K);
+    const Eigen::GeneralizedSelfAdjointEigenSolver<DenseMatrix> modes(K, M, Eigen::EigenvaluesOnly);
+    return std::sqrt(modes.eigenvalues().maxCoeff());
+  }
+
+  void mass_matrix(const Vec& q, DenseMatrix& M) const override {
+    const int n = dof();
+    M.resize(n, n);
+    for (int i = 0; i < n; ++i) {
+      for (int j = i; j < n; ++j) M(i, j) = M(j, i) = coupling_(i, j) * std::cos(q[i] - q[j]);
+    }
+  }
+  // ∂T/∂θ_a = −θ̇_a Σ_j C_aj sin(θ_a − θ_j) θ̇_j.
+  void kinetic_gradient(const Vec& q, const Vec& v, Vec& T_q) const override {
+    const int n = dof();
+    T_q.resize(n);
+    for (int a = 0; a < n; ++a) {
+      double sum = 0;
+      for (int j = 0; j < n; ++j) sum += coupling_(a, j) * std::sin(q[a] - q[j]) * v[j];
+      T_q[a] = -v[a] * sum;
+    }
+  }
+  // (Mv)_i = Σ_j C_ij cos(θ_i − θ_j) v_j: ∂/∂θ_b = C_ib sin(θ_i − θ_b) v_b for b ≠ i, and
+  // −Σ_j C_ij sin(θ_i − θ_j) v_j for b = i.
+  void mass_velocity_jacobian(const Vec& q, const Vec& v, DenseMatrix& D) const override {
+    const int n = dof();
+    D = DenseMatrix::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+      for (int b = 0; b < n; ++b) {
+        if (b == i) continue;
+        const double term = coupling_(i, b) * std::sin(q[i] - q[b]) * v[b];
+        D(i, b) = term;
+        D(i, i) -= term;
+      }
+    }
+  }
+  // ∂²T/∂θ_a∂θ_b = C_ab cos(θ_a − θ_b) θ̇_aθ̇_b for b ≠ a; the diagonal is minus the row's rest.
+  void kinetic_hessian(const Vec& q, const Vec& v, DenseMatrix& T_qq) const override {
+    const int n = dof();
+    T_qq = DenseMatrix::Zero(n, n);
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) {
+        if (b == a) continue;
+        const double term = coupling_(a, b) * std::cos(q[a] - q[b]) * v[a] * v[b];
+        T_qq(a, b) = term;
+        T_qq(a, a) -= term;
+      }
+    }
+  }
+  double potential(const Vec& q) const override { return -weight_.dot(q.array().cos().matrix()); }
+  void gradient(const Vec& q, Vec& g) const override {
+    g = weight_.cwiseProduct(q.array().sin().matrix());
+  }
+  void potential_hessian(const Vec& q, DenseMatrix& K) const override {
+    K = weight_.cwiseProduct(q.array().cos().matrix()).asDiagonal();
+  }
+
+ private:
+  DenseMatrix coupling_;  // C_ij = μ_ij l_i l_j
+  Vec weight_;            // g μ_ii l_i
+  Vec theta_, omega_;
+};
+
 }  // namespace
 
 std::unique_ptr<Problem> make_rod_chain(Params& params) {
@@ -77,7 +180,13 @@ std::unique_ptr<Problem> make_rod_chain(Params& params) {
                                    angle_ok, "|theta| <= 1000");
   const double omega =
       params.real("omega", 0.0, "initial angular velocity of every rod (rad per time unit)");
-  Vec node_mass(n);
+  const std::string coordinates = params.choice(
+      "coordinates", "cartesian", {"cartesian", "joint"},
+      "Cartesian node coordinates with one length constraint per rod, or the n absolute rod "
+      "angles with the mass M(theta) (non_separable)");
+  // Every Cartesian spec (and committed result) stays as it was.
+  params.omit_default_from_canonical("coordinates");
+  Vec node_mass(n), rod_lengths(n), angles(n);
   std::vector<rods::Rod> chain;
   State initial{0.0, Vec(2 * n), Vec(2 * n)};
   // Build the state from the angles, node by node from the pivot: every rod has its length and
@@ -97,6 +206,8 @@ std::unique_ptr<Problem> make_rod_chain(Params& params) {
           "mass or length at node {} of {}",
           i + 1, n));
     }
+    rod_lengths[i] = rod_length;
+    angles[i] = angle;
     chain.push_back({i == 0 ? rods::kPivot : i - 1, i, rod_length});
     x += rod_length * std::sin(angle);
     y -= rod_length * std::cos(angle);
@@ -104,6 +215,10 @@ std::unique_ptr<Problem> make_rod_chain(Params& params) {
     vy += rod_length * omega * std::sin(angle);
     initial.q.segment(2 * i, 2) << x, y;
     initial.p.segment(2 * i, 2) << node_mass[i] * vx, node_mass[i] * vy;
+  }
+  if (coordinates == "joint") {
+    return std::make_unique<RodChainJoint>(node_mass, rod_lengths, gravity, angles,
+                                           Vec::Constant(n, omega));
   }
   return std::make_unique<RodChain>(node_mass, std::move(chain), gravity, std::move(initial));
 }

@@ -111,6 +111,37 @@ const ProblemRegistrar kTimedRegistrar({"fails_when_timed",
                                         &make_fails_when_timed,
                                         {}});
 
+// The harmonic oscillator whose energy, not state, turns NaN once q[0] falls below half its
+// initial value (potential NaN, gradient finite): what a position-dependent mass does exactly on
+// its singularity (the spherical pendulum in angles on a pole: 0/0 in the velocity solve).
+class EnergyTurnsNan final : public Problem {
+ public:
+  EnergyTurnsNan() : base_(make_problem("harmonic")) {
+    threshold_ = 0.5 * base_->initial_state().q[0];
+    set_mass(base_->mass());
+    set_capabilities(0);
+    set_defaults(0.1, 3.0);
+  }
+  State initial_state() const override { return base_->initial_state(); }
+  double potential(const Vec& q) const override {
+    return q[0] >= threshold_ ? base_->potential(q) : kNan;
+  }
+  void gradient(const Vec& q, Vec& g) const override { base_->gradient(q, g); }
+
+ private:
+  std::unique_ptr<Problem> base_;
+  double threshold_ = 0;
+};
+
+std::unique_ptr<Problem> make_energy_turns_nan(Params&) {
+  return std::make_unique<EnergyTurnsNan>();
+}
+
+const ProblemRegistrar kEnergyRegistrar({"energy_turns_nan",
+                                         "test problem: a finite state whose energy turns NaN",
+                                         &make_energy_turns_nan,
+                                         {}});
+
 constexpr double kDt = 0.1;
 constexpr double kTEnd = 4.0;
 
@@ -217,6 +248,20 @@ TEST(TimingPass, AFailedTimingPassLeavesNoWallTimeAndSaysWhy) {
   EXPECT_EQ(result.record.status, "ok");
   EXPECT_FALSE(result.record.wall_s.has_value());
   EXPECT_EQ(result.record.message.value_or("").rfind("timing pass failed: ", 0), 0u)
+      << result.record.message.value_or("");
+}
+
+// A finite state with a NaN energy ends the run as the failure row `nan` (a NaN energy error
+// compares false with the divergence bound, so it used to pass as ok).
+TEST(EnergyCheck, AFiniteStateWithoutEnergyIsAFailureRow) {
+  RunConfig config;
+  config.dt = kDt;
+  config.t_end = kTEnd;
+  config.timing_repeats = 0;
+  const RunResult result = run_one("energy_turns_nan", "stormer_verlet", config);
+  EXPECT_FALSE(result.ok);
+  EXPECT_EQ(result.record.status, "nan");
+  EXPECT_NE(result.record.message.value_or("").find("non-finite energy"), std::string::npos)
       << result.record.message.value_or("");
 }
 
