@@ -1017,6 +1017,21 @@ const std::vector<Case>& cases() {
        "run --problem pendulum:theta0=2.5 --method composition:base=implicit_midpoint,max_iter=1 "
        "--dt 0.2 --t-end 2 --timing-repeats 0",
        1, "newton_max_iter"},
+      // The energy-preserving contrasts (integrators/avf.cpp, integrators/projection.cpp).
+      {"ProjectionUnknownBase",
+       "run --problem kepler --method projection:base=rk4 --dt 0.1 --t-end 1", 2, "gauss"},
+      {"ProjectionGaussStagesOutOfRange",
+       "run --problem kepler --method projection:s=4 --dt 0.1 --t-end 1", 2, "s"},
+      {"ProjectionOnNonSeparableProblem",
+       "run --problem double_pendulum --method projection --dt 0.01 --t-end 1", 2, "non-separable"},
+      {"AvfOnNonSeparableProblem", "run --problem double_pendulum --method avf --dt 0.01 --t-end 1",
+       2, "non-separable"},
+      {"AvfWithAForce", "run --problem damped_oscillator --method avf --dt 0.1 --t-end 1", 2,
+       "conservative"},
+      {"AvfZeroNodes", "run --problem kepler --method avf:nodes=0 --dt 0.1 --t-end 1", 2, "nodes"},
+      {"ProjectionOnConstrainedProblem",
+       "run --problem rod_chain --method projection --dt 0.01 --t-end 1", 2,
+       "holonomic constraints, which problem 'rod_chain' has"},
       // Errors of 10^3-10^4 on an orbit of size 1 once fitted "order 0.999".
       {"OrderFromErrorsAboveTheSolutionIsNoFit",
        "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,
