@@ -125,6 +125,7 @@ std::vector<std::string> flag_names(unsigned flags) {
       {kConservativeOnly, "conservative_only"},
       {kGeneralLagrangian, "general_lagrangian"},
       {kFreeRigidBodyOnly, "free_rigid_body_only"},
+      {kEnergyPreserving, "energy_preserving"},
       {kChargedParticleOnly, "charged_particle_only"},
   };
   std::vector<std::string> out;

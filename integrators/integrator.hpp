@@ -37,6 +37,9 @@ enum MethodFlag : unsigned {
   // Runs on free rigid bodies only (the Lie–Poisson splitting): applicable() admits it exactly
   // where free_rigid_body(problem) (problems/rigid_body.hpp) finds the structure it reads.
   kFreeRigidBodyOnly = 1u << 13,
+  // Keeps the energy H(q, p) of a conservative problem to round-off and solver tolerance by
+  // construction (avf for polynomial V, projection): a contrast to symplecticity, not a kind of it.
+  kEnergyPreserving = 1u << 14,
   // Runs on charged particles only (the Boris pusher): applicable() admits it exactly where
   // charged_particle_structure(problem) (problems/charged_particle.hpp) finds m, q, E, B and A.
   kChargedParticleOnly = 1u << 16,
