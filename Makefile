@@ -83,7 +83,10 @@ sanitize-build: deps
 # error_final by 2.5e-6 relative (1.11949350e-5 vs 1.11949627e-5 at h = 0.04). The energy-drift
 # runs of del, hp and hp:solver=newton on the pinned elastic bar took 198 s summed under the
 # sanitizers (62-69 s each, the longest three tests); the same methods keep their constraint
-# checks on that bar and their drift checks on the other constrained problems. Three of them also carry the label `slow`
+# checks on that bar and their drift checks on the other constrained problems. The committed rows
+# of chaos (chaotic orbits amplify any round-off difference) and structure (map defects at the
+# finite-difference floor) are re-run by the gcc suite only, like rigid_body's. Three of them also
+# carry the label `slow`
 # (tests/slow_tests.cmake), which -LE slow leaves out in any case; `make test-sanitize
 # SAN_EXCLUDE=` runs everything else. The report site's checks (tidy, headless Chromium) and the
 # docs checks run Python and a browser, not sanitised code (harness/report_test.cpp runs the report
