@@ -11,7 +11,7 @@ PACKAGES=(
   gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev
-  clang libclang-rt-14-dev python3
+  clang libclang-rt-14-dev python3 ccache
   libxml2-utils tidy chromium
 )
 if [ "${1:-}" = cluster ]; then

@@ -236,7 +236,7 @@ def sync_sources(repo: Path, src: Path) -> None:
         changed += 1
     removed = 0
     for path in src.rglob("*"):
-        if not path.is_file():
+        if not path.is_file() or path.is_relative_to(src / "build"):
             continue
         relative = path.relative_to(src).as_posix()
         if relative not in tracked and "/quick/" not in relative:
@@ -616,7 +616,11 @@ def main() -> int:
 
     started = time.monotonic()
     scratch = Path(args.scratch).resolve()
-    src, build, work = scratch / "src", scratch / "build", scratch / "work"
+    # The build folder sits inside the scratch copy as build/ does in the repository, so every
+    # compiler command seen from its build folder is the same as the main build's, paths relative
+    # to CCACHE_BASEDIR included: with ccache (.ci/run sets it up) only the mutated files and the
+    # few test files with absolute paths compiled in miss the cache.
+    src, build, work = scratch / "src", scratch / "src" / "build", scratch / "work"
     log_path = scratch / "mutation.log"
     scratch.mkdir(parents=True, exist_ok=True)
     work.mkdir(exist_ok=True)
