@@ -10,5 +10,8 @@
   if (match(f[col["problem"]], /[:,]n=[0-9]+/)) links = substr(f[col["problem"]], RSTART + 3, RLENGTH - 3) + 0
   method = f[col["method"]]; sub(/:.*/, "", method)
   if (f[col["wall_s"]] == "" || f[col["steps"]] + 0 == 0) next
-  print links, f[col["wall_s"]] / f[col["steps"]] > ("curves/" label "_" method ".dat")
+  file = "curves/" label "_" method ".dat"
+  # The first line is a header: common.gp reads column heads.
+  if (!(file in seen)) { print "n wall_s_per_step" > file; seen[file] = 1 }
+  print links, f[col["wall_s"]] / f[col["steps"]] > file
 }
