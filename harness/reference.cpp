@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -51,7 +52,17 @@ class ReferenceErrorObserver : public Observer {
 
 std::string reference_path(const std::string& dir, const std::string& problem_spec) {
   const auto problem = make_problem(problem_spec);
-  return (std::filesystem::path(dir) / (sanitize_for_path(problem->spec()) + ".csv")).string();
+  std::string name = sanitize_for_path(problem->spec());
+  // File systems refuse names over 255 bytes, which a long spec (rod_chain:n=64 lists 64
+  // angles) exceeds: keep a readable prefix and make it unique with a hash of the whole name.
+  // Every shorter name, and so every committed reference, is unchanged.
+  constexpr std::size_t kMaxStem = 200;
+  if (name.size() > kMaxStem) {
+    std::uint64_t hash = 14695981039346656037ull;  // FNV-1a, 64 bit: stable across builds
+    for (const unsigned char c : name) hash = (hash ^ c) * 1099511628211ull;
+    name = fmt::format("{}_{:016x}", name.substr(0, kMaxStem - 17), hash);
+  }
+  return (std::filesystem::path(dir) / (name + ".csv")).string();
 }
 
 int ReferenceSolution::row_at(double t) const {

@@ -11,6 +11,7 @@
 #include "harness/paths.hpp"
 #include "harness/table.hpp"
 #include "integrators/high_order_coefficients.hpp"
+#include "problems/lagrangian.hpp"
 
 namespace geomint {
 namespace {
@@ -28,14 +29,22 @@ constexpr int kMaxStageIterations = 100;
 // iteration and the accumulation of the state are long double.
 class Field {
  public:
-  explicit Field(const Problem& problem) : problem_(problem), dof_(problem.dof()) {
+  explicit Field(const Problem& problem)
+      : problem_(problem), dof_(problem.dof()), non_separable_(is_non_separable(problem)) {
     inverse_mass_ = problem.inverse_mass().cast<Real>();
   }
   void operator()(Real t, const VecL& y, VecL& ydot) {
     y_double_ = y.cast<double>();
     problem_.first_order_rhs(static_cast<double>(t), y_double_, ydot_double_);
     ydot.resize(2 * dof_);
-    ydot.head(dof_) = inverse_mass_.cwiseProduct(y.tail(dof_));
+    // The general kind has a position-dependent mass: q' = v(q, p) = M(q)⁻¹(p − a(q)) comes
+    // from the problem's Hamilton equations, in double like the forces (M⁻¹p with the
+    // placeholder mass of ones was a silently wrong field).
+    if (non_separable_) {
+      ydot.head(dof_) = ydot_double_.head(dof_).cast<Real>();
+    } else {
+      ydot.head(dof_) = inverse_mass_.cwiseProduct(y.tail(dof_));
+    }
     ydot.tail(dof_) = ydot_double_.tail(dof_).cast<Real>();
     ++evaluations;
   }
@@ -44,6 +53,7 @@ class Field {
  private:
   const Problem& problem_;
   int dof_;
+  bool non_separable_;
   VecL inverse_mass_;
   Vec y_double_, ydot_double_;
 };
@@ -152,6 +162,14 @@ ReferenceSummary generate_reference(const ReferenceOptions& options) {
         problem->name(),
         problem->has(kEndReference) ? " (this one carries its own reference at its end time)"
                                     : ""));
+  }
+  if (problem->has(kConstraints)) {
+    // Its Gauss step integrates q' = v, p' = −∇V: the constraint forces would be missing.
+    throw InputError(fmt::format(
+        "reference: problem '{}' has holonomic constraints, which the generator (unconstrained "
+        "Gauss collocation) does not enforce; generate the reference of an unconstrained "
+        "formulation instead (e.g. coordinates=joint or coordinates=angles)",
+        problem->name()));
   }
   if (!(options.t_end > 0 && std::isfinite(options.t_end))) {
     throw InputError(fmt::format("--t-end must be a finite number > 0 (got {})", options.t_end));

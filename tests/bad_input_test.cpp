@@ -315,6 +315,9 @@ const std::vector<Case>& cases() {
        2, "--every"},
       {"ReferenceEveryNegative",
        "reference --problem pendulum --t-end 1 --every -0.5 --out {dir}/r.csv", 2, "--every"},
+      // The generator integrates unconstrained systems: it would drop the constraint forces.
+      {"ReferenceConstrainedProblem",
+       "reference --problem rod_chain:n=2 --t-end 1 --out {dir}/r.csv", 2, "holonomic constraints"},
       // --- divergence rule ---
       {"DivergeFactorNegative",
        "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --diverge-factor -1", 2,
