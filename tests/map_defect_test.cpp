@@ -161,8 +161,9 @@ TEST(MapDefect, DefectOfAGivenJacobian) {
 // Constrained problems at non-unit masses and lengths (docs of the problems' registry lines):
 // one rod in the plane, one on the sphere, and a chain of three rods with unequal masses.
 const std::vector<std::string> kConstrainedProblems = {
-    "cartesian_pendulum:theta0=1.2,length=2.5,mass=0.7,gravity=9.81",
-    "spherical_pendulum:length=2.5,gravity=3,mass=0.4,theta0=0.7,phi0=0.3",
+    "cartesian_pendulum:theta0=1.2,v0=0.8,length=2.5,mass=0.7,gravity=9.81",
+    "spherical_pendulum:length=2.5,gravity=3,mass=0.4,theta0=0.7,phi0=0.3,theta_dot0=0.4,"
+    "phi_dot0=-0.9",
     "rod_chain:n=3,mass=2,mass_ratio=0.5,length=0.7,length_ratio=1.5,gravity=2.5,theta1=0.3,"
     "theta2=-1.1,theta3=2.5,omega=0.4"};
 
