@@ -76,17 +76,27 @@ std::string map_defect_not_applicable(const Integrator& method, const Problem& p
   return "";
 }
 
-bool computed_step(Integrator& method, const Problem& problem, State& state, double h) {
+StepStatus computed_step_status(Integrator& method, const Problem& problem, State& state,
+                                double h) {
   method.reset(problem, state, h);
   if (method.info().flags & kAdaptive) {
     const double t_stop = state.t + h;
     while (state.t < t_stop) {
-      if (!method.adaptive_step(problem, state, t_stop).ok) return false;
+      StepStatus status = method.adaptive_step(problem, state, t_stop);
+      if (!status.ok) return status;
     }
-  } else if (!method.step(problem, state, h).ok) {
-    return false;
+  } else {
+    StepStatus status = method.step(problem, state, h);
+    if (!status.ok) return status;
   }
-  return state.q.allFinite() && state.p.allFinite();
+  if (!state.q.allFinite() || !state.p.allFinite()) {
+    return StepStatus::failure("nan", "non-finite state after the step");
+  }
+  return StepStatus::success();
+}
+
+bool computed_step(Integrator& method, const Problem& problem, State& state, double h) {
+  return computed_step_status(method, problem, state, h).ok;
 }
 
 double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian) {
@@ -228,13 +238,21 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
       minus.q -= epsilon * directions.col(j).head(n);
       minus.p -= epsilon * directions.col(j).tail(n);
       if (!project_onto_manifold(problem, plus) || !project_onto_manifold(problem, minus)) {
-        return {};
+        ManifoldMap failed;
+        failed.failure = "a perturbed start could not be projected onto the constraint manifold";
+        return failed;
       }
       auto column = differences[level].col(j);
       column.segment(0, n) = (plus.q - minus.q) / (2 * epsilon);
       column.segment(n, n) = (plus.p - minus.p) / (2 * epsilon);
-      if (!computed_step(method, problem, plus, h) || !computed_step(method, problem, minus, h)) {
-        return {};
+      for (State* start : {&plus, &minus}) {
+        const StepStatus status = computed_step_status(method, problem, *start, h);
+        if (!status.ok) {
+          ManifoldMap failed;
+          failed.failure = fmt::format("the step from a perturbed start failed: {} ({})",
+                                       status.reason, status.message);
+          return failed;
+        }
       }
       column.segment(2 * n, n) = (plus.q - minus.q) / (2 * epsilon);
       column.segment(3 * n, n) = (plus.p - minus.p) / (2 * epsilon);
@@ -273,11 +291,14 @@ MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem
 
 MapDefect symplecticity_defect_map(Integrator& method, const Problem& problem, const State& state,
                                    double h) {
-  MapDefect out{kNaN, kNaN, kNaN};
+  MapDefect out{kNaN, kNaN, kNaN, ""};
   if (!map_defect_not_applicable(method, problem, h).empty()) return out;
   if (problem.has(kConstraints)) {
     const ManifoldMap map = computed_manifold_map(method, problem, state, h);
-    if (map.tangent_basis.size() == 0) return out;
+    if (map.tangent_basis.size() == 0) {
+      out.failure = map.failure;
+      return out;
+    }
     const long k = map.tangent_basis.cols() / 2;
     const Eigen::MatrixXd form = canonical_form(map.tangent_basis.rows() / 2);
     // The restricted form ω(u_i, u_j) on the chart's basis (canonical for an exact U).
@@ -294,7 +315,10 @@ MapDefect symplecticity_defect_map(Integrator& method, const Problem& problem, c
     return out;
   }
   const MapJacobian map = computed_map_jacobian(method, problem, state, h);
-  if (map.jacobian.size() == 0) return out;
+  if (map.jacobian.size() == 0) {
+    out.failure = "the step from a perturbed start failed or was not finite";
+    return out;
+  }
   const double jacobian_norm = map.jacobian.norm();
   const double form_norm = std::sqrt(2.0 * static_cast<double>(state.q.size()));
   out.defect = map_defect_of_jacobian(map.jacobian);

@@ -19,6 +19,7 @@ struct MapDefect {
   double defect = 0;         // ‖JᵀΩJ − Ω‖_F/‖Ω‖_F; NaN when a step failed
   double fd_error = 0;       // estimated error of `defect` from the finite-difference J
   double jacobian_norm = 0;  // ‖J‖_F
+  std::string failure;       // why the defect is NaN when a step or a projection failed
 };
 
 // Relative sizes δ tried for the coarsest of three central-difference steps (δ, δ/2, δ/4 times
@@ -41,6 +42,8 @@ inline constexpr int kMaxMapDefectDof = 100;
 // The one-step map as the harness takes it: a fresh `method` reset at `state`, then one step()
 // (fixed-step methods) or adaptive_step()s up to state.t + h (adaptive ones). False on failure.
 bool computed_step(Integrator& method, const Problem& problem, State& state, double h);
+// The same with the failed step's status.
+StepStatus computed_step_status(Integrator& method, const Problem& problem, State& state, double h);
 
 // J at `state` with the estimate ‖E‖_F of its error (empty J when a step fails), for the δ of
 // kMapDefectRelativeSteps with the smallest estimate: 2n(|steps| + 2) pairs of steps.
@@ -65,7 +68,8 @@ struct ManifoldMap {
   double basis_error = 0;         // ‖E_U‖_F, ‖E_JU‖_F: the extrapolations' difference
   double image_error = 0;
   double relative_step = 0;
-  double weight = 0;  // ‖U‖‖E_U‖ + ‖JU‖‖E_JU‖, what the δ kept minimises
+  double weight = 0;    // ‖U‖‖E_U‖ + ‖JU‖‖E_JU‖, what the δ kept minimises
+  std::string failure;  // why U is empty: the failed step's reason and message, or the projection
 };
 ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, const State& state,
                                   double h);
