@@ -158,7 +158,7 @@ Eigen::MatrixXd dense_constraint_jacobian(const Problem& problem, double t, cons
 }
 
 // A smooth projection P onto T*Q_c = {g(q) = 0, G(q)M⁻¹p (+ ∂g/∂t) = 0} at time t: q moves along
-// M⁻¹G(q̃)ᵀν from the perturbed q̃ (Newton on ν until g is at round-off, then two more
+// M⁻¹G(q̃)ᵀν from the perturbed q̃ (Newton on ν until g is at round-off, then three more
 // corrections so that the result does not depend on where the iteration stopped), p is then
 // projected M⁻¹-orthogonally onto the tangent space at the new q. P is the identity on the
 // manifold, so DP·u = u for every tangent vector u: it is only the chart's way back. False when
@@ -193,9 +193,9 @@ bool project_onto_manifold(const Problem& problem, State& state) {
 }
 
 // The chart directions v at a state of T*Q_c (2n × 2k, k = n − m): (T, 0) and (0, M T (TᵀMT)⁻¹),
-// T an orthonormal basis of ker G(q). Both are tangent to first order in the momentum block up to
-// the p-correction that P adds to the q directions, and for them UᵀΩU is the canonical form of
-// R^{2k} (the p directions lie in ker G M⁻¹, the correction in range Gᵀ ⟂ T).
+// T an orthonormal basis of ker G(q). The p directions are tangent already (they lie in ker GM⁻¹);
+// P adds to each q direction its hidden-constraint momentum correction, which lies in range Gᵀ ⟂ T.
+// So UᵀΩU is the canonical form of R^{2k}: ω((Ta, c), (0, MT(TᵀMT)⁻¹b)) = aᵀb.
 Eigen::MatrixXd chart_directions(const Problem& problem, const State& state) {
   const long n = state.q.size();
   const Eigen::MatrixXd G = dense_constraint_jacobian(problem, state.t, state.q);
