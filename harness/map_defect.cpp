@@ -3,10 +3,12 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "integrators/constrained_step.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -62,9 +64,6 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 std::string map_defect_not_applicable(const Integrator& method, const Problem& problem, double h) {
   if (problem.has(kFirstOrderOnly)) return "first-order problem: no canonical (q, p) pair";
   if (problem.has(kForce)) return "forced problem: the step is not a Hamiltonian map";
-  if (problem.has(kConstraints)) {
-    return "constrained problem: the map acts on the constraint manifold (not measured yet)";
-  }
   if (problem.dof() > kMaxMapDefectDof) {
     return fmt::format("{} degrees of freedom: more than the {} the 32n-step difference takes",
                        problem.dof(), kMaxMapDefectDof);
@@ -77,17 +76,27 @@ std::string map_defect_not_applicable(const Integrator& method, const Problem& p
   return "";
 }
 
-bool computed_step(Integrator& method, const Problem& problem, State& state, double h) {
+StepStatus computed_step_status(Integrator& method, const Problem& problem, State& state,
+                                double h) {
   method.reset(problem, state, h);
   if (method.info().flags & kAdaptive) {
     const double t_stop = state.t + h;
     while (state.t < t_stop) {
-      if (!method.adaptive_step(problem, state, t_stop).ok) return false;
+      StepStatus status = method.adaptive_step(problem, state, t_stop);
+      if (!status.ok) return status;
     }
-  } else if (!method.step(problem, state, h).ok) {
-    return false;
+  } else {
+    StepStatus status = method.step(problem, state, h);
+    if (!status.ok) return status;
   }
-  return state.q.allFinite() && state.p.allFinite();
+  if (!state.q.allFinite() || !state.p.allFinite()) {
+    return StepStatus::failure("nan", "non-finite state after the step");
+  }
+  return StepStatus::success();
+}
+
+bool computed_step(Integrator& method, const Problem& problem, State& state, double h) {
+  return computed_step_status(method, problem, state, h).ok;
 }
 
 double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian) {
@@ -135,13 +144,181 @@ MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, co
   return best;
 }
 
+namespace {
+
+// G(q) at time t, dense (m × n); the time-free call on time-free problems.
+Eigen::MatrixXd dense_constraint_jacobian(const Problem& problem, double t, const Vec& q) {
+  SparseMatrix G;
+  if (problem.has(kTimeDependentConstraints)) {
+    problem.constraint_jacobian_at(t, q, G);
+  } else {
+    problem.constraint_jacobian(q, G);
+  }
+  return Eigen::MatrixXd(G);
+}
+
+// A smooth projection P onto T*Q_c = {g(q) = 0, G(q)M⁻¹p (+ ∂g/∂t) = 0} at time t: q moves along
+// M⁻¹G(q̃)ᵀν from the perturbed q̃ (Newton on ν until g is at round-off, then three more
+// corrections so that the result does not depend on where the iteration stopped), p is then
+// projected M⁻¹-orthogonally onto the tangent space at the new q. P is the identity on the
+// manifold, so DP·u = u for every tangent vector u: it is only the chart's way back. False when
+// the Newton iteration does not reach round-off.
+bool project_onto_manifold(const Problem& problem, State& state) {
+  const Vec& inverse_mass = problem.inverse_mass();
+  const Eigen::MatrixXd direction =
+      inverse_mass.asDiagonal() * dense_constraint_jacobian(problem, state.t, state.q).transpose();
+  Vec residual;
+  int polish = 0;
+  for (int iteration = 0; iteration < 30 && polish < 3; ++iteration) {
+    if (problem.has(kTimeDependentConstraints)) {
+      problem.constraint_at(state.t, state.q, residual);
+    } else {
+      problem.constraint(state.q, residual);
+    }
+    const Eigen::MatrixXd G = dense_constraint_jacobian(problem, state.t, state.q);
+    if (!residual.allFinite() || !G.allFinite()) return false;
+    const double round_off = 8 * std::numeric_limits<double>::epsilon() *
+                             G.cwiseAbs().rowwise().sum().maxCoeff() *
+                             state.q.lpNorm<Eigen::Infinity>();
+    if (residual.size() == 0) {
+      polish = 1;
+      break;
+    }
+    if (residual.lpNorm<Eigen::Infinity>() <= round_off) ++polish;
+    state.q -= direction * (G * direction).partialPivLu().solve(residual);
+  }
+  if (polish == 0 || !state.q.allFinite()) return false;
+  project_momentum_to_tangent_space(problem, state.t, state.q, state.p);
+  return state.p.allFinite();
+}
+
+// The chart directions v at a state of T*Q_c (2n × 2k, k = n − m): (T, 0) and (0, M T (TᵀMT)⁻¹),
+// T an orthonormal basis of ker G(q). The p directions are tangent already (they lie in ker GM⁻¹);
+// P adds to each q direction its hidden-constraint momentum correction, which lies in range Gᵀ ⟂ T.
+// So UᵀΩU is the canonical form of R^{2k}: ω((Ta, c), (0, MT(TᵀMT)⁻¹b)) = aᵀb.
+Eigen::MatrixXd chart_directions(const Problem& problem, const State& state) {
+  const long n = state.q.size();
+  const Eigen::MatrixXd G = dense_constraint_jacobian(problem, state.t, state.q);
+  const long m = G.rows();
+  const Eigen::MatrixXd basis = Eigen::HouseholderQR<Eigen::MatrixXd>(G.transpose()).householderQ();
+  const Eigen::MatrixXd tangent = basis.rightCols(n - m);
+  const Eigen::MatrixXd mass_tangent = problem.inverse_mass().cwiseInverse().asDiagonal() * tangent;
+  const Eigen::MatrixXd dual = mass_tangent * (tangent.transpose() * mass_tangent).inverse();
+  Eigen::MatrixXd directions = Eigen::MatrixXd::Zero(2 * n, 2 * (n - m));
+  directions.topLeftCorner(n, n - m) = tangent;
+  directions.bottomRightCorner(n, n - m) = dual;
+  return directions;
+}
+
+}  // namespace
+
+ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, const State& state,
+                                  double h) {
+  const long n = state.q.size();
+  Vec gradient;
+  problem.gradient(state.q, gradient);
+  const double q_scale = block_scale(
+      state.q, h * (problem.inverse_mass().cwiseProduct(state.p)).cwiseAbs().maxCoeff());
+  const double p_scale = block_scale(state.p, h * gradient.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd directions = chart_directions(problem, state);
+  const long k = directions.cols() / 2;
+  // Each column stacks the difference of the projected starts (a tangent vector u) over the
+  // difference of their images (J u): one Richardson pipeline for both.
+  const int levels = static_cast<int>(std::log2(kMapDefectRelativeSteps.front() /
+                                                kMapDefectRelativeSteps.back())) +
+                     3;
+  std::vector<Eigen::MatrixXd> differences(levels, Eigen::MatrixXd(4 * n, 2 * k));
+  for (long j = 0; j < 2 * k; ++j) {
+    const double step = kMapDefectRelativeSteps.front() * (j < k ? q_scale : p_scale);
+    for (int level = 0; level < levels; ++level) {
+      const double epsilon = std::ldexp(step, -level);
+      State plus = state, minus = state;
+      plus.q += epsilon * directions.col(j).head(n);
+      plus.p += epsilon * directions.col(j).tail(n);
+      minus.q -= epsilon * directions.col(j).head(n);
+      minus.p -= epsilon * directions.col(j).tail(n);
+      if (!project_onto_manifold(problem, plus) || !project_onto_manifold(problem, minus)) {
+        ManifoldMap failed;
+        failed.failure = "a perturbed start could not be projected onto the constraint manifold";
+        return failed;
+      }
+      auto column = differences[level].col(j);
+      column.segment(0, n) = (plus.q - minus.q) / (2 * epsilon);
+      column.segment(n, n) = (plus.p - minus.p) / (2 * epsilon);
+      for (State* start : {&plus, &minus}) {
+        const StepStatus status = computed_step_status(method, problem, *start, h);
+        if (!status.ok) {
+          ManifoldMap failed;
+          failed.failure = fmt::format("the step from a perturbed start failed: {} ({})",
+                                       status.reason, status.message);
+          return failed;
+        }
+      }
+      column.segment(2 * n, n) = (plus.q - minus.q) / (2 * epsilon);
+      column.segment(3 * n, n) = (plus.p - minus.p) / (2 * epsilon);
+      if (!column.allFinite()) return {};
+    }
+  }
+  ManifoldMap best;
+  for (const double relative : kMapDefectRelativeSteps) {
+    const int level =
+        static_cast<int>(std::lround(std::log2(kMapDefectRelativeSteps.front() / relative)));
+    const Eigen::MatrixXd coarse = (4 * differences[level + 1] - differences[level]) / 3;
+    const Eigen::MatrixXd fine = (4 * differences[level + 2] - differences[level + 1]) / 3;
+    const Eigen::MatrixXd error = fine - coarse;
+    const double basis_error = error.topRows(2 * n).norm();
+    const double image_error = error.bottomRows(2 * n).norm();
+    // The δ whose errors move the defect least (first order: 2‖U‖‖E_U‖ + 2‖JU‖‖E_JU‖).
+    const double weight =
+        fine.topRows(2 * n).norm() * basis_error + fine.bottomRows(2 * n).norm() * image_error;
+    if (best.tangent_basis.size() == 0 || weight < best.weight) {
+      best.tangent_basis = fine.topRows(2 * n);
+      best.image = fine.bottomRows(2 * n);
+      best.basis_error = basis_error;
+      best.image_error = image_error;
+      best.relative_step = relative;
+      best.weight = weight;
+    }
+  }
+  return best;
+}
+
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h) {
-  MapDefect out{kNaN, kNaN, kNaN};
   const auto method = make_integrator(method_spec);
-  if (!map_defect_not_applicable(*method, problem, h).empty()) return out;
-  const MapJacobian map = computed_map_jacobian(*method, problem, state, h);
-  if (map.jacobian.size() == 0) return out;
+  return symplecticity_defect_map(*method, problem, state, h);
+}
+
+MapDefect symplecticity_defect_map(Integrator& method, const Problem& problem, const State& state,
+                                   double h) {
+  MapDefect out{kNaN, kNaN, kNaN, ""};
+  if (!map_defect_not_applicable(method, problem, h).empty()) return out;
+  if (problem.has(kConstraints)) {
+    const ManifoldMap map = computed_manifold_map(method, problem, state, h);
+    if (map.tangent_basis.size() == 0) {
+      out.failure = map.failure;
+      return out;
+    }
+    const long k = map.tangent_basis.cols() / 2;
+    const Eigen::MatrixXd form = canonical_form(map.tangent_basis.rows() / 2);
+    // The restricted form ω(u_i, u_j) on the chart's basis (canonical for an exact U).
+    const Eigen::MatrixXd restricted = map.tangent_basis.transpose() * form * map.tangent_basis;
+    const double restricted_norm = restricted.norm();
+    const double basis_norm = map.tangent_basis.norm(), image_norm = map.image.norm();
+    out.defect = (map.image.transpose() * form * map.image - restricted).norm() / restricted_norm;
+    // The symplectic matrix of the chart, k = n − m: ‖J‖_F of the unconstrained case.
+    out.jacobian_norm = image_norm * std::sqrt(2.0 * static_cast<double>(k)) / basis_norm;
+    out.fd_error = (2 * basis_norm * map.basis_error + 2 * image_norm * map.image_error +
+                    4 * std::numeric_limits<double>::epsilon() *
+                        (basis_norm * basis_norm + image_norm * image_norm)) /
+                   restricted_norm;
+    return out;
+  }
+  const MapJacobian map = computed_map_jacobian(method, problem, state, h);
+  if (map.jacobian.size() == 0) {
+    out.failure = "the step from a perturbed start failed or was not finite";
+    return out;
+  }
   const double jacobian_norm = map.jacobian.norm();
   const double form_norm = std::sqrt(2.0 * static_cast<double>(state.q.size()));
   out.defect = map_defect_of_jacobian(map.jacobian);
