@@ -8,6 +8,7 @@
 #include <numbers>
 #include <vector>
 
+#include "harness/metrics.hpp"
 #include "integrators/newton.hpp"
 #include "problems/charged_particle.hpp"
 #include "problems/rigid_body.hpp"
@@ -45,15 +46,15 @@ class EnergyObserver : public Observer {
     window_max_[window] = std::max(window_max_[window], error);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["energy_err_max"] = err_max_;
-    metrics["energy_err_final"] = err_final_;
+    metrics[metric::energy_err_max.key()] = err_max_;
+    metrics[metric::energy_err_final.key()] = err_final_;
     std::vector<double> times, maxima;
     for (int w = 0; w < kDriftWindows; ++w) {
       if (window_max_[w] < 0) continue;
       times.push_back(t0_ + (w + 0.5) * window_length_);
       maxima.push_back(window_max_[w]);
     }
-    metrics["energy_drift"] = least_squares_slope(times, maxima);
+    metrics[metric::energy_drift.key()] = least_squares_slope(times, maxima);
   }
 
  private:
@@ -66,7 +67,7 @@ class EnergyObserver : public Observer {
 class MomentumObserver : public Observer {
  public:
   using Map = Vec (Problem::*)(const Vec&, const Vec&) const;
-  MomentumObserver(Map map, std::string column) : map_(map), column_(std::move(column)) {}
+  MomentumObserver(Map map, const MetricDecl& column) : map_(map), column_(column) {}
   void begin(const Problem& problem, const State& state, double) override {
     initial_ = (problem.*map_)(state.q, state.p);
   }
@@ -74,12 +75,12 @@ class MomentumObserver : public Observer {
     err_max_ = std::max(err_max_, ((problem.*map_)(state.q, state.p) - initial_).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics[column_] = err_max_;
+    metrics[column_.key()] = err_max_;
   }
 
  private:
   Map map_;
-  std::string column_;
+  const MetricDecl& column_;
   Vec initial_;
   double err_max_ = 0;
 };
@@ -97,7 +98,7 @@ class CasimirObserver : public Observer {
     err_max_ = std::max(err_max_, std::abs(problem.casimir(state.q, state.p) - initial_) / scale);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["casimir_err_max"] = err_max_;
+    metrics[metric::casimir_err_max.key()] = err_max_;
   }
 
  private:
@@ -118,7 +119,7 @@ class OrthogonalityObserver : public Observer {
     err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["orthogonality_err_max"] = err_max_;
+    metrics[metric::orthogonality_err_max.key()] = err_max_;
   }
 
  private:
@@ -140,7 +141,7 @@ class MagneticMomentObserver : public Observer {
     err_max_ = std::max(err_max_, std::abs(magnetic_moment(state) - initial_) / scale);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["magnetic_moment_err_max"] = err_max_;
+    metrics[metric::magnetic_moment_err_max.key()] = err_max_;
   }
 
  private:
@@ -178,8 +179,8 @@ class ConstraintObserver : public Observer {
         std::max(velocity_, problem.constraint_velocity_residual(state.t, state.q, state.p));
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["constraint_err_max"] = position_;
-    metrics["constraint_vel_err_max"] = velocity_;
+    metrics[metric::constraint_err_max.key()] = position_;
+    metrics[metric::constraint_vel_err_max.key()] = velocity_;
   }
 
  private:
@@ -197,8 +198,8 @@ class ExactErrorObserver : public Observer {
     error_final_ = error;
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["error_max"] = error_max_;
-    metrics["error_final"] = error_final_;
+    metrics[metric::error_max.key()] = error_max_;
+    metrics[metric::error_final.key()] = error_final_;
   }
 
  private:
@@ -236,8 +237,8 @@ class PhaseObserver : public Observer {
     }
     if (times.size() < 2) return;
     const double slope = least_squares_slope(times, shifts);
-    metrics["phase_err"] = 2 * std::numbers::pi * shifts.back() / period_;
-    metrics["period_err"] = -slope / (1 + slope);
+    metrics[metric::phase_err.key()] = 2 * std::numbers::pi * shifts.back() / period_;
+    metrics[metric::period_err.key()] = -slope / (1 + slope);
   }
 
  private:
@@ -340,7 +341,7 @@ class PericentreObserver : public Observer {
     // The unwrapped angle gains a whole turn per orbit; what is left is the precession.
     const double turn = 2 * std::numbers::pi;
     const double slope = least_squares_slope(index, passages_);
-    metrics["perihelion_err"] = slope - turn * std::round(slope / turn);
+    metrics[metric::perihelion_err.key()] = slope - turn * std::round(slope / turn);
   }
 
  private:
@@ -385,8 +386,8 @@ class EndReferenceObserver : public Observer {
   }
   void finish(std::map<std::string, double>& metrics) const override {
     if (!reached_) return;
-    metrics["error_final"] = error_;
-    metrics["scd"] = -std::log10(worst_relative_);
+    metrics[metric::error_final.key()] = error_;
+    metrics[metric::scd.key()] = -std::log10(worst_relative_);
   }
 
  private:
@@ -419,11 +420,11 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
   if (has_energy_reference(problem)) observers.push_back(std::make_unique<EnergyObserver>());
   if (problem.has(kLinearMomentum)) {
     observers.push_back(
-        std::make_unique<MomentumObserver>(&Problem::linear_momentum, "momentum_err_max"));
+        std::make_unique<MomentumObserver>(&Problem::linear_momentum, metric::momentum_err_max));
   }
   if (problem.has(kAngularMomentum)) {
-    observers.push_back(
-        std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
+    observers.push_back(std::make_unique<MomentumObserver>(&Problem::angular_momentum,
+                                                           metric::angular_momentum_err_max));
   }
   if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());

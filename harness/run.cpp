@@ -12,6 +12,7 @@
 
 #include "harness/chaos_metrics.hpp"
 #include "harness/map_defect.hpp"
+#include "harness/metrics.hpp"
 #include "harness/modified_energy.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
@@ -470,10 +471,9 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
                                           if (series) series->observe(*problem, s, last);
                                         });
   for (const auto& observer : observers) observer->finish(record.metrics);
-  if (std::find(config.extra_metrics.begin(), config.extra_metrics.end(), "symplecticity_defect") !=
-          config.extra_metrics.end() &&
+  if (requested(config.extra_metrics, metric::symplecticity_defect) &&
       symplecticity_defect_applies(*integrator, *problem)) {
-    record.metrics["symplecticity_defect"] =
+    record.metrics[metric::symplecticity_defect.key()] =
         symplecticity_defect(method_spec, *problem, problem->initial_state(), config.dt);
   }
   add_normal_mode_metrics(method_spec, *problem, config.dt, config.extra_metrics, record.metrics);

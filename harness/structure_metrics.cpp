@@ -10,6 +10,7 @@
 #include <complex>
 #include <limits>
 
+#include "harness/metrics.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -45,8 +46,9 @@ class ZeroCrossingPeriodObserver : public Observer {
   void finish(std::map<std::string, double>& metrics) const override {
     if (crossings_ < 2) return;
     const double measured = (last_crossing_ - first_) / (crossings_ - 1);
-    metrics["period_measured"] = measured;
-    if (!std::isnan(period_)) metrics["period_err_rel"] = (measured - period_) / period_;
+    metrics[metric::period_measured.key()] = measured;
+    if (!std::isnan(period_))
+      metrics[metric::period_err_rel.key()] = (measured - period_) / period_;
   }
 
  private:
@@ -96,7 +98,7 @@ class EnergyGrowthObserver : public Observer {
       log_max.push_back(std::log(maxima_[i]));
     }
     if (log_t.size() < 2) return;
-    metrics["energy_growth_exponent"] = least_squares_slope(log_t, log_max);
+    metrics[metric::energy_growth_exponent.key()] = least_squares_slope(log_t, log_max);
   }
 
  private:
@@ -114,16 +116,17 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 const std::vector<std::string>& optional_metric_names() {
-  static const std::vector<std::string> names = {"symplecticity_defect",
-                                                 "period_measured",
-                                                 "energy_growth_exponent",
-                                                 "mode_freq_err_max",
-                                                 "mode_damping_max",
-                                                 "symplecticity_defect_map",
-                                                 "lyapunov_max",
-                                                 "megno",
-                                                 "valid_time",
-                                                 "modified_energy_err_max"};
+  static const std::vector<std::string> names = [] {
+    std::vector<const MetricDecl*> options;
+    for (const MetricDecl* decl : metric_table()) {
+      if (decl->option_rank > 0) options.push_back(decl);
+    }
+    std::sort(options.begin(), options.end(),
+              [](const auto* a, const auto* b) { return a->option_rank < b->option_rank; });
+    std::vector<std::string> out;
+    for (const MetricDecl* decl : options) out.push_back(decl->key());
+    return out;
+  }();
   return names;
 }
 
@@ -299,8 +302,8 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
 void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics) {
-  const bool frequency = requested(names, "mode_freq_err_max");
-  const bool damping = requested(names, "mode_damping_max");
+  const bool frequency = requested(names, metric::mode_freq_err_max);
+  const bool damping = requested(names, metric::mode_damping_max);
   if (!frequency && !damping) return;
   const std::vector<DiscreteMode> modes = discrete_normal_modes(method_spec, problem, h);
   if (modes.empty()) return;
@@ -314,17 +317,17 @@ void add_normal_mode_metrics(const std::string& method_spec, const Problem& prob
     }
     damping_error = std::max(damping_error, std::abs(mode.amplitude - 1));
   }
-  if (frequency) metrics["mode_freq_err_max"] = frequency_error;
-  if (damping) metrics["mode_damping_max"] = damping_error;
+  if (frequency) metrics[metric::mode_freq_err_max.key()] = frequency_error;
+  if (damping) metrics[metric::mode_damping_max.key()] = damping_error;
 }
 
 std::vector<std::unique_ptr<Observer>> make_optional_observers(
     const Problem& problem, const std::vector<std::string>& names) {
   std::vector<std::unique_ptr<Observer>> observers;
-  if (requested(names, "period_measured") && !problem.has(kForce) && problem.dof() >= 1) {
+  if (requested(names, metric::period_measured) && !problem.has(kForce) && problem.dof() >= 1) {
     observers.push_back(std::make_unique<ZeroCrossingPeriodObserver>());
   }
-  if (requested(names, "energy_growth_exponent") && !problem.has(kForce)) {
+  if (requested(names, metric::energy_growth_exponent) && !problem.has(kForce)) {
     observers.push_back(std::make_unique<EnergyGrowthObserver>());
   }
   return observers;
