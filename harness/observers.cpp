@@ -2,6 +2,8 @@
 // exact solution.
 #include "harness/observers.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -24,21 +26,49 @@ double energy_reference(const Problem& problem, double energy0, double t) {
   return problem.energy(exact.q, exact.p);
 }
 
+bool divergence_rule_on(double factor) { return factor > 0 && std::isfinite(factor); }
+
 // energy_err_max, energy_err_final: |H(q_k, p_k) − H_ref(t_k)| / |H_0|; energy_drift: slope
 // per unit time of the per-window maxima of that error over kDriftWindows equal time windows.
+// With a divergence factor, also the divergence rule of a conservative run (admit), on the same
+// energy evaluation as the metric: one problem.energy() per step point.
 class EnergyObserver : public Observer {
  public:
+  EnergyObserver(const Problem& problem, double diverge_factor)
+      : diverge_factor_(diverge_factor),
+        // First-order-only problems have no energy and forced ones no conserved one.
+        rule_(divergence_rule_on(diverge_factor) && !problem.has(kForce) &&
+              !problem.has(kFirstOrderOnly)) {}
   void begin(const Problem& problem, const State& state, double t_end) override {
     energy0_ = problem.energy(state.q, state.p);
     scale_ = std::abs(energy0_) > 0 ? std::abs(energy0_) : 1.0;
+    divergence_scale_ = std::max(std::abs(energy0_), 1e-300);
     t0_ = state.t;
     window_length_ = (t_end - state.t) / kDriftWindows;
     window_max_.assign(kDriftWindows, -1.0);
   }
+  StepStatus admit(const Problem& problem, const State& state) override {
+    if (!rule_) return StepStatus::success();
+    energy_ = problem.energy(state.q, state.p);
+    energy_at_ = &state;
+    // A finite state can still have no energy: a position-dependent mass that is singular
+    // there (the spherical pendulum in angles on a pole) gives 0/0, which no comparison flags.
+    if (!std::isfinite(energy_)) {
+      return StepStatus::failure(
+          "nan", fmt::format("non-finite energy at t={} (the mass is singular there)", state.t));
+    }
+    if (std::abs(energy_ - energy0_) > diverge_factor_ * divergence_scale_) {
+      return StepStatus::failure(
+          "diverged",
+          fmt::format("relative energy error above {:g} at t={:.6g}", diverge_factor_, state.t));
+    }
+    return StepStatus::success();
+  }
   void observe(const Problem& problem, const State& state) override {
-    const double error =
-        std::abs(problem.energy(state.q, state.p) - energy_reference(problem, energy0_, state.t)) /
-        scale_;
+    // The energy admit() evaluated at this very state, else a fresh evaluation.
+    const double energy = energy_at_ == &state ? energy_ : problem.energy(state.q, state.p);
+    energy_at_ = nullptr;
+    const double error = std::abs(energy - energy_reference(problem, energy0_, state.t)) / scale_;
     err_max_ = std::max(err_max_, error);
     err_final_ = error;
     int window = static_cast<int>((state.t - t0_) / window_length_);
@@ -58,9 +88,30 @@ class EnergyObserver : public Observer {
   }
 
  private:
-  double energy0_ = 0, scale_ = 1, t0_ = 0, window_length_ = 1;
+  double diverge_factor_ = 0;
+  bool rule_ = false;
+  double energy0_ = 0, scale_ = 1, divergence_scale_ = 1, t0_ = 0, window_length_ = 1;
+  double energy_ = 0;                 // the energy admit() evaluated, at *energy_at_
+  const State* energy_at_ = nullptr;  // the state admit() evaluated, until observe() uses it
   double err_max_ = 0, err_final_ = 0;
   std::vector<double> window_max_;
+};
+
+// The divergence rule of a run without a conserved energy (forced, first-order): it stops when
+// max(|q|∞, |p|∞) exceeds kDivergedStateNorm. No metric of its own.
+class StateNormRule : public Observer {
+ public:
+  void begin(const Problem&, const State&, double) override {}
+  StepStatus admit(const Problem&, const State& state) override {
+    if (std::max(state.q.lpNorm<Eigen::Infinity>(), state.p.lpNorm<Eigen::Infinity>()) >
+        kDivergedStateNorm) {
+      return StepStatus::failure("diverged",
+                                 fmt::format("state norm above 1e100 at t={:.6g}", state.t));
+    }
+    return StepStatus::success();
+  }
+  void observe(const Problem&, const State&) override {}
+  void finish(std::map<std::string, double>&) const override {}
 };
 
 // Absolute error ‖J(q_k, p_k) − J(q_0, p_0)‖ of a momentum map J.
@@ -415,9 +466,16 @@ bool has_energy_reference(const Problem& problem) {
   return !problem.has(kForce) || problem.has(kExact);
 }
 
-std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem) {
+std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem,
+                                                             double diverge_factor) {
   std::vector<std::unique_ptr<Observer>> observers;
-  if (has_energy_reference(problem)) observers.push_back(std::make_unique<EnergyObserver>());
+  if (has_energy_reference(problem)) {
+    observers.push_back(std::make_unique<EnergyObserver>(problem, diverge_factor));
+  }
+  const bool conservative = !problem.has(kForce) && !problem.has(kFirstOrderOnly);
+  if (divergence_rule_on(diverge_factor) && !conservative) {
+    observers.push_back(std::make_unique<StateNormRule>());
+  }
   if (problem.has(kLinearMomentum)) {
     observers.push_back(
         std::make_unique<MomentumObserver>(&Problem::linear_momentum, metric::momentum_err_max));
