@@ -12,7 +12,6 @@
 
 #include "harness/chaos_metrics.hpp"
 #include "harness/map_defect.hpp"
-#include "harness/metrics.hpp"
 #include "harness/modified_energy.hpp"
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
@@ -408,6 +407,10 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
           make_modified_energy_observer(*integrator, *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(modified));
   }
+  if (auto step_map = make_step_map_observer(*integrator, method_spec, *problem, config.dt,
+                                             config.extra_metrics)) {
+    observers.push_back(std::move(step_map));
+  }
   if (auto chaos = make_chaos_observer(integrator->spec(), *problem, config.extra_metrics)) {
     observers.push_back(std::move(chaos));
   }
@@ -451,12 +454,6 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
                                           if (series) series->observe(*problem, s, last);
                                         });
   for (const auto& observer : observers) observer->finish(record.metrics);
-  if (requested(config.extra_metrics, metric::symplecticity_defect) &&
-      symplecticity_defect_applies(*integrator, *problem)) {
-    record.metrics[metric::symplecticity_defect.key()] =
-        symplecticity_defect(method_spec, *problem, problem->initial_state(), config.dt);
-  }
-  add_normal_mode_metrics(method_spec, *problem, config.dt, config.extra_metrics, record.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
   result.final_impulses = integrator->last_constraint_impulses();

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <utility>
 
 #include "harness/metrics.hpp"
 #include "problems/problem.hpp"
@@ -331,6 +332,51 @@ std::vector<std::unique_ptr<Observer>> make_optional_observers(
     observers.push_back(std::make_unique<EnergyGrowthObserver>());
   }
   return observers;
+}
+
+namespace {
+
+// symplecticity_defect and the normal-mode metrics read the method's one-step map, not the
+// trajectory: computed in finish() from the problem's initial state, whatever the run did.
+class StepMapObserver : public Observer {
+ public:
+  StepMapObserver(const Problem& problem, std::string method_spec, double h,
+                  std::vector<std::string> names, bool defect)
+      : problem_(problem),
+        method_spec_(std::move(method_spec)),
+        h_(h),
+        names_(std::move(names)),
+        defect_(defect) {}
+  void begin(const Problem&, const State&, double) override {}
+  void observe(const Problem&, const State&) override {}
+  void finish(std::map<std::string, double>& metrics) const override {
+    if (defect_) {
+      metrics[metric::symplecticity_defect.key()] =
+          symplecticity_defect(method_spec_, problem_, problem_.initial_state(), h_);
+    }
+    add_normal_mode_metrics(method_spec_, problem_, h_, names_, metrics);
+  }
+
+ private:
+  const Problem& problem_;
+  std::string method_spec_;
+  double h_;
+  std::vector<std::string> names_;
+  bool defect_;
+};
+
+}  // namespace
+
+std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
+                                                 const std::string& method_spec,
+                                                 const Problem& problem, double h,
+                                                 const std::vector<std::string>& names) {
+  const bool defect = requested(names, metric::symplecticity_defect) &&
+                      symplecticity_defect_applies(method, problem);
+  const bool modes =
+      requested(names, metric::mode_freq_err_max) || requested(names, metric::mode_damping_max);
+  if (!defect && !modes) return nullptr;
+  return std::make_unique<StepMapObserver>(problem, method_spec, h, names, defect);
 }
 
 }  // namespace geomint
