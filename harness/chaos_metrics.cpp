@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "harness/map_defect.hpp"
+#include "harness/metrics.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/newton.hpp"
 #include "problems/problem.hpp"
@@ -14,10 +15,6 @@ namespace geomint {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-bool requested(const std::vector<std::string>& names, const std::string& name) {
-  return std::find(names.begin(), names.end(), name) != names.end();
-}
 
 // A fixed, generic initial direction: a tangent vector along a symmetry (the flow, a conserved
 // momentum) would not see the shear that makes MEGNO 2 on a torus, so no component is zero and
@@ -59,10 +56,10 @@ class ChaosObserver : public Observer {
   }
   void finish(std::map<std::string, double>& metrics) const override {
     const bool ok = !failed_ && sums_.steps() > 0;
-    metrics["lyapunov_max"] = ok ? sums_.lyapunov() : kNaN;
-    metrics["megno"] = ok ? sums_.megno_mean() : kNaN;
-    metrics["megno_final"] = ok ? sums_.megno_instant() : kNaN;
-    metrics["chaos_tangent_fd"] = kind_ == ChaosTangent::kFiniteDifference ? 1 : 0;
+    metrics[metric::lyapunov_max.key()] = ok ? sums_.lyapunov() : kNaN;
+    metrics[metric::megno.key()] = ok ? sums_.megno_mean() : kNaN;
+    metrics[metric::megno_final.key()] = ok ? sums_.megno_instant() : kNaN;
+    metrics[metric::chaos_tangent_fd.key()] = kind_ == ChaosTangent::kFiniteDifference ? 1 : 0;
   }
 
  private:
@@ -128,8 +125,8 @@ class ValidTimeObserver : public Observer {
     if (!(error < kValidTimeErrorThreshold)) found_ = true;
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["valid_time"] = t_last_ - t0_;
-    metrics["valid_time_reached"] = found_ ? 1 : 0;
+    metrics[metric::valid_time.key()] = t_last_ - t0_;
+    metrics[metric::valid_time_reached.key()] = found_ ? 1 : 0;
   }
 
  private:
@@ -188,7 +185,7 @@ std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
                                               const Problem& problem,
                                               const std::vector<std::string>& names,
                                               ChaosTangent kind) {
-  if (!requested(names, "lyapunov_max") && !requested(names, "megno")) return nullptr;
+  if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
   auto method = make_integrator(method_spec);
   const bool usable = (kind == ChaosTangent::kLinearisedStep &&
                        symplecticity_defect_not_applicable(*method, problem).empty()) ||
@@ -201,7 +198,7 @@ std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
 std::unique_ptr<Observer> make_valid_time_observer(
     const Problem& problem, std::shared_ptr<const ReferenceSolution> reference,
     const std::vector<std::string>& names) {
-  if (!requested(names, "valid_time")) return nullptr;
+  if (!requested(names, metric::valid_time)) return nullptr;
   if (problem.has(kExact)) reference = nullptr;
   if (!problem.has(kExact) && !reference) return nullptr;
   return std::make_unique<ValidTimeObserver>(std::move(reference));

@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "harness/record.hpp"
 #include "harness/toml_reader.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
@@ -29,6 +30,30 @@ std::optional<double> parse_number(const std::string& text) {
   const double value = std::strtod(text.c_str(), &end);
   if (end != text.c_str() + text.size()) return std::nullopt;
   return value;
+}
+
+// The columns a gate on `table` may name, from the schema that writes that table (the metric
+// columns from the metric table, harness/metrics.hpp); empty for tables without a schema here
+// (stability, a gate on every table), whose columns are not checked.
+template <typename Record>
+std::vector<std::string> schema_names(const std::vector<Column<Record>>& schema) {
+  std::vector<std::string> names;
+  for (const auto& column : schema) names.push_back(column.name);
+  return names;
+}
+std::vector<std::string> gate_columns(const std::string& table) {
+  if (table == "summary") return schema_names(record_schema());
+  if (table == "order") return schema_names(order_schema());
+  return {};
+}
+
+void check_gate_column(const Gate& gate, const std::string& where) {
+  const std::vector<std::string> columns = gate_columns(gate.table);
+  if (columns.empty() || std::find(columns.begin(), columns.end(), gate.column) != columns.end()) {
+    return;
+  }
+  throw InputError(fmt::format("{}: column '{}' is not a column of table '{}' (one of: {})", where,
+                               gate.column, gate.table, fmt::join(columns, ", ")));
 }
 
 std::string node_text(const toml::node& node, const std::string& where) {
@@ -216,6 +241,7 @@ std::vector<Gate> load_gates(const std::string& path) {
         gate.where.emplace_back(where_column, expected);
       }
     }
+    check_gate_column(gate, block.where());
     gates.push_back(std::move(gate));
   }
   return gates;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "harness/metrics.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -213,6 +214,11 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
       {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nquick_min = 2\n", "quick_min"},
       {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nvariants = [\"ci\"]\n", "variants"},
       {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\nfile = \"order.csv\"\n", "scene"},
+      // A summary or order gate names a column of that table's schema (a metric of the table).
+      {"[[gate]]\nname = \"a\"\ntable = \"summary\"\ncolumn = \"energy_error_max\"\nmax = 1\n",
+       "'energy_error_max' is not a column of table 'summary'"},
+      {"[[gate]]\nname = \"a\"\ntable = \"order\"\ncolumn = \"energy_err_max\"\nmax = 1\n",
+       "'energy_err_max' is not a column of table 'order'"},
       {"[[gate]]\nname = \"a\"\ncolumn = \"x\"\nmax = 1\n[[gate]]\nname = \"a\"\ncolumn = "
        "\"x\"\nmax = 1\n",
        "twice"},
@@ -225,6 +231,13 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
       EXPECT_NE(std::string(error.what()).find(needle), std::string::npos)
           << error.what() << " should mention " << needle;
     }
+  }
+  // Every metric of the table is a column a summary gate may name.
+  for (const auto& name : metric_names()) {
+    EXPECT_NO_THROW(load_gates(write_temp(
+        "metric.toml",
+        "[[gate]]\nname = \"a\"\ntable = \"summary\"\ncolumn = \"" + name + "\"\nmax = 1\n")))
+        << name;
   }
   EXPECT_THROW(load_result_files({"/nonexistent/summary.csv"}), InputError);
   // A folder without tables is an input error naming it, not a gate that "selects no row".

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/metrics.hpp"
 #include "integrators/constrained_step.hpp"
 #include "problems/problem.hpp"
 
@@ -53,10 +54,6 @@ bool central_difference(Integrator& method, const Problem& problem, const State&
   column.head(n) = (plus.q - minus.q) / actual;
   column.tail(n) = (plus.p - minus.p) / actual;
   return column.allFinite();
-}
-
-bool requested(const std::vector<std::string>& names, const std::string& name) {
-  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 }  // namespace
@@ -355,7 +352,7 @@ class MapDefectObserver : public Observer {
     for (const State& state : points) {
       const MapDefect at_h = symplecticity_defect_map(method_spec_, *problem_, state, h_);
       if (std::isnan(at_h.defect)) {
-        metrics["symplecticity_defect_map"] = kNaN;
+        metrics[metric::symplecticity_defect_map.key()] = kNaN;
         return;
       }
       defect = std::max(defect, at_h.defect);
@@ -368,11 +365,11 @@ class MapDefectObserver : public Observer {
         error_half = std::max(error_half, at_half.fd_error);
       }
     }
-    metrics["symplecticity_defect_map"] = defect;
-    metrics["symplecticity_defect_map_fd_err"] = error;
+    metrics[metric::symplecticity_defect_map.key()] = defect;
+    metrics[metric::symplecticity_defect_map_fd_err.key()] = error;
     // An adaptive solver's map over h is governed by its tolerance, not by h: no slope.
     if (!adaptive_ && defect > 10 * error && defect_half > 10 * error_half) {
-      metrics["symplecticity_defect_map_slope"] = std::log2(defect / defect_half);
+      metrics[metric::symplecticity_defect_map_slope.key()] = std::log2(defect / defect_half);
     }
   }
 
@@ -392,7 +389,7 @@ class MapDefectObserver : public Observer {
 std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names) {
-  if (!requested(names, "symplecticity_defect_map")) return nullptr;
+  if (!requested(names, metric::symplecticity_defect_map)) return nullptr;
   const auto method = make_integrator(method_spec);
   if (!map_defect_not_applicable(*method, problem, h).empty()) return nullptr;
   return std::make_unique<MapDefectObserver>(method_spec, h,

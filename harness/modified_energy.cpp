@@ -10,6 +10,7 @@
 #include <optional>
 #include <utility>
 
+#include "harness/metrics.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -86,7 +87,7 @@ class ModifiedEnergyObserver : public Observer {
     add(problem, state, h_, at_h_);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["modified_energy_err_max"] = at_h_.modified / scale(*problem_);
+    metrics[metric::modified_energy_err_max.key()] = at_h_.modified / scale(*problem_);
     std::vector<double> log_steps = {std::log(h_)}, log_energy = {std::log(at_h_.energy)},
                         log_modified = {std::log(at_h_.modified)};
     for (int refinement : {2, 4}) {
@@ -97,8 +98,8 @@ class ModifiedEnergyObserver : public Observer {
       log_modified.push_back(std::log(errors->modified));
     }
     if (!(at_h_.energy > 0) || !(at_h_.modified > 0)) return;
-    metrics["modified_energy_err_slope"] = least_squares_slope(log_steps, log_modified);
-    metrics["energy_err_slope"] = least_squares_slope(log_steps, log_energy);
+    metrics[metric::modified_energy_err_slope.key()] = least_squares_slope(log_steps, log_modified);
+    metrics[metric::energy_err_slope.key()] = least_squares_slope(log_steps, log_energy);
   }
 
  private:
@@ -143,7 +144,7 @@ class ModifiedEnergyObserver : public Observer {
 std::unique_ptr<Observer> make_modified_energy_observer(const Integrator& method,
                                                         const Problem& problem, double h,
                                                         const std::vector<std::string>& names) {
-  if (std::find(names.begin(), names.end(), "modified_energy_err_max") == names.end()) {
+  if (!requested(names, metric::modified_energy_err_max)) {
     return nullptr;
   }
   if (!modified_energy_not_applicable(method, problem, h).empty()) return nullptr;

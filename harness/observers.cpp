@@ -2,12 +2,15 @@
 // exact solution.
 #include "harness/observers.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <vector>
 
+#include "harness/metrics.hpp"
 #include "integrators/newton.hpp"
 #include "problems/charged_particle.hpp"
 #include "problems/rigid_body.hpp"
@@ -23,21 +26,49 @@ double energy_reference(const Problem& problem, double energy0, double t) {
   return problem.energy(exact.q, exact.p);
 }
 
+bool divergence_rule_on(double factor) { return factor > 0 && std::isfinite(factor); }
+
 // energy_err_max, energy_err_final: |H(q_k, p_k) − H_ref(t_k)| / |H_0|; energy_drift: slope
 // per unit time of the per-window maxima of that error over kDriftWindows equal time windows.
+// With a divergence factor, also the divergence rule of a conservative run (admit), on the same
+// energy evaluation as the metric: one problem.energy() per step point.
 class EnergyObserver : public Observer {
  public:
+  EnergyObserver(const Problem& problem, double diverge_factor)
+      : diverge_factor_(diverge_factor),
+        // First-order-only problems have no energy and forced ones no conserved one.
+        rule_(divergence_rule_on(diverge_factor) && !problem.has(kForce) &&
+              !problem.has(kFirstOrderOnly)) {}
   void begin(const Problem& problem, const State& state, double t_end) override {
     energy0_ = problem.energy(state.q, state.p);
     scale_ = std::abs(energy0_) > 0 ? std::abs(energy0_) : 1.0;
+    divergence_scale_ = std::max(std::abs(energy0_), 1e-300);
     t0_ = state.t;
     window_length_ = (t_end - state.t) / kDriftWindows;
     window_max_.assign(kDriftWindows, -1.0);
   }
+  StepStatus admit(const Problem& problem, const State& state) override {
+    if (!rule_) return StepStatus::success();
+    energy_ = problem.energy(state.q, state.p);
+    energy_at_ = &state;
+    // A finite state can still have no energy: a position-dependent mass that is singular
+    // there (the spherical pendulum in angles on a pole) gives 0/0, which no comparison flags.
+    if (!std::isfinite(energy_)) {
+      return StepStatus::failure(
+          "nan", fmt::format("non-finite energy at t={} (the mass is singular there)", state.t));
+    }
+    if (std::abs(energy_ - energy0_) > diverge_factor_ * divergence_scale_) {
+      return StepStatus::failure(
+          "diverged",
+          fmt::format("relative energy error above {:g} at t={:.6g}", diverge_factor_, state.t));
+    }
+    return StepStatus::success();
+  }
   void observe(const Problem& problem, const State& state) override {
-    const double error =
-        std::abs(problem.energy(state.q, state.p) - energy_reference(problem, energy0_, state.t)) /
-        scale_;
+    // The energy admit() evaluated at this very state, else a fresh evaluation.
+    const double energy = energy_at_ == &state ? energy_ : problem.energy(state.q, state.p);
+    energy_at_ = nullptr;
+    const double error = std::abs(energy - energy_reference(problem, energy0_, state.t)) / scale_;
     err_max_ = std::max(err_max_, error);
     err_final_ = error;
     int window = static_cast<int>((state.t - t0_) / window_length_);
@@ -45,28 +76,49 @@ class EnergyObserver : public Observer {
     window_max_[window] = std::max(window_max_[window], error);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["energy_err_max"] = err_max_;
-    metrics["energy_err_final"] = err_final_;
+    metrics[metric::energy_err_max.key()] = err_max_;
+    metrics[metric::energy_err_final.key()] = err_final_;
     std::vector<double> times, maxima;
     for (int w = 0; w < kDriftWindows; ++w) {
       if (window_max_[w] < 0) continue;
       times.push_back(t0_ + (w + 0.5) * window_length_);
       maxima.push_back(window_max_[w]);
     }
-    metrics["energy_drift"] = least_squares_slope(times, maxima);
+    metrics[metric::energy_drift.key()] = least_squares_slope(times, maxima);
   }
 
  private:
-  double energy0_ = 0, scale_ = 1, t0_ = 0, window_length_ = 1;
+  double diverge_factor_ = 0;
+  bool rule_ = false;
+  double energy0_ = 0, scale_ = 1, divergence_scale_ = 1, t0_ = 0, window_length_ = 1;
+  double energy_ = 0;                 // the energy admit() evaluated, at *energy_at_
+  const State* energy_at_ = nullptr;  // the state admit() evaluated, until observe() uses it
   double err_max_ = 0, err_final_ = 0;
   std::vector<double> window_max_;
+};
+
+// The divergence rule of a run without a conserved energy (forced, first-order): it stops when
+// max(|q|∞, |p|∞) exceeds kDivergedStateNorm. No metric of its own.
+class StateNormRule : public Observer {
+ public:
+  void begin(const Problem&, const State&, double) override {}
+  StepStatus admit(const Problem&, const State& state) override {
+    if (std::max(state.q.lpNorm<Eigen::Infinity>(), state.p.lpNorm<Eigen::Infinity>()) >
+        kDivergedStateNorm) {
+      return StepStatus::failure("diverged",
+                                 fmt::format("state norm above 1e100 at t={:.6g}", state.t));
+    }
+    return StepStatus::success();
+  }
+  void observe(const Problem&, const State&) override {}
+  void finish(std::map<std::string, double>&) const override {}
 };
 
 // Absolute error ‖J(q_k, p_k) − J(q_0, p_0)‖ of a momentum map J.
 class MomentumObserver : public Observer {
  public:
   using Map = Vec (Problem::*)(const Vec&, const Vec&) const;
-  MomentumObserver(Map map, std::string column) : map_(map), column_(std::move(column)) {}
+  MomentumObserver(Map map, const MetricDecl& column) : map_(map), column_(column) {}
   void begin(const Problem& problem, const State& state, double) override {
     initial_ = (problem.*map_)(state.q, state.p);
   }
@@ -74,12 +126,12 @@ class MomentumObserver : public Observer {
     err_max_ = std::max(err_max_, ((problem.*map_)(state.q, state.p) - initial_).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics[column_] = err_max_;
+    metrics[column_.key()] = err_max_;
   }
 
  private:
   Map map_;
-  std::string column_;
+  const MetricDecl& column_;
   Vec initial_;
   double err_max_ = 0;
 };
@@ -97,7 +149,7 @@ class CasimirObserver : public Observer {
     err_max_ = std::max(err_max_, std::abs(problem.casimir(state.q, state.p) - initial_) / scale);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["casimir_err_max"] = err_max_;
+    metrics[metric::casimir_err_max.key()] = err_max_;
   }
 
  private:
@@ -118,7 +170,7 @@ class OrthogonalityObserver : public Observer {
     err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["orthogonality_err_max"] = err_max_;
+    metrics[metric::orthogonality_err_max.key()] = err_max_;
   }
 
  private:
@@ -140,7 +192,7 @@ class MagneticMomentObserver : public Observer {
     err_max_ = std::max(err_max_, std::abs(magnetic_moment(state) - initial_) / scale);
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["magnetic_moment_err_max"] = err_max_;
+    metrics[metric::magnetic_moment_err_max.key()] = err_max_;
   }
 
  private:
@@ -178,8 +230,8 @@ class ConstraintObserver : public Observer {
         std::max(velocity_, problem.constraint_velocity_residual(state.t, state.q, state.p));
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["constraint_err_max"] = position_;
-    metrics["constraint_vel_err_max"] = velocity_;
+    metrics[metric::constraint_err_max.key()] = position_;
+    metrics[metric::constraint_vel_err_max.key()] = velocity_;
   }
 
  private:
@@ -197,8 +249,8 @@ class ExactErrorObserver : public Observer {
     error_final_ = error;
   }
   void finish(std::map<std::string, double>& metrics) const override {
-    metrics["error_max"] = error_max_;
-    metrics["error_final"] = error_final_;
+    metrics[metric::error_max.key()] = error_max_;
+    metrics[metric::error_final.key()] = error_final_;
   }
 
  private:
@@ -236,8 +288,8 @@ class PhaseObserver : public Observer {
     }
     if (times.size() < 2) return;
     const double slope = least_squares_slope(times, shifts);
-    metrics["phase_err"] = 2 * std::numbers::pi * shifts.back() / period_;
-    metrics["period_err"] = -slope / (1 + slope);
+    metrics[metric::phase_err.key()] = 2 * std::numbers::pi * shifts.back() / period_;
+    metrics[metric::period_err.key()] = -slope / (1 + slope);
   }
 
  private:
@@ -340,7 +392,7 @@ class PericentreObserver : public Observer {
     // The unwrapped angle gains a whole turn per orbit; what is left is the precession.
     const double turn = 2 * std::numbers::pi;
     const double slope = least_squares_slope(index, passages_);
-    metrics["perihelion_err"] = slope - turn * std::round(slope / turn);
+    metrics[metric::perihelion_err.key()] = slope - turn * std::round(slope / turn);
   }
 
  private:
@@ -385,8 +437,8 @@ class EndReferenceObserver : public Observer {
   }
   void finish(std::map<std::string, double>& metrics) const override {
     if (!reached_) return;
-    metrics["error_final"] = error_;
-    metrics["scd"] = -std::log10(worst_relative_);
+    metrics[metric::error_final.key()] = error_;
+    metrics[metric::scd.key()] = -std::log10(worst_relative_);
   }
 
  private:
@@ -414,16 +466,23 @@ bool has_energy_reference(const Problem& problem) {
   return !problem.has(kForce) || problem.has(kExact);
 }
 
-std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem) {
+std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem,
+                                                             double diverge_factor) {
   std::vector<std::unique_ptr<Observer>> observers;
-  if (has_energy_reference(problem)) observers.push_back(std::make_unique<EnergyObserver>());
+  if (has_energy_reference(problem)) {
+    observers.push_back(std::make_unique<EnergyObserver>(problem, diverge_factor));
+  }
+  const bool conservative = !problem.has(kForce) && !problem.has(kFirstOrderOnly);
+  if (divergence_rule_on(diverge_factor) && !conservative) {
+    observers.push_back(std::make_unique<StateNormRule>());
+  }
   if (problem.has(kLinearMomentum)) {
     observers.push_back(
-        std::make_unique<MomentumObserver>(&Problem::linear_momentum, "momentum_err_max"));
+        std::make_unique<MomentumObserver>(&Problem::linear_momentum, metric::momentum_err_max));
   }
   if (problem.has(kAngularMomentum)) {
-    observers.push_back(
-        std::make_unique<MomentumObserver>(&Problem::angular_momentum, "angular_momentum_err_max"));
+    observers.push_back(std::make_unique<MomentumObserver>(&Problem::angular_momentum,
+                                                           metric::angular_momentum_err_max));
   }
   if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());

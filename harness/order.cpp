@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/metrics.hpp"
 #include "harness/observers.hpp"
 #include "harness/reference.hpp"
 
@@ -143,7 +144,7 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     config.timing_repeats = 0;
     config.diverge_factor = diverge_factor;
     RunResult result = run_one(problem_spec, method_spec, config);
-    exact = result.record.metrics.count("error_final") > 0;
+    exact = result.record.metrics.count(metric::error_final.key()) > 0;
     dts.push_back(config.dt);
     result.record.order_level = k;
     study.runs.push_back(std::move(result));
@@ -190,7 +191,8 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
       const double p_squared = (run.final_state.p - reference.p).squaredNorm();
       error_q = std::sqrt(q_squared);
       error_p = std::sqrt(p_squared);
-      error = exact ? run.record.metrics.at("error_final") : std::sqrt(q_squared + p_squared);
+      error = exact ? run.record.metrics.at(metric::error_final.key())
+                    : std::sqrt(q_squared + p_squared);
       if (study.multiplier_applies) error_multiplier = multiplier_error(*problem, run, study);
     }
     errors.push_back(error);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "harness/metrics.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -27,18 +28,6 @@ const std::vector<std::pair<const char*, long Counters::*>>& counter_columns() {
       {"linear_solves", &Counters::linear_solves},
       {"factorizations", &Counters::factorizations},
       {"rejected", &Counters::rejected}};
-  return columns;
-}
-
-// The metric columns: the run of standard_columns() from energy_err_max to perihelion_err, so a
-// metric's name is spelled in one place (table.cpp) for every writer.
-const std::vector<std::string>& metric_columns() {
-  static const std::vector<std::string> columns = [] {
-    const auto& standard = standard_columns();
-    const auto first = std::find(standard.begin(), standard.end(), "energy_err_max");
-    const auto last = std::find(standard.begin(), standard.end(), "perihelion_err");
-    return std::vector<std::string>(first, last + 1);
-  }();
   return columns;
 }
 
@@ -77,8 +66,8 @@ std::vector<RecordColumn> build_schema() {
       {"t_reached", real(&RunRecord::t_reached)},
       {"steps", integer(&RunRecord::steps)},
   };
-  for (const auto& name : metric_columns()) {
-    schema.push_back({name, [name](const RunRecord& r) {
+  for (const auto& name : metric_names()) {
+    schema.push_back({name, [name = name](const RunRecord& r) {
                         const auto found = r.metrics.find(name);
                         if (found == r.metrics.end()) return std::optional<std::string>();
                         return std::optional(format_number(found->second));
@@ -108,12 +97,9 @@ const std::vector<RecordColumn>& record_schema() {
 
 Row to_row(const RunRecord& record) {
   for (const auto& [name, value] : record.metrics) {
-    const auto& metrics = metric_columns();
-    if (std::find(metrics.begin(), metrics.end(), name) == metrics.end()) {
-      throw std::logic_error(
-          fmt::format("metric '{}' has no column in the run record schema "
-                      "(harness/record.cpp)",
-                      name));
+    if (find_metric(name) == nullptr) {
+      throw std::logic_error(fmt::format(
+          "metric '{}' is not declared in the metric table (harness/metrics.hpp)", name));
     }
   }
   return row_of(record_schema(), record);

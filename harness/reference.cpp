@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "harness/metrics.hpp"
 #include "harness/paths.hpp"
 #include "harness/table.hpp"
 #include "integrators/newton.hpp"
@@ -38,8 +39,8 @@ class ReferenceErrorObserver : public Observer {
   }
   void finish(std::map<std::string, double>& metrics) const override {
     if (!reached_end_) return;
-    metrics["error_max"] = error_max_;
-    metrics["error_final"] = error_final_;
+    metrics[metric::error_max.key()] = error_max_;
+    metrics[metric::error_final.key()] = error_final_;
   }
 
  private:

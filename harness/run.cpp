@@ -22,12 +22,6 @@
 namespace geomint {
 namespace {
 
-// A forced run whose state passes this has blown up (the energy rule is
-// RunConfig::diverge_factor; both are off when the factor is 0 or inf).
-constexpr double kDivergedStateNorm = 1e100;
-
-bool divergence_rule_on(double factor) { return factor > 0 && std::isfinite(factor); }
-
 bool finite(const State& state) { return state.q.allFinite() && state.p.allFinite(); }
 
 // Time series writer: t, energy, invariants, problem extras, then q and p. Rows are streamed to
@@ -175,51 +169,29 @@ struct [[nodiscard]] LoopOutcome {
 
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
 // Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
-// only when dt does not divide t_end. `checked` = false (timing pass) skips the per-step
-// finiteness and divergence checks, which cost an energy evaluation per step, and `visit` for
-// fixed-step methods; the metric pass has already established that the run succeeds.
-template <typename Visit>
+// only when dt does not divide t_end. With `checked`, a step point must be finite and pass
+// `admit(state)` (the observers' divergence rule, make_metric_observers) before it is visited;
+// `checked` = false (timing pass) skips both, and `visit` for fixed-step methods: the metric
+// pass has already established that the run succeeds.
+template <typename Admit, typename Visit>
 LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& state,
-                      const RunConfig& config, bool adaptive, bool checked, Visit&& visit) {
+                      const RunConfig& config, bool adaptive, bool checked, Admit&& admit,
+                      Visit&& visit) {
   LoopOutcome outcome;
   const double t0 = state.t;
-  const double energy0 = problem.energy(state.q, state.p);
-  const double energy_scale = std::max(std::abs(energy0), 1e-300);
-  // First-order-only problems have no energy: the state-norm rule, as for forced ones.
-  const bool conservative = !problem.has(kForce) && !problem.has(kFirstOrderOnly);
-  const bool divergence = divergence_rule_on(config.diverge_factor);
   outcome.t_reached = t0;
   // Sets outcome.status and returns false when the state fails the checks; a passing step
-  // builds no status object.
+  // builds no failure message.
   auto check = [&](const State& s) {
     if (!checked) return true;
     if (!finite(s)) {
       outcome.status = StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
       return false;
     }
-    if (!divergence) return true;
-    if (conservative) {
-      const double energy = problem.energy(s.q, s.p);
-      // A finite state can still have no energy: a position-dependent mass that is singular
-      // there (the spherical pendulum in angles on a pole) gives 0/0, which no comparison flags.
-      if (!std::isfinite(energy)) {
-        outcome.status = StepStatus::failure(
-            "nan", fmt::format("non-finite energy at t={} (the mass is singular there)", s.t));
-        return false;
-      }
-      if (std::abs(energy - energy0) > config.diverge_factor * energy_scale) {
-        outcome.status = StepStatus::failure(
-            "diverged", fmt::format("relative energy error above {:g} at t={:.6g}",
-                                    config.diverge_factor, s.t));
-        return false;
-      }
-    } else if (std::max(s.q.lpNorm<Eigen::Infinity>(), s.p.lpNorm<Eigen::Infinity>()) >
-               kDivergedStateNorm) {
-      outcome.status =
-          StepStatus::failure("diverged", fmt::format("state norm above 1e100 at t={:.6g}", s.t));
-      return false;
-    }
-    return true;
+    StepStatus admitted = admit(s);
+    if (admitted.ok) return true;
+    outcome.status = std::move(admitted);
+    return false;
   };
   if (adaptive) {
     const double t_end = t0 + config.t_end;
@@ -349,8 +321,9 @@ TimingOutcome time_run(const std::string& problem_spec, const std::string& metho
     State state = problem->initial_state();
     const auto start = Clock::now();
     integrator->reset(*problem, state, config.dt);
-    LoopOutcome outcome =
-        integrate(*problem, *integrator, state, config, adaptive, false, [](const State&, bool) {});
+    LoopOutcome outcome = integrate(
+        *problem, *integrator, state, config, adaptive, false,
+        [](const State&) { return StepStatus::success(); }, [](const State&, bool) {});
     if (!outcome.status.ok) {
       failed = std::move(outcome.status);
       return std::nullopt;
@@ -421,7 +394,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (!adaptive) record.dt = config.dt;
   record.t_end = config.t_end;
 
-  auto observers = make_metric_observers(*problem);
+  auto observers = make_metric_observers(*problem, config.diverge_factor);
   check_optional_metrics(config.extra_metrics, "--metric");
   for (auto& observer : make_optional_observers(*problem, config.extra_metrics)) {
     observers.push_back(std::move(observer));
@@ -433,6 +406,10 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (auto modified =
           make_modified_energy_observer(*integrator, *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(modified));
+  }
+  if (auto step_map = make_step_map_observer(*integrator, method_spec, *problem, config.dt,
+                                             config.extra_metrics)) {
+    observers.push_back(std::move(step_map));
   }
   if (auto chaos = make_chaos_observer(integrator->spec(), *problem, config.extra_metrics)) {
     observers.push_back(std::move(chaos));
@@ -463,20 +440,20 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   for (auto& observer : observers) observer->begin(*problem, state, config.t_end);
   if (series) series->observe(*problem, state, false);
   integrator->reset(*problem, state, config.dt);
-  const LoopOutcome outcome = integrate(*problem, *integrator, state, config, adaptive, true,
+  const auto admit = [&](const State& s) {
+    for (auto& observer : observers) {
+      StepStatus status = observer->admit(*problem, s);
+      if (!status.ok) return status;
+    }
+    return StepStatus::success();
+  };
+  const LoopOutcome outcome = integrate(*problem, *integrator, state, config, adaptive, true, admit,
                                         [&](const State& s, bool last) {
                                           for (auto& observer : observers)
                                             observer->observe(*problem, s);
                                           if (series) series->observe(*problem, s, last);
                                         });
   for (const auto& observer : observers) observer->finish(record.metrics);
-  if (std::find(config.extra_metrics.begin(), config.extra_metrics.end(), "symplecticity_defect") !=
-          config.extra_metrics.end() &&
-      symplecticity_defect_applies(*integrator, *problem)) {
-    record.metrics["symplecticity_defect"] =
-        symplecticity_defect(method_spec, *problem, problem->initial_state(), config.dt);
-  }
-  add_normal_mode_metrics(method_spec, *problem, config.dt, config.extra_metrics, record.metrics);
   result.ok = outcome.status.ok;
   result.final_state = state;
   result.final_impulses = integrator->last_constraint_impulses();

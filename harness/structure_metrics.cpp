@@ -9,7 +9,9 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <utility>
 
+#include "harness/metrics.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -45,8 +47,9 @@ class ZeroCrossingPeriodObserver : public Observer {
   void finish(std::map<std::string, double>& metrics) const override {
     if (crossings_ < 2) return;
     const double measured = (last_crossing_ - first_) / (crossings_ - 1);
-    metrics["period_measured"] = measured;
-    if (!std::isnan(period_)) metrics["period_err_rel"] = (measured - period_) / period_;
+    metrics[metric::period_measured.key()] = measured;
+    if (!std::isnan(period_))
+      metrics[metric::period_err_rel.key()] = (measured - period_) / period_;
   }
 
  private:
@@ -96,7 +99,7 @@ class EnergyGrowthObserver : public Observer {
       log_max.push_back(std::log(maxima_[i]));
     }
     if (log_t.size() < 2) return;
-    metrics["energy_growth_exponent"] = least_squares_slope(log_t, log_max);
+    metrics[metric::energy_growth_exponent.key()] = least_squares_slope(log_t, log_max);
   }
 
  private:
@@ -114,16 +117,17 @@ bool requested(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 const std::vector<std::string>& optional_metric_names() {
-  static const std::vector<std::string> names = {"symplecticity_defect",
-                                                 "period_measured",
-                                                 "energy_growth_exponent",
-                                                 "mode_freq_err_max",
-                                                 "mode_damping_max",
-                                                 "symplecticity_defect_map",
-                                                 "lyapunov_max",
-                                                 "megno",
-                                                 "valid_time",
-                                                 "modified_energy_err_max"};
+  static const std::vector<std::string> names = [] {
+    std::vector<const MetricDecl*> options;
+    for (const MetricDecl* decl : metric_table()) {
+      if (decl->option_rank > 0) options.push_back(decl);
+    }
+    std::sort(options.begin(), options.end(),
+              [](const auto* a, const auto* b) { return a->option_rank < b->option_rank; });
+    std::vector<std::string> out;
+    for (const MetricDecl* decl : options) out.push_back(decl->key());
+    return out;
+  }();
   return names;
 }
 
@@ -299,8 +303,8 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
 void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics) {
-  const bool frequency = requested(names, "mode_freq_err_max");
-  const bool damping = requested(names, "mode_damping_max");
+  const bool frequency = requested(names, metric::mode_freq_err_max);
+  const bool damping = requested(names, metric::mode_damping_max);
   if (!frequency && !damping) return;
   const std::vector<DiscreteMode> modes = discrete_normal_modes(method_spec, problem, h);
   if (modes.empty()) return;
@@ -314,20 +318,65 @@ void add_normal_mode_metrics(const std::string& method_spec, const Problem& prob
     }
     damping_error = std::max(damping_error, std::abs(mode.amplitude - 1));
   }
-  if (frequency) metrics["mode_freq_err_max"] = frequency_error;
-  if (damping) metrics["mode_damping_max"] = damping_error;
+  if (frequency) metrics[metric::mode_freq_err_max.key()] = frequency_error;
+  if (damping) metrics[metric::mode_damping_max.key()] = damping_error;
 }
 
 std::vector<std::unique_ptr<Observer>> make_optional_observers(
     const Problem& problem, const std::vector<std::string>& names) {
   std::vector<std::unique_ptr<Observer>> observers;
-  if (requested(names, "period_measured") && !problem.has(kForce) && problem.dof() >= 1) {
+  if (requested(names, metric::period_measured) && !problem.has(kForce) && problem.dof() >= 1) {
     observers.push_back(std::make_unique<ZeroCrossingPeriodObserver>());
   }
-  if (requested(names, "energy_growth_exponent") && !problem.has(kForce)) {
+  if (requested(names, metric::energy_growth_exponent) && !problem.has(kForce)) {
     observers.push_back(std::make_unique<EnergyGrowthObserver>());
   }
   return observers;
+}
+
+namespace {
+
+// symplecticity_defect and the normal-mode metrics read the method's one-step map, not the
+// trajectory: computed in finish() from the problem's initial state, whatever the run did.
+class StepMapObserver : public Observer {
+ public:
+  StepMapObserver(const Problem& problem, std::string method_spec, double h,
+                  std::vector<std::string> names, bool defect)
+      : problem_(problem),
+        method_spec_(std::move(method_spec)),
+        h_(h),
+        names_(std::move(names)),
+        defect_(defect) {}
+  void begin(const Problem&, const State&, double) override {}
+  void observe(const Problem&, const State&) override {}
+  void finish(std::map<std::string, double>& metrics) const override {
+    if (defect_) {
+      metrics[metric::symplecticity_defect.key()] =
+          symplecticity_defect(method_spec_, problem_, problem_.initial_state(), h_);
+    }
+    add_normal_mode_metrics(method_spec_, problem_, h_, names_, metrics);
+  }
+
+ private:
+  const Problem& problem_;
+  std::string method_spec_;
+  double h_;
+  std::vector<std::string> names_;
+  bool defect_;
+};
+
+}  // namespace
+
+std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
+                                                 const std::string& method_spec,
+                                                 const Problem& problem, double h,
+                                                 const std::vector<std::string>& names) {
+  const bool defect = requested(names, metric::symplecticity_defect) &&
+                      symplecticity_defect_applies(method, problem);
+  const bool modes =
+      requested(names, metric::mode_freq_err_max) || requested(names, metric::mode_damping_max);
+  if (!defect && !modes) return nullptr;
+  return std::make_unique<StepMapObserver>(problem, method_spec, h, names, defect);
 }
 
 }  // namespace geomint

@@ -70,6 +70,14 @@ void add_normal_mode_metrics(const std::string& method_spec, const Problem& prob
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics);
 
+// The observer of the requested metrics of `method`'s one-step map on `problem` with step h
+// (symplecticity_defect when it applies, mode_freq_err_max, mode_damping_max), computed when the
+// run finishes; nullptr when none is requested. `method_spec` builds the fresh integrators.
+std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
+                                                 const std::string& method_spec,
+                                                 const Problem& problem, double h,
+                                                 const std::vector<std::string>& names);
+
 // Observers for the requested optional trajectory metrics that apply to `problem`.
 std::vector<std::unique_ptr<Observer>> make_optional_observers(
     const Problem& problem, const std::vector<std::string>& names);

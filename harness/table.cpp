@@ -27,6 +27,7 @@
 #include <stdexcept>
 
 #include "harness/blas.hpp"
+#include "harness/metrics.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -91,65 +92,19 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
 }
 
 const std::vector<std::string>& standard_columns() {
-  static const std::vector<std::string> columns = {"label",
-                                                   "problem",
-                                                   "method",
-                                                   "family",
-                                                   "dt",
-                                                   "tol",
-                                                   "t_end",
-                                                   "status",
-                                                   "message",
-                                                   "t_reached",
-                                                   "steps",
-                                                   "energy_err_max",
-                                                   "energy_err_final",
-                                                   "energy_drift",
-                                                   "modified_energy_err_max",
-                                                   "modified_energy_err_slope",
-                                                   "energy_err_slope",
-                                                   "energy_growth_exponent",
-                                                   "momentum_err_max",
-                                                   "angular_momentum_err_max",
-                                                   "casimir_err_max",
-                                                   "constraint_err_max",
-                                                   "constraint_vel_err_max",
-                                                   "orthogonality_err_max",
-                                                   "magnetic_moment_err_max",
-                                                   "symplecticity_defect",
-                                                   "symplecticity_defect_map",
-                                                   "symplecticity_defect_map_fd_err",
-                                                   "symplecticity_defect_map_slope",
-                                                   "lyapunov_max",
-                                                   "megno",
-                                                   "megno_final",
-                                                   "chaos_tangent_fd",
-                                                   "valid_time",
-                                                   "valid_time_reached",
-                                                   "mode_freq_err_max",
-                                                   "mode_damping_max",
-                                                   "error_final",
-                                                   "error_max",
-                                                   "scd",
-                                                   "phase_err",
-                                                   "period_err",
-                                                   "period_measured",
-                                                   "period_err_rel",
-                                                   "perihelion_err",
-                                                   "order",
-                                                   "declared_order",
-                                                   "points_used",
-                                                   "force_evals",
-                                                   "energy_evals",
-                                                   "hessian_evals",
-                                                   "newton_iters",
-                                                   "linear_solves",
-                                                   "factorizations",
-                                                   "rejected",
-                                                   "wall_s",
-                                                   "wall_s_min",
-                                                   "wall_s_iqr",
-                                                   "wall_s_repeats"};
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> out = {"label", "problem", "method",  "family",    "dt",   "tol",
+                                    "t_end", "status",  "message", "t_reached", "steps"};
+    const auto& metrics = metric_names();
+    out.insert(out.end(), metrics.begin(), metrics.end());
+    for (const char* name :
+         {"order", "declared_order", "points_used", "force_evals", "energy_evals", "hessian_evals",
+          "newton_iters", "linear_solves", "factorizations", "rejected", "wall_s", "wall_s_min",
+          "wall_s_iqr", "wall_s_repeats"}) {
+      out.emplace_back(name);
+    }
+    return out;
+  }();
   return columns;
 }
 
