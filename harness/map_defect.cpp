@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/run_spec.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -137,8 +138,13 @@ MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, co
 
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h) {
+  return symplecticity_defect_map(MethodFactory(method_spec), problem, state, h);
+}
+
+MapDefect symplecticity_defect_map(const MethodFactory& factory, const Problem& problem,
+                                   const State& state, double h) {
   MapDefect out{kNaN, kNaN, kNaN};
-  const auto method = make_integrator(method_spec);
+  const auto method = factory.make();
   if (!map_defect_not_applicable(*method, problem, h).empty()) return out;
   const MapJacobian map = computed_map_jacobian(*method, problem, state, h);
   if (map.jacobian.size() == 0) return out;
@@ -158,8 +164,8 @@ namespace {
 // the defects are computed in finish() from fresh integrators, so the run is not disturbed.
 class MapDefectObserver : public Observer {
  public:
-  MapDefectObserver(std::string method_spec, double h, bool adaptive)
-      : method_spec_(std::move(method_spec)), h_(h), adaptive_(adaptive) {}
+  MapDefectObserver(MethodFactory method, double h, bool adaptive)
+      : method_(std::move(method)), h_(h), adaptive_(adaptive) {}
   void begin(const Problem& problem, const State& state, double t_end) override {
     problem_ = &problem;
     states_ = {state};
@@ -176,14 +182,14 @@ class MapDefectObserver : public Observer {
     if (has_last_ && last_.t > points.back().t) points.push_back(last_);
     double defect = 0, error = 0, defect_half = 0, error_half = 0;
     for (const State& state : points) {
-      const MapDefect at_h = symplecticity_defect_map(method_spec_, *problem_, state, h_);
+      const MapDefect at_h = symplecticity_defect_map(method_, *problem_, state, h_);
       if (std::isnan(at_h.defect)) {
         metrics["symplecticity_defect_map"] = kNaN;
         return;
       }
       defect = std::max(defect, at_h.defect);
       error = std::max(error, at_h.fd_error);
-      const MapDefect at_half = symplecticity_defect_map(method_spec_, *problem_, state, h_ / 2);
+      const MapDefect at_half = symplecticity_defect_map(method_, *problem_, state, h_ / 2);
       if (std::isnan(at_half.defect)) {
         defect_half = kNaN;
       } else if (!std::isnan(defect_half)) {
@@ -200,7 +206,7 @@ class MapDefectObserver : public Observer {
   }
 
  private:
-  std::string method_spec_;
+  MethodFactory method_;
   double h_;
   bool adaptive_;
   const Problem* problem_ = nullptr;
@@ -216,10 +222,15 @@ std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spe
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names) {
   if (!requested(names, "symplecticity_defect_map")) return nullptr;
-  const auto method = make_integrator(method_spec);
-  if (!map_defect_not_applicable(*method, problem, h).empty()) return nullptr;
-  return std::make_unique<MapDefectObserver>(method_spec, h,
-                                             (method->info().flags & kAdaptive) != 0);
+  return make_map_defect_observer(MethodFactory(method_spec), problem, h, names);
+}
+
+std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
+                                                   const Problem& problem, double h,
+                                                   const std::vector<std::string>& names) {
+  if (!requested(names, "symplecticity_defect_map")) return nullptr;
+  if (!map_defect_not_applicable(method.prototype(), problem, h).empty()) return nullptr;
+  return std::make_unique<MapDefectObserver>(method, h, method.adaptive());
 }
 
 }  // namespace geomint

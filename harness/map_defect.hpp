@@ -14,6 +14,8 @@
 
 namespace geomint {
 
+class MethodFactory;  // harness/run_spec.hpp
+
 // The defect of one map at one state, with the estimated error of the finite differences.
 struct MapDefect {
   double defect = 0;         // ‖JᵀΩJ − Ω‖_F/‖Ω‖_F; NaN when a step failed
@@ -57,6 +59,8 @@ MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, co
 // difference of the two extrapolations, ‖E‖_F, bounds its error (truncation and the map's noise
 // alike), so that fd_error = (2‖J‖_F‖E‖_F + 4ε‖J‖²_F)/‖Ω‖_F (first order in E: JᵀΩJ changes by
 // EᵀΩJ + JᵀΩE). NaN defect when a step fails.
+MapDefect symplecticity_defect_map(const MethodFactory& method, const Problem& problem,
+                                   const State& state, double h);
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h);
 
@@ -70,6 +74,9 @@ double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian);
 // log₂(max defect at h / max defect at h/2) at the same states (symplecticity_defect_map_slope:
 // p + 1 for a non-symplectic map of order p) when both stand above ten times their error
 // estimate and the method is not adaptive.
+std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
+                                                   const Problem& problem, double h,
+                                                   const std::vector<std::string>& names);
 std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names);
