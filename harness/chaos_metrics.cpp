@@ -7,6 +7,7 @@
 
 #include "harness/map_defect.hpp"
 #include "harness/metrics.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/newton.hpp"
 #include "problems/problem.hpp"
@@ -177,8 +178,9 @@ std::string chaos_tangent_not_applicable(const Integrator& method, const Problem
 std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
                                               const Problem& problem,
                                               const std::vector<std::string>& names) {
-  return make_chaos_observer(method_spec, problem, names,
-                             chaos_tangent(*make_integrator(method_spec), problem));
+  if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
+  const MethodFactory factory(method_spec);
+  return make_chaos_observer(factory, problem, names, chaos_tangent(factory.prototype(), problem));
 }
 
 std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
@@ -186,7 +188,14 @@ std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
                                               const std::vector<std::string>& names,
                                               ChaosTangent kind) {
   if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
-  auto method = make_integrator(method_spec);
+  return make_chaos_observer(MethodFactory(method_spec), problem, names, kind);
+}
+
+std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& factory, const Problem& problem,
+                                              const std::vector<std::string>& names,
+                                              ChaosTangent kind) {
+  if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
+  auto method = factory.make();
   const bool usable = (kind == ChaosTangent::kLinearisedStep &&
                        symplecticity_defect_not_applicable(*method, problem).empty()) ||
                       (kind == ChaosTangent::kFiniteDifference &&

@@ -13,6 +13,8 @@
 
 namespace geomint {
 
+class MethodFactory;  // harness/run_spec.hpp
+
 // How the tangent vector w is carried from step point y_k to y_{k+1}.
 enum class ChaosTangent {
   kNone,              // not applicable (chaos_tangent_not_applicable says why)
@@ -67,6 +69,10 @@ std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
 // The same with the tangent chosen (tests compare the two; nullptr where `kind` cannot be used).
 std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
                                               const Problem& problem,
+                                              const std::vector<std::string>& names,
+                                              ChaosTangent kind);
+// The same from a parsed method: the integrator that takes the tangents is made from `method`.
+std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& method, const Problem& problem,
                                               const std::vector<std::string>& names,
                                               ChaosTangent kind);
 

@@ -10,6 +10,7 @@
 
 #include "harness/metrics.hpp"
 #include "integrators/constrained_step.hpp"
+#include "harness/run_spec.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -282,7 +283,12 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
 
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h) {
-  const auto method = make_integrator(method_spec);
+  return symplecticity_defect_map(MethodFactory(method_spec), problem, state, h);
+}
+
+MapDefect symplecticity_defect_map(const MethodFactory& factory, const Problem& problem,
+                                   const State& state, double h) {
+  const auto method = factory.make();
   return symplecticity_defect_map(*method, problem, state, h);
 }
 
@@ -332,8 +338,8 @@ namespace {
 // the defects are computed in finish() from fresh integrators, so the run is not disturbed.
 class MapDefectObserver : public Observer {
  public:
-  MapDefectObserver(std::string method_spec, double h, bool adaptive)
-      : method_spec_(std::move(method_spec)), h_(h), adaptive_(adaptive) {}
+  MapDefectObserver(MethodFactory method, double h, bool adaptive)
+      : method_(std::move(method)), h_(h), adaptive_(adaptive) {}
   void begin(const Problem& problem, const State& state, double t_end) override {
     problem_ = &problem;
     states_ = {state};
@@ -350,14 +356,14 @@ class MapDefectObserver : public Observer {
     if (has_last_ && last_.t > points.back().t) points.push_back(last_);
     double defect = 0, error = 0, defect_half = 0, error_half = 0;
     for (const State& state : points) {
-      const MapDefect at_h = symplecticity_defect_map(method_spec_, *problem_, state, h_);
+      const MapDefect at_h = symplecticity_defect_map(method_, *problem_, state, h_);
       if (std::isnan(at_h.defect)) {
         metrics[metric::symplecticity_defect_map.key()] = kNaN;
         return;
       }
       defect = std::max(defect, at_h.defect);
       error = std::max(error, at_h.fd_error);
-      const MapDefect at_half = symplecticity_defect_map(method_spec_, *problem_, state, h_ / 2);
+      const MapDefect at_half = symplecticity_defect_map(method_, *problem_, state, h_ / 2);
       if (std::isnan(at_half.defect)) {
         defect_half = kNaN;
       } else if (!std::isnan(defect_half)) {
@@ -374,7 +380,7 @@ class MapDefectObserver : public Observer {
   }
 
  private:
-  std::string method_spec_;
+  MethodFactory method_;
   double h_;
   bool adaptive_;
   const Problem* problem_ = nullptr;
@@ -390,10 +396,15 @@ std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spe
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names) {
   if (!requested(names, metric::symplecticity_defect_map)) return nullptr;
-  const auto method = make_integrator(method_spec);
-  if (!map_defect_not_applicable(*method, problem, h).empty()) return nullptr;
-  return std::make_unique<MapDefectObserver>(method_spec, h,
-                                             (method->info().flags & kAdaptive) != 0);
+  return make_map_defect_observer(MethodFactory(method_spec), problem, h, names);
+}
+
+std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
+                                                   const Problem& problem, double h,
+                                                   const std::vector<std::string>& names) {
+  if (!requested(names, metric::symplecticity_defect_map)) return nullptr;
+  if (!map_defect_not_applicable(method.prototype(), problem, h).empty()) return nullptr;
+  return std::make_unique<MapDefectObserver>(method, h, method.adaptive());
 }
 
 }  // namespace geomint

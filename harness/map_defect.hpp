@@ -14,6 +14,8 @@
 
 namespace geomint {
 
+class MethodFactory;  // harness/run_spec.hpp
+
 // The defect of one map at one state, with the estimated error of the finite differences.
 struct MapDefect {
   double defect = 0;         // ‖JᵀΩJ − Ω‖_F/‖Ω‖_F; NaN when a step failed
@@ -83,6 +85,8 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
 // computed_manifold_map: ‖(JU)ᵀΩ(JU) − UᵀΩU‖_F/‖UᵀΩU‖_F (the symplectic form restricted to
 // T*Q_c, GNI Theorem VII.1.5), with fd_error = (2‖U‖‖E_U‖ + 2‖JU‖‖E_JU‖ + 4ε(‖U‖² +
 // ‖JU‖²))/‖UᵀΩU‖_F; on an unconstrained problem (U = I) both are the formulas above.
+MapDefect symplecticity_defect_map(const MethodFactory& method, const Problem& problem,
+                                   const State& state, double h);
 MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
                                    const State& state, double h);
 // The same for a given integrator (reset at every perturbed start).
@@ -99,6 +103,9 @@ double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian);
 // log₂(max defect at h / max defect at h/2) at the same states (symplecticity_defect_map_slope:
 // p + 1 for a non-symplectic map of order p) when both stand above ten times their error
 // estimate and the method is not adaptive.
+std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
+                                                   const Problem& problem, double h,
+                                                   const std::vector<std::string>& names);
 std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names);

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "harness/metrics.hpp"
+#include "harness/run_spec.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -75,8 +76,8 @@ struct EnergyErrors {
 // three methods with a known correction (docs/METHOD.md §10).
 class ModifiedEnergyObserver : public Observer {
  public:
-  ModifiedEnergyObserver(std::string method_spec, ModifiedEnergyCorrection correction, double h)
-      : method_spec_(std::move(method_spec)), correction_(correction), h_(h) {}
+  ModifiedEnergyObserver(MethodFactory method, ModifiedEnergyCorrection correction, double h)
+      : method_(std::move(method)), correction_(correction), h_(h) {}
   void begin(const Problem& problem, const State& state, double) override {
     problem_ = &problem;
     initial_ = state;
@@ -119,7 +120,7 @@ class ModifiedEnergyObserver : public Observer {
   // The errors of the run at h/refinement over the same span; nullopt when a step fails.
   std::optional<EnergyErrors> rerun(int refinement) const {
     const double h = h_ / refinement;
-    auto method = make_integrator(method_spec_);
+    auto method = method_.make();
     State state = initial_;
     method->reset(*problem_, state, h);
     EnergyErrors errors;
@@ -130,7 +131,7 @@ class ModifiedEnergyObserver : public Observer {
     return errors;
   }
 
-  std::string method_spec_;
+  MethodFactory method_;
   ModifiedEnergyCorrection correction_;
   double h_;
   const Problem* problem_ = nullptr;
@@ -147,9 +148,18 @@ std::unique_ptr<Observer> make_modified_energy_observer(const Integrator& method
   if (!requested(names, metric::modified_energy_err_max)) {
     return nullptr;
   }
-  if (!modified_energy_not_applicable(method, problem, h).empty()) return nullptr;
+  return make_modified_energy_observer(MethodFactory(method.spec()), problem, h, names);
+}
+
+std::unique_ptr<Observer> make_modified_energy_observer(const MethodFactory& method,
+                                                        const Problem& problem, double h,
+                                                        const std::vector<std::string>& names) {
+  if (std::find(names.begin(), names.end(), "modified_energy_err_max") == names.end()) {
+    return nullptr;
+  }
+  if (!modified_energy_not_applicable(method.prototype(), problem, h).empty()) return nullptr;
   return std::make_unique<ModifiedEnergyObserver>(
-      method.spec(), *modified_energy_correction(method.info().name), h);
+      method, *modified_energy_correction(method.info().name), h);
 }
 
 }  // namespace geomint

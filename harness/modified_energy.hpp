@@ -13,6 +13,8 @@
 
 namespace geomint {
 
+class MethodFactory;  // harness/run_spec.hpp
+
 // The coefficients of H₂ = curvature·vᵀ∇²V v + force·∇VᵀM⁻¹∇V (v = M⁻¹p) for one method.
 struct ModifiedEnergyCorrection {
   double curvature = 0;  // a, the coefficient of pᵀM⁻¹∇²V M⁻¹p
@@ -40,6 +42,11 @@ double modified_energy(const ModifiedEnergyCorrection& correction, const Problem
 // over h, h/2, h/4 (the run itself and two reruns of the same span in finish(); absent when a
 // rerun fails or an error is exactly 0). nullptr when the metric is not asked for or does not
 // apply: the columns then stay empty.
+std::unique_ptr<Observer> make_modified_energy_observer(const MethodFactory& method,
+                                                        const Problem& problem, double h,
+                                                        const std::vector<std::string>& names);
+// The same for the method of a given integrator (its spec is parsed once when the metric is asked
+// for).
 std::unique_ptr<Observer> make_modified_energy_observer(const Integrator& method,
                                                         const Problem& problem, double h,
                                                         const std::vector<std::string>& names);

@@ -114,26 +114,45 @@ OrderFit fit_order(const std::vector<double>& dts, const std::vector<double>& er
   return fit;
 }
 
-void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
-                          double dt0, long levels, double t_end) {
-  if (levels < kMinOrderLevels || levels > kMaxOrderLevels) {
-    throw InputError(fmt::format("--levels must be in {}..{} (got {})", kMinOrderLevels,
+std::vector<std::string> order_study_errors(const Problem& problem, const MethodFactory& method,
+                                            double dt0, long levels, double t_end) {
+  std::vector<std::string> errors;
+  const bool levels_ok = levels >= kMinOrderLevels && levels <= kMaxOrderLevels;
+  if (!levels_ok) {
+    errors.push_back(fmt::format("--levels must be in {}..{} (got {})", kMinOrderLevels,
                                  kMaxOrderLevels, levels));
   }
-  if (!(dt0 > 0 && std::isfinite(dt0))) {
-    throw InputError(fmt::format("--dt must be a finite number > 0 (got {})", dt0));
-  }
-  make_problem(problem_spec);
-  const bool adaptive = make_integrator(method_spec)->info().flags & kAdaptive;
+  const bool dt0_ok = dt0 > 0 && std::isfinite(dt0);
+  if (!dt0_ok) errors.push_back(fmt::format("--dt must be a finite number > 0 (got {})", dt0));
+  // The finest level's grid, once its step is known; its own --dt message would repeat the one
+  // above.
   RunConfig finest;
-  finest.dt = dt0 * std::ldexp(1.0, -static_cast<int>(levels - 1));
+  finest.dt = dt0_ok && levels_ok ? dt0 * std::ldexp(1.0, -static_cast<int>(levels - 1)) : 1.0;
   finest.t_end = t_end;
-  validate_run_config(finest, adaptive);
+  for (std::string& error : run_config_errors(finest, method.adaptive())) {
+    errors.push_back(std::move(error));
+  }
+  if (const Applicability fit = applicable(method.prototype(), problem); !fit.ok) {
+    errors.push_back(fit.reason);
+  }
+  return errors;
+}
+
+void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
+                          double dt0, long levels, double t_end) {
+  throw_input_errors(order_study_errors(*parse_problem(problem_spec), MethodFactory(method_spec),
+                                        dt0, levels, t_end));
 }
 
 OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
                        int levels, double t_end, double diverge_factor) {
-  validate_order_study(problem_spec, method_spec, dt0, levels, t_end);
+  return order_study(parse_problem(problem_spec), MethodFactory(method_spec), dt0, levels, t_end,
+                     diverge_factor);
+}
+
+OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const MethodFactory& method,
+                       double dt0, int levels, double t_end, double diverge_factor) {
+  throw_input_errors(order_study_errors(*problem, method, dt0, levels, t_end));
   OrderStudy study;
   std::vector<double> dts, errors;
   bool exact = true;
@@ -143,13 +162,12 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
     config.t_end = t_end;
     config.timing_repeats = 0;
     config.diverge_factor = diverge_factor;
-    RunResult result = run_one(problem_spec, method_spec, config);
+    RunResult result = run_one(RunSpec{problem, method, config});
     exact = result.record.metrics.count(metric::error_final.key()) > 0;
     dts.push_back(config.dt);
     result.record.order_level = k;
     study.runs.push_back(std::move(result));
   }
-  const auto problem = make_problem(problem_spec);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> errors_q, errors_p, errors_multiplier;
   study.multiplier_applies = problem->has(kConstraints) &&
@@ -213,7 +231,6 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
         fit_order(dts, errors_multiplier, kPlateau, kAsymptoticErrorFraction * multiplier_scale);
   }
   study.fit = fit_order(dts, errors, kPlateau, ceiling);
-  const auto method = make_integrator(method_spec);
   OrderRecord& record = study.record;
   record.problem = study.runs.front().record.problem;
   record.method = study.runs.front().record.method;
@@ -226,7 +243,7 @@ OrderStudy order_study(const std::string& problem_spec, const std::string& metho
   if (std::isfinite(study.fit_multiplier.order)) {
     record.order_multiplier = study.fit_multiplier.order;
   }
-  record.declared_order = method->info().order;
+  record.declared_order = method.info().order;
   for (int i : study.fit.used) record.points_used.push_back(dts[i]);
   record.status = std::isfinite(study.fit.order) ? "ok" : "no_fit";
   std::string note = study.fit.note;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 
 namespace geomint {
 
@@ -48,15 +49,24 @@ struct OrderStudy {
 constexpr int kMinOrderLevels = 3;
 constexpr int kMaxOrderLevels = 30;
 
-// Checks levels, dt0 and t_end, and t_end/dt of the finest level against kMaxFixedSteps
-// (InputError naming the option) — everything a study needs before its first run.
+// Every error a study can be refused for before its first run, one message each naming the
+// option: levels, dt0 and t_end, t_end/dt of the finest level against kMaxFixedSteps, and
+// whether the method applies to the problem.
+std::vector<std::string> order_study_errors(const Problem& problem, const MethodFactory& method,
+                                            double dt0, long levels, double t_end);
+// The same from spec strings (parsed here), as one InputError.
 void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
                           double dt0, long levels, double t_end);
 
-// Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing, and fits error_final (or, for
-// problems without an exact solution, the difference to the finest level — noted in the row),
-// the q and p parts of it, and the multiplier error where the problem knows its exact value.
-// Validates everything first (validate_order_study), so bad input throws before any run.
+// Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing (one problem object, a fresh
+// integrator from `method` per level), and fits error_final (or, for problems without an exact
+// solution, the difference to the finest level — noted in the row), the q and p parts of it, and
+// the multiplier error where the problem knows its exact value. Validates everything first
+// (order_study_errors), so bad input throws before any run.
+OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const MethodFactory& method,
+                       double dt0, int levels, double t_end,
+                       double diverge_factor = kDefaultDivergeFactor);
+// The same from spec strings (the scene reader, tests).
 OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
                        int levels, double t_end, double diverge_factor = kDefaultDivergeFactor);
 

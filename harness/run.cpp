@@ -16,6 +16,7 @@
 #include "harness/observers.hpp"
 #include "harness/paths.hpp"
 #include "harness/reference.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 #include "problems/lagrangian.hpp"
 
@@ -241,47 +242,60 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
 
 }  // namespace
 
-void validate_run_config(const RunConfig& config, bool adaptive) {
-  if (!adaptive && !(config.dt > 0 && std::isfinite(config.dt))) {
-    throw InputError(fmt::format("--dt must be a finite number > 0 (got {})", config.dt));
+std::vector<std::string> run_config_errors(const RunConfig& config, bool adaptive) {
+  std::vector<std::string> errors;
+  const bool dt_ok = adaptive || (config.dt > 0 && std::isfinite(config.dt));
+  if (!dt_ok) errors.push_back(fmt::format("--dt must be a finite number > 0 (got {})", config.dt));
+  const bool t_end_ok = config.t_end > 0 && std::isfinite(config.t_end);
+  if (!t_end_ok) {
+    errors.push_back(fmt::format("--t-end must be a finite number > 0 (got {})", config.t_end));
   }
-  if (!(config.t_end > 0 && std::isfinite(config.t_end))) {
-    throw InputError(fmt::format("--t-end must be a finite number > 0 (got {})", config.t_end));
-  }
-  if (!adaptive && config.t_end / config.dt > kMaxFixedSteps) {
-    throw InputError(fmt::format("--t-end/--dt = {:g} steps is more than the allowed {:g}",
+  // The step count means something only when both of its terms are valid.
+  if (!adaptive && dt_ok && t_end_ok && config.t_end / config.dt > kMaxFixedSteps) {
+    errors.push_back(fmt::format("--t-end/--dt = {:g} steps is more than the allowed {:g}",
                                  config.t_end / config.dt, kMaxFixedSteps));
   }
   if (config.max_steps < 1 || static_cast<double>(config.max_steps) > kMaxFixedSteps) {
-    throw InputError(
+    errors.push_back(
         fmt::format("--max-steps must be in 1..{:g} (got {})", kMaxFixedSteps, config.max_steps));
   }
   if (config.series_every < 1) {
-    throw InputError(fmt::format("--every must be >= 1 (got {})", config.series_every));
+    errors.push_back(fmt::format("--every must be >= 1 (got {})", config.series_every));
   }
   if (config.timing_repeats < 0 || config.timing_repeats > kMaxTimingRepeats) {
-    throw InputError(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
+    errors.push_back(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
                                  config.timing_repeats));
   }
   if (!(config.diverge_factor >= 0)) {
-    throw InputError(
+    errors.push_back(
         fmt::format("--diverge-factor must be >= 0 (0 or inf: no divergence rule; got {})",
                     config.diverge_factor));
   }
+  return errors;
 }
 
-void check_series_section(const Problem& problem, long section) {
-  if (section < 0) return;
+void validate_run_config(const RunConfig& config, bool adaptive) {
+  throw_input_errors(run_config_errors(config, adaptive));
+}
+
+std::string series_section_error(const Problem& problem, long section) {
+  if (section < 0) return {};
   // The crossing is interpolated with q̇ = M⁻¹p and ṗ = −∇V: canonical separable problems only.
   if (section >= problem.dof() || problem.has(kFirstOrderOnly) || problem.has(kForce) ||
       problem.has(kConstraints) || is_non_separable(problem)) {
-    throw InputError(fmt::format(
+    return fmt::format(
         "series_section = {}: a Poincare section needs a coordinate index in 0..{} of an "
         "unforced, unconstrained, separable problem (H = p^T M^-1 p/2 + V(q)); '{}' is not",
-        section, problem.dof() - 1, problem.spec()));
+        section, problem.dof() - 1, problem.spec());
   }
+  return {};
 }
 
+void check_series_section(const Problem& problem, long section) {
+  if (std::string why = series_section_error(problem, section); !why.empty()) {
+    throw InputError(why);
+  }
+}
 void check_run_outputs(const RunConfig& config) {
   if (!config.series_path.empty()) check_output_file(config.series_path, "--series");
 }
@@ -309,15 +323,20 @@ TimingStats timing_stats(std::vector<double> seconds) {
 
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats) {
-  const auto problem = make_problem(problem_spec);
+  return time_run(RunSpec::parse(problem_spec, method_spec, config), repeats);
+}
+
+TimingOutcome time_run(const RunSpec& spec, int repeats) {
+  const Problem* problem = spec.problem.get();
+  const RunConfig& config = spec.config;
+  const bool adaptive = spec.method.adaptive();
   const int wanted = std::max(1, repeats);
   using Clock = std::chrono::steady_clock;
   const auto pass_start = Clock::now();
   // One run from a fresh integrator; its wall time, or nullopt with the failed status.
   StepStatus failed = StepStatus::success();
   const auto one_run = [&]() -> std::optional<double> {
-    auto integrator = make_integrator(method_spec);
-    const bool adaptive = (integrator->info().flags & kAdaptive) != 0;
+    auto integrator = spec.method.make();
     State state = problem->initial_state();
     const auto start = Clock::now();
     integrator->reset(*problem, state, config.dt);
@@ -375,16 +394,17 @@ void record_timing(const TimingOutcome& timing, RunRecord& record) {
 
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
                   const RunConfig& config) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method_spec);
-  const MethodInfo info = integrator->info();
-  const bool adaptive = (info.flags & kAdaptive) != 0;
-  validate_run_config(config, adaptive);
-  check_run_outputs(config);
-  if (const Applicability fit = applicable(*integrator, *problem); !fit.ok) {
-    throw InputError(fit.reason);
-  }
-  if (!config.series_path.empty()) check_series_section(*problem, config.series_section);
+  return run_one(RunSpec::parse(problem_spec, method_spec, config));
+}
+
+RunResult run_one(const RunSpec& spec) {
+  throw_input_errors(spec.validate());
+  const Problem* problem = spec.problem.get();
+  const RunConfig& config = spec.config;
+  const std::string& method_spec = spec.method.spec();
+  auto integrator = spec.method.make();
+  const MethodInfo& info = spec.method.info();
+  const bool adaptive = spec.method.adaptive();
 
   RunResult result;
   RunRecord& record = result.record;
@@ -467,7 +487,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
   if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
-    record_timing(time_run(problem_spec, method_spec, config, config.timing_repeats), record);
+    record_timing(time_run(spec, config.timing_repeats), record);
   }
   return result;
 }

@@ -13,6 +13,8 @@
 
 namespace geomint {
 
+struct RunSpec;  // harness/run_spec.hpp
+
 // A conservative run is stopped with status `diverged` when its relative energy error
 // |H − H₀|/|H₀| exceeds this factor (forced problems: when max(|q|∞, |p|∞) exceeds 1e100);
 // `--diverge-factor` / scene key `diverge_factor`. 0 or +inf turns the rule off (non-finite
@@ -63,6 +65,8 @@ struct RunConfig {
 // InputError unless the Poincaré section q_i = 0 (i = `section`; −1 = none) can be written for
 // `problem` (RunConfig::series_section).
 void check_series_section(const Problem& problem, long section);
+// The same check as a message, empty when the section can be written.
+std::string series_section_error(const Problem& problem, long section);
 
 struct RunResult {
   RunRecord record;  // identifiers, status, metrics, counters, wall_s
@@ -72,8 +76,10 @@ struct RunResult {
   std::optional<ConstraintImpulses> final_impulses;
 };
 
-// Validates specs and config (InputError on bad input), then runs. Numerical failures are
-// reported in the result (status != ok), never thrown.
+// Validates the spec (RunSpec::validate(); one InputError listing every error), then runs.
+// Numerical failures are reported in the result (status != ok), never thrown.
+RunResult run_one(const RunSpec& spec);
+// The same from spec strings (RunSpec::parse), for the command line, the scene reader and tests.
 RunResult run_one(const std::string& problem_spec, const std::string& method_spec,
                   const RunConfig& config);
 
@@ -100,6 +106,8 @@ struct [[nodiscard]] TimingOutcome {
   // "timing pass failed: reason: message", the row's message when the status failed.
   std::string failure_message() const;
 };
+// Each run builds a fresh integrator from spec.method (no spec text is re-parsed).
+TimingOutcome time_run(const RunSpec& spec, int repeats);
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats);
 // Writes a successful outcome's statistics into the record (wall_s = median, wall_s_min,
@@ -107,8 +115,10 @@ TimingOutcome time_run(const std::string& problem_spec, const std::string& metho
 void record_timing(const TimingOutcome& timing, RunRecord& record);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
-// --timing-repeats, --diverge-factor and --max-steps (InputError naming the offending option).
-// A grid longer than max_steps is no input error but a failure row (run_one).
+// --timing-repeats, --diverge-factor and --max-steps: one message per offending option, naming
+// it and what is allowed. A grid longer than max_steps is no input error but a failure row.
+std::vector<std::string> run_config_errors(const RunConfig& config, bool adaptive);
+// The same as one InputError listing every message.
 void validate_run_config(const RunConfig& config, bool adaptive);
 
 // Checks the run's output paths before anything is computed (InputError naming the option):

@@ -28,27 +28,10 @@ int run_main(int argc, char** argv) {
   app.set_version_flag("--version",
                        fmt::format("geomint {} ({})", build_version(), build_git_sha()),
                        "print the version (the CMake project version) and the git commit");
-  app.footer(
-      "Exit codes: 0 ok; 1 a run failed (run), no order could be fitted (order), a gate failed "
-      "(gate) or a benchmark got slower (perf-compare); 2 bad input: the message names the "
-      "offending option, key or value, and nothing is "
-      "written (checked before any computing, outputs included); 3 internal error (\"geomint: "
-      "internal error: ...\"): a defect, or an I/O failure after those checks such as a full "
-      "disk. A numerical failure is a row whose status says what happened; a sweep exits 0 with "
-      "its failures as rows.");
-  // The order of `geomint --help`.
-  const std::vector<Verb> verbs = {add_list(app),      add_run(app),         add_order(app),
-                                   add_sweep(app),     add_merge(app),       add_slurm(app),
-                                   add_reference(app), add_modes(app),       add_gate(app),
-                                   add_report(app),    add_perf_compare(app)};
-  std::vector<std::string> commands;
   bool quiet = false;
-  for (const Verb& verb : verbs) {
-    commands.push_back(verb.name);
-    verb.command->add_flag("--quiet", quiet,
-                           "no progress and no informational lines on stderr (errors are still "
-                           "printed; exit codes unchanged)");
-  }
+  const std::vector<Verb> verbs = add_verbs(app, quiet);
+  std::vector<std::string> commands;
+  for (const Verb& verb : verbs) commands.push_back(verb.name);
 
   if (!check_command(program, commands, argc, argv)) return kExitBadInput;
   try {

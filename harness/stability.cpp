@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "harness/run_spec.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -16,7 +17,7 @@ constexpr double kTwoPi = 6.283185307179586;
 
 struct Search {
   const Problem& problem;
-  const std::string& method_spec;
+  const MethodFactory& method;
   const StabilityOptions& options;
   double horizon;
   long runs = 0;
@@ -24,7 +25,7 @@ struct Search {
   // One run of the criterion at step h.
   bool stable(double h, std::string* reason) {
     ++runs;
-    auto integrator = make_integrator(method_spec);
+    auto integrator = method.make();
     State state = problem.initial_state();
     const double energy0 = problem.energy(state.q, state.p);
     const double bound = options.growth * std::max(std::abs(energy0), 1e-300);
@@ -81,7 +82,7 @@ void resolve(const Problem& problem, const StabilityOptions& options, double* ho
 }  // namespace
 
 double predicted_homega_limit(const std::string& method_spec) {
-  return make_integrator(method_spec)->predicted_linear_stability().homega_limit;
+  return MethodFactory(method_spec).prototype().predicted_linear_stability().homega_limit;
 }
 
 void validate_stability_options(const StabilityOptions& options, const std::string& where) {
@@ -121,10 +122,14 @@ void validate_stability_options(const StabilityOptions& options, const std::stri
 
 void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
                             const std::string& where) {
-  const auto problem = make_problem(problem_spec);
+  check_stability_budget(*parse_problem(problem_spec), problem_spec, options, where);
+}
+
+void check_stability_budget(const Problem& problem, const std::string& problem_spec,
+                            const StabilityOptions& options, const std::string& where) {
   double horizon = 0, h_lo = 0, h_hi = 0;
   try {
-    resolve(*problem, options, &horizon, &h_lo, &h_hi);
+    resolve(problem, options, &horizon, &h_lo, &h_hi);
   } catch (const InputError& error) {
     throw InputError(fmt::format("{}: {}", where, error.what()));
   }
@@ -150,11 +155,16 @@ void check_stability_budget(const std::string& problem_spec, const StabilityOpti
 
 StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
                                  const StabilityOptions& options) {
+  return stability_search(*parse_problem(problem_spec), MethodFactory(method_spec), options);
+}
+
+StabilityResult stability_search(const Problem& problem_ref, const MethodFactory& method,
+                                 const StabilityOptions& options) {
+  const Problem* problem = &problem_ref;
   validate_stability_options(options, "stability");
-  check_stability_budget(problem_spec, options, "stability");
-  const auto problem = make_problem(problem_spec);
-  const auto integrator = make_integrator(method_spec);
-  const MethodInfo info = integrator->info();
+  check_stability_budget(*problem, problem->spec(), options, "stability");
+  const Integrator* integrator = &method.prototype();
+  const MethodInfo& info = method.info();
   if (info.flags & kAdaptive) {
     throw InputError(fmt::format(
         "method '{}' is adaptive: a stability search needs a fixed-step method", info.name));
@@ -167,7 +177,7 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
   const double omega = problem_omega(*problem);
   // Reported in h·ω when ω is known, in h otherwise.
   const double unit = omega > 0 ? omega : 1.0;
-  Search search{*problem, integrator->spec(), options, horizon};
+  Search search{*problem, method, options, horizon};
 
   // Geometric scan from the bottom of the range; the last point is h_hi itself.
   std::vector<double> grid;

@@ -8,8 +8,11 @@
 #include <vector>
 
 #include "harness/table.hpp"
+#include "problems/problem.hpp"
 
 namespace geomint {
+
+class MethodFactory;  // harness/run_spec.hpp
 
 // What one `[[stability]]` scene block (or one test) asks for. The search range is given in
 // h·ω (ω = the problem's omega_max at its initial state) or, for problems without omega_max, in
@@ -45,6 +48,9 @@ struct StabilityResult {
 // Scans h·ω geometrically from the bottom of the range, bisects between the last stable and the
 // first unstable point, and records whether a larger point of the scan is stable again
 // (non-monotone stability). Throws InputError for adaptive methods, bad ranges or bad specs.
+StabilityResult stability_search(const Problem& problem, const MethodFactory& method,
+                                 const StabilityOptions& options);
+// The same from spec strings (the scene reader, tests).
 StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
                                  const StabilityOptions& options);
 
@@ -66,6 +72,9 @@ void validate_stability_options(const StabilityOptions& options, const std::stri
 // search that would run for days is rejected when the scene is loaded.
 void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
                             const std::string& where);
+// The same for a problem object; `problem_spec` is the spelling the messages name.
+void check_stability_budget(const Problem& problem, const std::string& problem_spec,
+                            const StabilityOptions& options, const std::string& where);
 
 // Columns of stability.csv, in order.
 const std::vector<std::string>& stability_columns();

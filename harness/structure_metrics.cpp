@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "harness/metrics.hpp"
+#include "harness/run_spec.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -176,7 +177,12 @@ double symplecticity_defect(const Eigen::MatrixXd& tangent) {
 
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,
                             const State& state, double h) {
-  const auto method = make_integrator(method_spec);
+  return symplecticity_defect(MethodFactory(method_spec), problem, state, h);
+}
+
+double symplecticity_defect(const MethodFactory& factory, const Problem& problem,
+                            const State& state, double h) {
+  const auto method = factory.make();
   if (!symplecticity_defect_applies(*method, problem)) return kNaN;
   State start = state;
   method->reset(problem, start, h);
@@ -251,7 +257,12 @@ double rayleigh_quotient(const SparseMatrix& stiffness, const Vec& mass, const V
 
 std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
                                                 const Problem& problem, double h) {
-  const auto method = make_integrator(method_spec);
+  return discrete_normal_modes(MethodFactory(method_spec), problem, h);
+}
+
+std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
+                                                const Problem& problem, double h) {
+  const auto method = factory.make();
   if (!normal_modes_not_applicable(*method, problem).empty()) return {};
   State state = problem.initial_state();
   method->reset(problem, state, h);
@@ -270,7 +281,7 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
   // Entries of the projected blocks carry rounding of about n ε ‖DΦ‖; a block of the modal
   // oscillator further away than this bound means the method is no function of hM⁻¹K.
   const double block_tolerance = 1e-8 * std::max(1.0, tangent.cwiseAbs().maxCoeff());
-  const auto modal_method = make_integrator(method_spec);
+  const auto modal_method = factory.make();
   std::vector<DiscreteMode> modes;
   for (long j = 0; j < n; ++j) {
     const double x_x = modal_q.row(j) * tangent.topLeftCorner(n, n) * shapes.col(j);
@@ -303,10 +314,17 @@ std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
 void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics) {
+  if (!requested(names, metric::mode_freq_err_max) && !requested(names, metric::mode_damping_max)) return;
+  add_normal_mode_metrics(MethodFactory(method_spec), problem, h, names, metrics);
+}
+
+void add_normal_mode_metrics(const MethodFactory& factory, const Problem& problem, double h,
+                             const std::vector<std::string>& names,
+                             std::map<std::string, double>& metrics) {
   const bool frequency = requested(names, metric::mode_freq_err_max);
   const bool damping = requested(names, metric::mode_damping_max);
   if (!frequency && !damping) return;
-  const std::vector<DiscreteMode> modes = discrete_normal_modes(method_spec, problem, h);
+  const std::vector<DiscreteMode> modes = discrete_normal_modes(factory, problem, h);
   if (modes.empty()) return;
   // Rigid modes (ω = 0 to rounding, a free chain's translation) have no relative error.
   const double rigid = 1e-8 * modes.back().omega;

@@ -14,6 +14,11 @@
 
 namespace geomint {
 
+class MethodFactory;  // harness/run_spec.hpp
+
+// The metrics below that take a MethodFactory run fresh integrators from it; their spec-string
+// forms parse the spec once and call them (the command line, tests).
+
 // The names accepted by --metric / implied by table_columns; "period_measured" also reports
 // period_err_rel.
 const std::vector<std::string>& optional_metric_names();
@@ -25,6 +30,8 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 // linearised step (Integrator::step_tangent, integrators/tangent.hpp) taken by a fresh integrator
 // from a reset at `state`, never a difference quotient; NaN when the step fails. Its floor (round
 // off, docs/USAGE.md "Optional structure metrics") is measured by tests/structure_metrics_test.cpp.
+double symplecticity_defect(const MethodFactory& method, const Problem& problem, const State& state,
+                            double h);
 double symplecticity_defect(const std::string& method_spec, const Problem& problem,
                             const State& state, double h);
 // The same defect of a given 2n×2n DΦ.
@@ -62,10 +69,15 @@ std::string normal_modes_not_applicable(const Integrator& method, const Problem&
 // of the dense eigenvector, and each block is the method's step on the mode's own oscillator
 // (unit mass, stiffness ω²) unless that differs from the projected block (then the projected
 // one). Empty when not applicable or the step fails.
+std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& method, const Problem& problem,
+                                                double h);
 std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
                                                 const Problem& problem, double h);
 // mode_freq_err_max = max over modes with ω > 0 of |ω̃ − ω|/ω, mode_damping_max = max |ρ − 1|;
 // added to `metrics` when asked for in `names` and applicable.
+void add_normal_mode_metrics(const MethodFactory& method, const Problem& problem, double h,
+                             const std::vector<std::string>& names,
+                             std::map<std::string, double>& metrics);
 void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics);

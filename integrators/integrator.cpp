@@ -51,22 +51,41 @@ void register_method(IntegratorEntry entry) {
   entries.push_back(std::move(entry));
 }
 
-std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {
-  const Spec spec = Spec::parse(spec_text);
+namespace {
+// The registry entry named by `spec`; InputError listing the valid names otherwise.
+const IntegratorEntry& find_method(const Spec& spec) {
   std::vector<std::string> names;
   for (const auto& entry : integrator_registry()) {
-    if (entry.name != spec.name) {
-      names.push_back(entry.name);
-      continue;
-    }
-    Params params(spec, fmt::format("method '{}'", spec.name));
-    auto integrator = entry.factory(params);
-    params.finish();
-    integrator->spec_ = params.canonical();
-    return integrator;
+    if (entry.name == spec.name) return entry;
+    names.push_back(entry.name);
   }
   throw InputError(
       fmt::format("unknown method '{}' (valid: {})", spec.name, fmt::join(names, ", ")));
+}
+}  // namespace
+
+std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {
+  const Spec spec = Spec::parse(spec_text);
+  const IntegratorEntry& entry = find_method(spec);
+  Params params(spec, fmt::format("method '{}'", spec.name));
+  auto integrator = entry.factory(params);
+  params.finish();
+  integrator->spec_ = params.canonical();
+  return integrator;
+}
+
+IntegratorMaker integrator_maker(const std::string& spec_text) {
+  // Building one integrator checks every key and value and gives the canonical spec; later
+  // integrators reuse the parsed spec and the entry's factory.
+  const std::string canonical = make_integrator(spec_text)->spec();
+  const Spec spec = Spec::parse(spec_text);
+  const auto factory = find_method(spec).factory;
+  return [spec, factory, canonical] {
+    Params params(spec, fmt::format("method '{}'", spec.name));
+    auto integrator = factory(params);
+    integrator->spec_ = canonical;
+    return integrator;
+  };
 }
 
 std::vector<std::string> integrator_test_specs() {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -162,6 +163,10 @@ struct Counters {
   long rejected = 0;        // rejected steps (adaptive solvers)
 };
 
+class Integrator;
+// Makes a fresh integrator of one parsed method spec (integrator_maker, below).
+using IntegratorMaker = std::function<std::unique_ptr<Integrator>()>;
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
@@ -246,6 +251,7 @@ class Integrator {
   Vec extra_force_;  // eval_total_force's F(q, v, t), kept to avoid an allocation per call
   Vec kick_velocity_, kick_change_;  // solve_force_kick's next iterate and its change
   friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
+  friend IntegratorMaker integrator_maker(const std::string& spec_text);
   std::string spec_;
 };
 
@@ -279,6 +285,9 @@ StepStatus too_much_accuracy(const std::string& reason, const std::string& metho
 
 // Registry (integrators/registry.def). Throws InputError for unknown names/keys/values.
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
+// The same check, once: a callable that makes fresh integrators of this spec from the parsed
+// text and the registry entry found for it (repeated runs build from the parse, not the text).
+IntegratorMaker integrator_maker(const std::string& spec_text);
 
 // `max_iter` of an implicit base method (its Newton iterations per solve), read from the wrapping
 // method's `params` and appended to `base_spec` (a name at its defaults); 0 leaves the base's own

@@ -311,6 +311,12 @@ const std::vector<Case>& cases() {
       {"EveryZero",
        "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --series {dir}/s.csv --every 0", 2,
        "--every"},
+      // --- every error at once (RunSpec::validate): the second error is named too ---
+      {"RunListsEveryError",
+       "run --problem pendulum --method rk4 --dt -0.1 --t-end 1 --series {dir}/s.csv --every 0", 2,
+       "--every"},
+      {"OrderListsEveryError",
+       "order --problem pendulum --method rk4 --dt -0.1 --levels 2 --t-end 1", 2, "--dt"},
       {"ReferenceEveryZero", "reference --problem pendulum --t-end 1 --every 0 --out {dir}/r.csv",
        2, "--every"},
       {"ReferenceEveryNegative",

@@ -10,6 +10,7 @@
 #include "harness/map_defect.hpp"
 #include "harness/order.hpp"
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint::verify {
@@ -31,13 +32,13 @@ CheckResult not_declared(const char* check, const std::string& method, const cha
   return result;
 }
 
-RunResult run_untimed(const std::string& problem, const std::string& method, double dt,
-                      double t_end) {
+RunResult run_untimed(std::shared_ptr<const Problem> problem, const MethodFactory& method,
+                      double dt, double t_end) {
   RunConfig config;
   config.dt = dt;
   config.t_end = t_end;
   config.timing_repeats = 0;
-  return run_one(problem, method, config);
+  return run_one(RunSpec{std::move(problem), method, config});
 }
 
 }  // namespace
@@ -58,7 +59,8 @@ Ladder kepler_ladder() { return {"kepler:e=0.6", 0.02, 7, 5.0}; }
 
 CheckResult declared_order(const std::string& method, const Ladder& ladder, double tolerance) {
   CheckResult result = start("declared_order", method, ladder.problem);
-  const int declared = make_integrator(method)->info().order;
+  const MethodFactory factory(method);
+  const int declared = factory.info().order;
   result.bound = declared;
   // On Kepler the round-off plateau sits near 1e-13, above the fit's plateau floor, so a finest
   // point there would bend the slope: hence fewer levels for the high orders.
@@ -68,7 +70,8 @@ CheckResult declared_order(const std::string& method, const Ladder& ladder, doub
   const int levels = declared >= 6   ? ladder.levels - 2
                      : declared <= 1 ? ladder.levels + 2
                                      : ladder.levels;
-  const OrderStudy study = order_study(ladder.problem, method, dt0, levels, ladder.t_end);
+  const OrderStudy study =
+      order_study(parse_problem(ladder.problem), factory, dt0, levels, ladder.t_end);
   result.measured = study.fit.order;
   if (!std::isfinite(study.fit.order)) {
     result.detail = "no order could be fitted: " + study.fit.note;
@@ -86,9 +89,10 @@ CheckResult energy_without_drift(const std::string& method, const std::string& p
   result.bound = 0.1;
   // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
   // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
-  const double dt = make_integrator(method)->info().order >= 6 ? 0.2 : 0.05;
+  const MethodFactory factory(method);
+  const double dt = factory.info().order >= 6 ? 0.2 : 0.05;
   const double t_end = steps * dt;
-  const RunResult run = run_untimed(problem, method, dt, t_end);
+  const RunResult run = run_untimed(parse_problem(problem), factory, dt, t_end);
   if (!run.ok) {
     result.measured = INFINITY;
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
@@ -106,8 +110,9 @@ CheckResult energy_without_drift(const std::string& method, const std::string& p
 CheckResult symplectic_map(const std::string& method, const std::string& problem_spec, double h) {
   CheckResult result = start("symplectic_map", method, problem_spec);
   result.bound = 1;
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
+  const auto problem = parse_problem(problem_spec);
+  const MethodFactory factory(method);
+  auto integrator = factory.make();
   if (const std::string why = map_defect_not_applicable(*integrator, *problem, h); !why.empty()) {
     result.applies = false;
     result.passed = true;
@@ -123,7 +128,7 @@ CheckResult symplectic_map(const std::string& method, const std::string& problem
   result.measured = 0;
   for (int k = 0; k <= 20; ++k) {
     if (k % 10 == 0) {
-      const MapDefect at = symplecticity_defect_map(method, *problem, state, h);
+      const MapDefect at = symplecticity_defect_map(factory, *problem, state, h);
       if (!(at.defect >= 0)) {
         result.measured = INFINITY;
         result.detail =
@@ -151,8 +156,8 @@ CheckResult symplectic_map(const std::string& method, const std::string& problem
 
 double reversibility_defect(const std::string& method, const std::string& problem_spec, double h,
                             int steps) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
+  const auto problem = parse_problem(problem_spec);
+  auto integrator = MethodFactory(method).make();
   const State initial = problem->initial_state();
   State state = initial;
   integrator->reset(*problem, state, h);
@@ -181,8 +186,8 @@ CheckResult reversible(const std::string& method, const std::string& problem, do
 
 MomentumErrors momentum_errors(const std::string& method, const std::string& problem_spec, double h,
                                int steps) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
+  const auto problem = parse_problem(problem_spec);
+  auto integrator = MethodFactory(method).make();
   State state = problem->initial_state();
   const Vec linear0 = problem->linear_momentum(state.q, state.p);
   const Vec angular0 = problem->angular_momentum(state.q, state.p);
@@ -221,7 +226,7 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
                             double steps_per_unit, double units, double bound) {
   CheckResult result = start("constraint_kept", method, problem_spec);
   result.bound = bound;
-  const auto problem = make_problem(problem_spec);
+  const auto problem = parse_problem(problem_spec);
   const State initial = problem->initial_state();
   // g is a length error and G M⁻¹p a rate of one: measured against the configuration's size and
   // the speed (set by gravity, length per 100 default steps, when released from rest).
@@ -230,7 +235,8 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
       std::max(problem->inverse_mass().cwiseProduct(initial.p).lpNorm<Eigen::Infinity>(),
                length / (problem->default_dt() * 100));
   const double unit = length / speed;
-  const RunResult run = run_untimed(problem_spec, method, unit / steps_per_unit, unit * units);
+  const RunResult run =
+      run_untimed(problem, MethodFactory(method), unit / steps_per_unit, unit * units);
   if (!run.ok) {
     result.measured = INFINITY;
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
@@ -247,8 +253,8 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
 
 double conserved_momentum_error(const std::string& method, const std::string& problem_spec,
                                 double h, int steps) {
-  const auto problem = make_problem(problem_spec);
-  auto integrator = make_integrator(method);
+  const auto problem = parse_problem(problem_spec);
+  auto integrator = MethodFactory(method).make();
   State state = problem->initial_state();
   std::vector<Vec (Problem::*)(const Vec&, const Vec&) const> maps;
   if (problem->has(kLinearMomentum)) maps.push_back(&Problem::linear_momentum);
@@ -276,7 +282,7 @@ const char* const kChargedParticle = "charged_particle";
 }  // namespace
 
 CheckResult general_check(const std::string& method, const std::string& name) {
-  const unsigned flags = make_integrator(method)->info().flags;
+  const unsigned flags = MethodFactory(method).info().flags;
   if (!(flags & kGeneralLagrangian))
     return not_declared(name.c_str(), method, "general-Lagrangian");
   if (name == "declared_order_general") {
@@ -332,7 +338,7 @@ std::vector<std::string> check_names() {
 
 CheckResult run_check(const std::string& method, const std::string& name,
                       const std::string& constrained_problem) {
-  const unsigned flags = make_integrator(method)->info().flags;
+  const unsigned flags = MethodFactory(method).info().flags;
   const bool constraints_only = flags & kConstraintsOnly;
   const std::vector<std::string> names = check_names();
   if (name.size() > 8 && name.compare(name.size() - 8, 8, "_general") == 0 &&

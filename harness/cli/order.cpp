@@ -25,12 +25,22 @@ struct OrderOptions {
 
 int run_order(OrderOptions options, const Context& context) {
   add_initial_state(options.problem_spec, options.initial_path);
-  validate_order_study(options.problem_spec, options.method_spec, options.dt0, options.levels,
-                       options.t_end);
-  if (!options.out_path.empty()) check_output_file(options.out_path, "--out");
+  // Spec strings become objects here, once; then every input error is reported together.
+  const auto problem = parse_problem(options.problem_spec);
+  const MethodFactory method(options.method_spec);
+  std::vector<std::string> errors =
+      order_study_errors(*problem, method, options.dt0, options.levels, options.t_end);
+  if (!options.out_path.empty()) {
+    try {
+      check_output_file(options.out_path, "--out");
+    } catch (const InputError& error) {
+      errors.emplace_back(error.what());
+    }
+  }
+  throw_input_errors(errors);
   const OrderStudy study =
-      order_study(options.problem_spec, options.method_spec, options.dt0,
-                  static_cast<int>(options.levels), options.t_end, options.diverge_factor);
+      order_study(problem, method, options.dt0, static_cast<int>(options.levels), options.t_end,
+                  options.diverge_factor);
   for (const auto& run_result : study.runs) {
     const Row row = to_row(run_result.record);
     inform(context,

@@ -9,6 +9,7 @@
 
 #include "harness/cli/verbs.hpp"
 #include "harness/paths.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 #include "harness/table.hpp"
 
@@ -29,14 +30,18 @@ struct RunOptions {
 
 int run_run(RunOptions options, const Context& context) {
   add_initial_state(options.problem_spec, options.initial_path);
-  const auto problem = make_problem(options.problem_spec);
+  // Spec strings become objects here, once; an unknown name, key or value stops at once.
+  RunSpec spec{parse_problem(options.problem_spec), MethodFactory(options.method_spec), {}};
+  std::vector<std::string> errors;
+  // Counted in a long so that a huge value is reported, not wrapped into range.
   if (options.timing_repeats < 0 || options.timing_repeats > kMaxTimingRepeats) {
-    throw InputError(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
+    errors.push_back(fmt::format("--timing-repeats must be in 0..{} (got {})", kMaxTimingRepeats,
                                  options.timing_repeats));
+    options.timing_repeats = 0;
   }
-  RunConfig config;
-  config.dt = options.dt_given ? options.dt : problem->default_dt();
-  config.t_end = options.t_end_given ? options.t_end : problem->default_t_end();
+  RunConfig& config = spec.config;
+  config.dt = options.dt_given ? options.dt : spec.problem->default_dt();
+  config.t_end = options.t_end_given ? options.t_end : spec.problem->default_t_end();
   config.series_path = options.series_path;
   config.series_every = options.every;
   config.series_state = options.series_state;
@@ -47,15 +52,23 @@ int run_run(RunOptions options, const Context& context) {
   config.command_line = context.command_line;
   // Outputs are checked before anything is computed.
   const std::string& out_path = options.out_path;
-  if (!out_path.empty()) check_output_file(out_path, "--out");
+  if (!out_path.empty()) {
+    try {
+      check_output_file(out_path, "--out");
+    } catch (const InputError& error) {
+      errors.emplace_back(error.what());
+    }
+  }
   if (!options.series_path.empty() && !out_path.empty() &&
       same_file_path(options.series_path, out_path)) {
-    throw InputError(
+    errors.push_back(
         fmt::format("--series and --out name the same file '{}' (the summary would overwrite "
                     "the series)",
                     out_path));
   }
-  const RunResult result = run_one(options.problem_spec, options.method_spec, config);
+  for (std::string& error : spec.validate()) errors.push_back(std::move(error));
+  throw_input_errors(errors);
+  const RunResult result = run_one(spec);
   const std::string csv = records_to_csv({result.record}, provenance(context.command_line));
   if (out_path.empty()) {
     std::cout << csv;

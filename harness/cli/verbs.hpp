@@ -3,9 +3,15 @@
 // order here is the order of `geomint --help`.
 #pragma once
 
+#include <vector>
+
 #include "harness/cli/common.hpp"
 
 namespace geomint::cli {
+
+// Adds the exit-code footer and every verb below to `app` in this order, each verb with --quiet
+// bound to `quiet` (harness/cli/app.cpp).
+std::vector<Verb> add_verbs(CLI::App& app, bool& quiet);
 
 Verb add_list(CLI::App& app);
 Verb add_run(CLI::App& app);

@@ -1,0 +1,28 @@
+// The whole command line: the exit-code footer of `geomint --help` and every verb in its order,
+// each with --quiet (run_main dispatches to them).
+#include "harness/cli/verbs.hpp"
+
+namespace geomint::cli {
+
+std::vector<Verb> add_verbs(CLI::App& app, bool& quiet) {
+  app.footer(
+      "Exit codes: 0 ok; 1 a run failed (run), no order could be fitted (order), a gate failed "
+      "(gate) or a benchmark got slower (perf-compare); 2 bad input: the message names the "
+      "offending option, key or value, and nothing is "
+      "written (checked before any computing, outputs included); 3 internal error (\"geomint: "
+      "internal error: ...\"): a defect, or an I/O failure after those checks such as a full "
+      "disk. A numerical failure is a row whose status says what happened; a sweep exits 0 with "
+      "its failures as rows.");
+  // The order of `geomint --help`.
+  std::vector<Verb> verbs = {add_list(app),  add_run(app),    add_order(app),       add_sweep(app),
+                             add_merge(app), add_slurm(app),  add_reference(app),   add_modes(app),
+                             add_gate(app),  add_report(app), add_perf_compare(app)};
+  for (const Verb& verb : verbs) {
+    verb.command->add_flag("--quiet", quiet,
+                           "no progress and no informational lines on stderr (errors are still "
+                           "printed; exit codes unchanged)");
+  }
+  return verbs;
+}
+
+}  // namespace geomint::cli
