@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -167,7 +168,9 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
   const double omega = problem_omega(*problem);
   // Reported in h·ω when ω is known, in h otherwise.
   const double unit = omega > 0 ? omega : 1.0;
-  Search search{*problem, integrator->spec(), options, horizon};
+  // What runs (hp without solver= runs Newton on a non-separable problem): the row names it.
+  const std::string ran_spec = spec_on(*integrator, *problem);
+  Search search{*problem, ran_spec, options, horizon};
 
   // Geometric scan from the bottom of the range; the last point is h_hi itself.
   std::vector<double> grid;
@@ -221,8 +224,8 @@ StabilityResult stability_search(const std::string& problem_spec, const std::str
 
   Row& row = result.row;
   row["problem"] = problem->spec();
-  row["method"] = integrator->spec();
-  const Spec spec = Spec::parse(integrator->spec());
+  row["method"] = ran_spec;
+  const Spec spec = Spec::parse(ran_spec);
   if (spec.values.count("alpha")) row["alpha"] = spec.values.at("alpha");
   row["omega"] = omega > 0 ? format_number(omega) : "";
   row["homega_lo"] = format_number(h_lo * unit);
