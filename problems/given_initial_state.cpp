@@ -83,7 +83,7 @@ class GivenInitialState : public Problem {
 
 // A non-separable problem from a file: the forwarding above plus the base's LagrangianSystem, so
 // that energy(), first_order_rhs() and the general integrators see its M(q), a(q) and V, not the
-// placeholder unit mass (docs/MECHANICS_GENERAL.md, "initial= on non-separable problems").
+// placeholder unit mass (docs/MECHANICS_GENERAL.md §8, the paragraph on initial=).
 class GivenInitialLagrangian final : public GivenInitialState, public LagrangianSystem {
  public:
   GivenInitialLagrangian(std::unique_ptr<Problem> base, State initial)
