@@ -18,6 +18,7 @@
 #include "harness/reference.hpp"
 #include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
+#include "integrators/general_step.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -409,7 +410,10 @@ RunResult run_one(const RunSpec& spec) {
   RunResult result;
   RunRecord& record = result.record;
   record.problem = problem->spec();
-  record.method = integrator->spec();
+  // What runs: hp without solver= runs Newton on a non-separable problem, and its row says so,
+  // so that re-running the row's spec reproduces it (integrators/general_step.hpp).
+  const std::string ran_spec = spec_on(*integrator, *problem);
+  record.method = ran_spec;
   record.family = method_family(info);
   if (!adaptive) record.dt = config.dt;
   record.t_end = config.t_end;
@@ -420,7 +424,7 @@ RunResult run_one(const RunSpec& spec) {
     observers.push_back(std::move(observer));
   }
   if (auto map_defect =
-          make_map_defect_observer(integrator->spec(), *problem, config.dt, config.extra_metrics)) {
+          make_map_defect_observer(ran_spec, *problem, config.dt, config.extra_metrics)) {
     observers.push_back(std::move(map_defect));
   }
   if (auto modified =
@@ -431,7 +435,7 @@ RunResult run_one(const RunSpec& spec) {
                                              config.extra_metrics)) {
     observers.push_back(std::move(step_map));
   }
-  if (auto chaos = make_chaos_observer(integrator->spec(), *problem, config.extra_metrics)) {
+  if (auto chaos = make_chaos_observer(ran_spec, *problem, config.extra_metrics)) {
     observers.push_back(std::move(chaos));
   }
   if (problem->has(kExact)) {
@@ -454,7 +458,7 @@ RunResult run_one(const RunSpec& spec) {
   }
   std::unique_ptr<SeriesWriter> series;
   if (!config.series_path.empty()) {
-    series = std::make_unique<SeriesWriter>(*problem, config, integrator->spec());
+    series = std::make_unique<SeriesWriter>(*problem, config, ran_spec);
   }
   State state = problem->initial_state();
   for (auto& observer : observers) observer->begin(*problem, state, config.t_end);

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "harness/run_spec.hpp"
+#include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
@@ -177,6 +178,8 @@ StabilityResult stability_search(const Problem& problem_ref, const MethodFactory
   const double omega = problem_omega(*problem);
   // Reported in h·ω when ω is known, in h otherwise.
   const double unit = omega > 0 ? omega : 1.0;
+  // What runs (hp without solver= runs Newton on a non-separable problem): the row names it.
+  const std::string ran_spec = spec_on(*integrator, *problem);
   Search search{*problem, method, options, horizon};
 
   // Geometric scan from the bottom of the range; the last point is h_hi itself.
@@ -231,8 +234,8 @@ StabilityResult stability_search(const Problem& problem_ref, const MethodFactory
 
   Row& row = result.row;
   row["problem"] = problem->spec();
-  row["method"] = integrator->spec();
-  const Spec spec = Spec::parse(integrator->spec());
+  row["method"] = ran_spec;
+  const Spec spec = Spec::parse(ran_spec);
   if (spec.values.count("alpha")) row["alpha"] = spec.values.at("alpha");
   row["omega"] = omega > 0 ? format_number(omega) : "";
   row["homega_lo"] = format_number(h_lo * unit);

@@ -20,6 +20,15 @@ double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoe
 
 }  // namespace
 
+std::string spec_on(const Integrator& method, const Problem& problem) {
+  if (is_non_separable(problem)) {
+    if (const auto* resolves = dynamic_cast<const ResolvesOnGeneralLagrangian*>(&method)) {
+      return resolves->general_lagrangian_spec();
+    }
+  }
+  return method.spec();
+}
+
 StepStatus general_del_step(const LagrangianSystem& system, State& state, double h, double alpha,
                             const GeneralNewtonSettings& newton, Counters& counters) {
   const Vec q0 = state.q;

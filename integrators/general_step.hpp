@@ -24,6 +24,20 @@ class ExplainsGeneralRefusal {
   virtual std::string general_lagrangian_refusal() const = 0;
 };
 
+// A method whose options resolve differently on a non-separable problem derives from this too:
+// `hp` without solver= runs the Newton step there (its minimiser has no objective), so a row must
+// name hp:…,solver=newton, not the separable default solver=minimize that its spec() reads —
+// otherwise re-running the row's spec is refused. Returns the canonical spec of what runs.
+class ResolvesOnGeneralLagrangian {
+ public:
+  virtual ~ResolvesOnGeneralLagrangian() = default;
+  virtual std::string general_lagrangian_spec() const = 0;
+};
+
+// The canonical spec of what `method` runs on `problem`, the one a result row records: spec(),
+// or on a non-separable problem the ResolvesOnGeneralLagrangian spec where the method has one.
+std::string spec_on(const Integrator& method, const Problem& problem);
+
 // The registry's test specs flagged kGeneralLagrangian (for refusal messages and tests).
 std::vector<std::string> general_lagrangian_methods();
 

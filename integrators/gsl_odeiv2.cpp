@@ -12,6 +12,7 @@
 
 #include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/lagrangian.hpp"
 
 namespace geomint {
 namespace {
@@ -47,12 +48,16 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
         // Sees only first_order_rhs: runs the general kind too (Hamilton's equations of its L).
         return {"gsl_rk8pd", 8, kExplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
                 "GSL odeiv2 rk8pd: embedded Runge-Kutta Prince-Dormand (8, 9)"};
+      // msbdf and rk4imp take the Jacobian of first_order_rhs, which a non-separable problem
+      // gives analytically (Hamilton's equations of its L, docs/MECHANICS_GENERAL.md §1).
       case GslMethod::kMsbdf:
         // Variable order 1..5: the declared order is the maximum.
-        return {"gsl_msbdf", 5, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
+        return {"gsl_msbdf", 5,
+                kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable | kGeneralLagrangian,
                 "GSL odeiv2 msbdf: variable-order BDF in Nordsieck form (Byrne & Hindmarsh)"};
       case GslMethod::kRk4imp:
-        return {"gsl_rk4imp", 4, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
+        return {"gsl_rk4imp", 4,
+                kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable | kGeneralLagrangian,
                 "GSL odeiv2 rk4imp: 2-stage Gauss-Legendre implicit Runge-Kutta, step doubling"};
     }
     return {};
@@ -65,7 +70,7 @@ class GslOdeiv2 final : public AdaptiveIntegrator {
     ydot_start_.resize(y_.size());
     problem.pack_first_order(state, y_.data());
     const bool needs_jacobian = method_ != GslMethod::kRk8pd;
-    if (needs_jacobian && !problem.has_first_order_jacobian()) {
+    if (needs_jacobian && !has_analytic_first_order_jacobian(problem)) {
       setup_status_ = StepStatus::failure(
           "needs_hessian",
           fmt::format("{} needs the Jacobian, i.e. a problem Hessian", info().name));

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
@@ -69,7 +70,9 @@ namespace {
 // Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
 // G(q_k)ᵀΛ and g(q_k + hv) = 0, solved by integrators/constrained_step.hpp, then p_{k+1}
 // projected onto the tangent space at q_{k+1}.
-class HamiltonPontryagin final : public Integrator, public ExplainsGeneralRefusal {
+class HamiltonPontryagin final : public Integrator,
+                                 public ExplainsGeneralRefusal,
+                                 public ResolvesOnGeneralLagrangian {
  public:
   HamiltonPontryagin(double alpha, bool minimize, bool minimize_written, Forcing forcing,
                      const NewtonOptions& newton)
@@ -103,6 +106,17 @@ class HamiltonPontryagin final : public Integrator, public ExplainsGeneralRefusa
            "general L(q, v) it is not (its Jacobian L_vv + h(alpha L_vq - (1-alpha) L_qv) - "
            "alpha(1-alpha)h^2 L_qq is not symmetric); hp:solver=newton or hp without solver= "
            "runs it";
+  }
+
+  // Without solver= the general step is Newton's (general_step below, same tol and max_iter):
+  // the canonical spec with solver=newton runs the same step, bit for bit.
+  std::string general_lagrangian_spec() const override {
+    if (!minimize_ || minimize_written_) return spec();
+    Spec resolved = Spec::parse(spec());
+    resolved.values["solver"] = "newton";
+    std::vector<std::string> options;
+    for (const auto& [key, value] : resolved.values) options.push_back(key + "=" + value);
+    return make_integrator(fmt::format("{}:{}", resolved.name, fmt::join(options, ",")))->spec();
   }
 
   void reset(const Problem& problem, const State& state, double h) override {

@@ -266,7 +266,11 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                                method.spec(), problem.name())};
   }
   if ((info.flags & kConservativeOnly) && problem.has(kForce)) {
-    return {false, fmt::format("method '{}' integrates separable conservative systems only; "
+    // The flag says the step is the flow of a Hamiltonian with no term for a force; whether the
+    // method also needs a separable H is a different requirement (kGeneralLagrangian, above):
+    // generalized_leapfrog and tao run non-separable H but no forced problem.
+    return {false, fmt::format("method '{}' integrates conservative systems only (its step "
+                               "follows a Hamiltonian H(q, p) and has no term for a force); "
                                "problem '{}' has a non-conservative force F(q, v, t) (damping, "
                                "driving or a modulation); methods without the flag "
                                "conservative_only take it",

@@ -22,6 +22,7 @@
 
 #include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/lagrangian.hpp"
 
 namespace geomint {
 namespace {
@@ -171,7 +172,8 @@ class OdeintDopri5 final : public OdeintAdaptive {
 };
 
 // Shampine's 4th-order Rosenbrock method with its embedded 3rd-order error estimate; the
-// Jacobian comes from the problem (so the problem needs a Hessian). Each attempt factorises
+// Jacobian comes from the problem (a Hessian, or on a non-separable problem the analytic
+// Jacobian of Hamilton's equations of its L, docs/MECHANICS_GENERAL.md §1). Each attempt factorises
 // I/(γh) − J once and back-substitutes six times (rosenbrock4.hpp, do_step).
 class OdeintRosenbrock4 final : public OdeintAdaptive {
  public:
@@ -182,13 +184,14 @@ class OdeintRosenbrock4 final : public OdeintAdaptive {
   explicit OdeintRosenbrock4(const AdaptiveSettings& settings) : OdeintAdaptive(settings) {}
 
   MethodInfo info() const override {
-    return {"odeint_rosenbrock4", 4, kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable,
+    return {"odeint_rosenbrock4", 4,
+            kImplicit | kAdaptive | kNeedsHessian | kFirstOrderCapable | kGeneralLagrangian,
             "Boost.Odeint rosenbrock4, controlled (Shampine 1982; Hairer & Wanner II, §IV.7)"};
   }
 
   void reset(const Problem& problem, const State& state, double h) override {
     begin(problem, state, h);
-    if (setup_status_.ok && !problem.has_first_order_jacobian()) {
+    if (setup_status_.ok && !has_analytic_first_order_jacobian(problem)) {
       setup_status_ = StepStatus::failure(
           "needs_hessian", "odeint_rosenbrock4 needs the Jacobian, i.e. a problem Hessian");
     }

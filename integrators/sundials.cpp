@@ -277,7 +277,13 @@ class Cvode final : public SundialsIntegrator {
         !check_setup(CVodeSetMaxNonlinIters(cvode, max_nonlin_iters_), "CVodeSetMaxNonlinIters")) {
       return;
     }
-    const bool analytic = problem.has_first_order_jacobian();
+    // The dense path takes the analytic Jacobian where the problem has a Hessian (or rhs_jacobian)
+    // and CVODE's difference quotient otherwise, a non-separable problem included (its committed
+    // rows, results/charged_particle, were measured so). KLU needs the matrix itself, which a
+    // non-separable problem gives analytically: the Jacobian of Hamilton's equations of its L.
+    const bool analytic = solver_kind_ == LinearSolverKind::kKlu
+                              ? has_analytic_first_order_jacobian(problem)
+                              : problem.has_first_order_jacobian();
     analytic_jacobian_ = analytic;
     if (solver_kind_ == LinearSolverKind::kKlu) {
       if (!analytic) {
@@ -455,7 +461,9 @@ class Ida final : public SundialsIntegrator {
 
   MethodInfo info() const override {
     if (index_ == 0) {
-      return {"ida", max_order_, kImplicit | kAdaptive | kFirstOrderCapable,
+      // y' − f(t, y) = 0 sees only first_order_rhs and its Jacobian: on a non-separable problem
+      // Hamilton's equations of its L (docs/MECHANICS_GENERAL.md §1), with the analytic Jacobian.
+      return {"ida", max_order_, kImplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
               "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
     }
     return {"ida", max_order_, kImplicit | kAdaptive | kConstrained | kConstraintsOnly | kRheonomic,
@@ -512,7 +520,7 @@ class Ida final : public SundialsIntegrator {
                      "IDASetLinearSolver")) {
       return;
     }
-    analytic_jacobian_ = index_ == 0 && problem.has_first_order_jacobian();
+    analytic_jacobian_ = index_ == 0 && has_analytic_first_order_jacobian(problem);
     if (analytic_jacobian_) check_setup(IDASetJacFn(ida, &jacobian), "IDASetJacFn");
   }
 

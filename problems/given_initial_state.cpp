@@ -4,6 +4,7 @@
 // the exact solution and period, which belong to the problem's own start.
 #include <fmt/format.h>
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -14,7 +15,7 @@
 namespace geomint {
 namespace {
 
-class GivenInitialState final : public Problem {
+class GivenInitialState : public Problem {
  public:
   GivenInitialState(std::unique_ptr<Problem> base, State initial)
       : base_(std::move(base)), initial_(std::move(initial)) {
@@ -72,10 +73,68 @@ class GivenInitialState final : public Problem {
     base_->series_values(q, p, values);
   }
 
+ protected:
+  const Problem& base() const { return *base_; }
+
  private:
   std::unique_ptr<Problem> base_;
   State initial_;
 };
+
+// A non-separable problem from a file: the forwarding above plus the base's LagrangianSystem, so
+// that energy(), first_order_rhs() and the general integrators see its M(q), a(q) and V, not the
+// placeholder unit mass (docs/MECHANICS_GENERAL.md §8, the paragraph on initial=).
+class GivenInitialLagrangian final : public GivenInitialState, public LagrangianSystem {
+ public:
+  GivenInitialLagrangian(std::unique_ptr<Problem> base, State initial)
+      : GivenInitialState(std::move(base), std::move(initial)),
+        system_(*general_lagrangian(GivenInitialState::base())) {}
+
+  void mass_matrix(const Vec& q, DenseMatrix& M) const override { system_.mass_matrix(q, M); }
+  void kinetic_gradient(const Vec& q, const Vec& v, Vec& T_q) const override {
+    system_.kinetic_gradient(q, v, T_q);
+  }
+  void mass_velocity_jacobian(const Vec& q, const Vec& v, DenseMatrix& D) const override {
+    system_.mass_velocity_jacobian(q, v, D);
+  }
+  void kinetic_hessian(const Vec& q, const Vec& v, DenseMatrix& T_qq) const override {
+    system_.kinetic_hessian(q, v, T_qq);
+  }
+  void gyroscopic(const Vec& q, Vec& a) const override { system_.gyroscopic(q, a); }
+  void gyroscopic_jacobian(const Vec& q, DenseMatrix& A) const override {
+    system_.gyroscopic_jacobian(q, A);
+  }
+  void gyroscopic_hessian(const Vec& q, const Vec& v, DenseMatrix& a_qq) const override {
+    system_.gyroscopic_hessian(q, v, a_qq);
+  }
+  // One override each for Problem's and LagrangianSystem's V and ∇V (the same functions).
+  double potential(const Vec& q) const override { return system_.potential(q); }
+  void gradient(const Vec& q, Vec& g) const override { system_.gradient(q, g); }
+  void potential_hessian(const Vec& q, DenseMatrix& K) const override {
+    system_.potential_hessian(q, K);
+  }
+
+ private:
+  const LagrangianSystem& system_;
+};
+
+// A start where M(q) is not positive definite (a coordinate singularity: the spherical pendulum's
+// pole in angles, r = 0 in polar coordinates) has no velocity v = M⁻¹(p − a): an input error, as
+// for the problems' own parameters, rather than a NaN first step.
+void check_general_start(const LagrangianSystem& system, const Problem& problem, const State& state,
+                         const std::string& path) {
+  DenseMatrix M;
+  system.mass_matrix(state.q, M);
+  Eigen::LLT<DenseMatrix> cholesky(M);
+  if (!M.allFinite() || cholesky.info() != Eigen::Success ||
+      !std::isfinite(system.hamiltonian(state.q, state.p))) {
+    throw InputError(fmt::format(
+        "initial state: {}: the mass matrix M(q) of problem '{}' is not positive definite at the "
+        "given q (a coordinate singularity, such as a pole of the angles or r = 0); allowed: a q "
+        "where M(q) is positive definite",
+        path, problem.spec()));
+  }
+}
 
 // Rows "q,p" (or "q,v" when the header says v), one per degree of freedom in the problem's
 // order; an optional header line "q,p" or "q,v"; blank lines and '#' comments skipped.
@@ -129,7 +188,13 @@ State read_initial_state(const Problem& problem, const std::string& path) {
   state.t = problem.initial_state().t;
   state.q = Eigen::Map<const Vec>(first.data(), n);
   state.p = Eigen::Map<const Vec>(second.data(), n);
-  if (velocities) state.p = problem.mass().cwiseProduct(state.p);
+  // Canonical p = M(q)v + a(q) (a constant diagonal M and a = 0 on a separable problem).
+  if (const LagrangianSystem* system = general_lagrangian(problem)) {
+    if (velocities) state.p = system->momentum(state.q, state.p);
+    check_general_start(*system, problem, state, path);
+  } else if (velocities) {
+    state.p = problem.mass().cwiseProduct(state.p);
+  }
   return state;
 }
 
@@ -143,15 +208,10 @@ std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> proble
                     "initial= (q,p rows) applies to Lagrangian problems only",
                     problem->name()));
   }
-  // The forwarding wrapper has no LagrangianSystem: a non-separable problem would silently run
-  // with its placeholder unit mass.
-  if (is_non_separable(*problem)) {
-    throw InputError(
-        fmt::format("initial state: problem '{}' has a position-dependent mass M(q) "
-                    "(non_separable); initial= applies to constant-mass problems only",
-                    problem->name()));
-  }
   State initial = read_initial_state(*problem, path);
+  if (is_non_separable(*problem)) {
+    return std::make_unique<GivenInitialLagrangian>(std::move(problem), std::move(initial));
+  }
   return std::make_unique<GivenInitialState>(std::move(problem), std::move(initial));
 }
 

@@ -98,6 +98,15 @@ inline bool is_non_separable(const Problem& problem) {
   return general_lagrangian(problem) != nullptr;
 }
 
+// Whether Problem::first_order_jacobian is analytic: a Hessian or a first-order rhs_jacobian
+// (Problem::has_first_order_jacobian), or — on a non-separable problem — the Hamiltonian vector
+// field's Jacobian of §1 of docs/MECHANICS_GENERAL.md, which every LagrangianSystem has (its
+// second-derivative blocks). The solvers that cannot run without a Jacobian (GSL msbdf/rk4imp,
+// odeint rosenbrock4, CVODE's KLU path) and IDA ask this, not has_first_order_jacobian().
+inline bool has_analytic_first_order_jacobian(const Problem& problem) {
+  return problem.has_first_order_jacobian() || is_non_separable(problem);
+}
+
 // The problem's own LagrangianSystem when it is non-separable, otherwise the SeparableLagrangian
 // adapter (the problem must outlive the view).
 std::shared_ptr<const LagrangianSystem> lagrangian_view(const Problem& problem);

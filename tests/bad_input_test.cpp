@@ -107,7 +107,8 @@ const std::vector<Case>& cases() {
       {"SprkUnknownTable", "run --problem kepler --method sprk:table=mclachlan7 --dt 0.1 --t-end 1",
        2, "table='mclachlan7' is not allowed (allowed: euler1"},
       {"SprkWithAForce", "run --problem damped_oscillator --method sprk --dt 0.1 --t-end 1", 2,
-       "integrates separable conservative systems only; problem 'damped_oscillator'"},
+       "integrates conservative systems only (its step follows a Hamiltonian H(q, p) and has no "
+       "term for a force); problem 'damped_oscillator'"},
       {"QuaternionOnHeavyTop", "run --problem heavy_top --method quaternion --dt 0.1 --t-end 1", 2,
        "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
       {"QuaternionUnknownBase",
@@ -151,9 +152,13 @@ const std::vector<Case>& cases() {
        "run --problem double_pendulum --method tao:omega=-1 --dt 0.01 --t-end 1", 2, ">= 0"},
       {"TaoOnConstrainedProblem", "run --problem rod_chain --method tao --dt 0.01 --t-end 1", 2,
        "does not handle holonomic constraints"},
+      // The reason is the force, not separability (the leapfrog runs non-separable H).
       {"LeapfrogOnForcedProblem",
        "run --problem damped_oscillator --method generalized_leapfrog --dt 0.01 --t-end 1", 2,
-       "non-conservative force"},
+       "integrates conservative systems only (its step follows a Hamiltonian H(q, p) and has no "
+       "term for a force); problem 'damped_oscillator' has a non-conservative force"},
+      {"TaoOnForcedProblem", "run --problem damped_oscillator --method tao --dt 0.01 --t-end 1", 2,
+       "integrates conservative systems only (its step follows a Hamiltonian H(q, p)"},
       {"LeapfrogZeroIterations",
        "run --problem double_pendulum --method generalized_leapfrog:max_iter=0 --dt 0.01 --t-end 1",
        2, "max_iter=0 is out of range"},
@@ -182,11 +187,21 @@ const std::vector<Case>& cases() {
       {"SpringPendulumAtTheOrigin", "run --problem spring_pendulum:r0=0 --method del", 2, "r0"},
       {"RodChainUnknownCoordinates", "run --problem rod_chain:coordinates=polar --method del", 2,
        "joint"},
-      {"InitialStateOnNonSeparableProblem",
-       "run --problem double_pendulum --method del --initial {dir}/start.csv --dt 0.01 --t-end 1",
+      // --initial on the general kind runs (p = M(q)v + a); a start where M(q) is singular does
+      // not.
+      {"InitialStateOnThePoleOfTheAngles",
+       "run --problem spherical_pendulum:coordinates=angles --method del --initial {dir}/start.csv "
+       "--dt 0.01 --t-end 1",
        2,
-       "position-dependent mass",
-       {{"start.csv", "q,p\n0.1,0\n0.2,0\n"}},
+       "is not positive definite at the given q (a coordinate singularity",
+       {{"start.csv", "q,v\n0,0.1\n0.2,0.3\n"}},
+       {"start.csv"}},
+      {"InitialStateAtTheOriginOfPolarKepler",
+       "run --problem kepler:coordinates=polar --method rk4 --initial {dir}/start.csv --dt 0.01 "
+       "--t-end 1",
+       2,
+       "allowed: a q where M(q) is positive definite",
+       {{"start.csv", "q,p\n0,0.1\n0.2,0.3\n"}},
        {"start.csv"}},
       {"ConstrainedOrderOnUnconstrainedProblem",
        "order --problem kepler --method composition:base=rattle --dt 0.1 --t-end 1", 2,

@@ -2,16 +2,21 @@
 // §7 "cross-formulation equality"): rod_chain in joint angles and spherical_pendulum in angles
 // start in the same physical state, with the same energy, and move the same way; a run through
 // the spherical pendulum's pole is a failure row, never a NaN reported as ok; the charged
-// particle's magnetic moment metric.
+// particle's magnetic moment metric; a general-kind row's method spec re-runs it; initial=FILE
+// with the position-dependent mass.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <set>
 #include <string>
 
 #include "harness/run.hpp"
 #include "harness/table.hpp"
+#include "integrators/integrator.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 
@@ -200,6 +205,96 @@ TEST(MagneticMoment, BorisKeepsItInAUniformFieldAndOnlyChargedParticlesHaveIt) {
   config.dt = 0.05;
   config.t_end = 1;
   EXPECT_EQ(run_one("kepler", "rk4", config).record.metrics.count("magnetic_moment_err_max"), 0u);
+}
+
+// Every row of a general-kind run names what ran: re-running the row's method spec reproduces
+// the row (same canonical spec, status, metrics and final state, bit for bit). `hp` without
+// solver= runs Newton there, and its row reads hp:…,solver=newton (the separable default
+// solver=minimize would be refused on a re-run). Every applicable method of the registry on one
+// spec of each non-separable problem and coordinate system, a few steps each.
+TEST(GeneralRows, RerunningARowsMethodSpecReproducesIt) {
+  std::set<std::string> kinds;
+  int rows = 0, resolved = 0;
+  for (const auto& problem_spec : problem_test_specs()) {
+    const auto problem = make_problem(problem_spec);
+    if (!is_non_separable(*problem)) continue;
+    const Spec canonical = Spec::parse(problem->spec());
+    const auto coordinates = canonical.values.find("coordinates");
+    const std::string kind =
+        canonical.name + (coordinates == canonical.values.end() ? "" : coordinates->second);
+    if (!kinds.insert(kind).second) continue;
+    RunConfig config;
+    config.dt = problem->default_dt();
+    config.t_end = 2 * config.dt;
+    config.timing_repeats = 0;
+    for (const auto& method_spec : integrator_test_specs()) {
+      const auto method = make_integrator(method_spec);
+      if (!applicable(*method, *problem).ok) continue;
+      const RunResult row = run_one(problem_spec, method_spec, config);
+      const std::string where = problem_spec + " " + method_spec + " -> " + row.record.method;
+      RunResult again;
+      try {
+        again = run_one(problem_spec, row.record.method, config);
+      } catch (const InputError& error) {
+        ADD_FAILURE() << where << ": the row's spec is refused: " << error.what();
+        continue;
+      }
+      EXPECT_EQ(again.record.method, row.record.method) << where;
+      EXPECT_EQ(again.record.status, row.record.status) << where;
+      EXPECT_EQ(again.record.steps, row.record.steps) << where;
+      EXPECT_TRUE(again.final_state.q == row.final_state.q) << where;
+      EXPECT_TRUE(again.final_state.p == row.final_state.p) << where;
+      for (const auto& [name, value] : row.record.metrics) {
+        const double other = again.record.metrics.at(name);
+        EXPECT_TRUE(other == value || (std::isnan(other) && std::isnan(value)))
+            << where << ": " << name << " " << value << " then " << other;
+      }
+      ++rows;
+      if (row.record.method != method->spec()) ++resolved;
+    }
+  }
+  EXPECT_GE(kinds.size(), 6u);
+  EXPECT_GE(rows, 50);
+  EXPECT_GE(resolved, 1);  // hp (solver=minimize by default) ran as hp:…,solver=newton
+}
+
+// initial=FILE on the general kind: a q,v file gives the canonical p = M(q)v (written out here
+// for the double pendulum at non-unit masses and lengths), and the problem started from its own
+// start through a file runs exactly as the problem itself — so the wrapper forwards M(q), not
+// the placeholder unit mass.
+TEST(GeneralRows, InitialStateFileUsesThePositionDependentMass) {
+  const std::filesystem::path dir =
+      std::filesystem::path(testing::TempDir()) / "geomint_general_initial";
+  std::filesystem::create_directories(dir);
+  const double m1 = 1.3, m2 = 0.7, l1 = 0.9, l2 = 1.6;
+  const std::string base = "double_pendulum:m1=1.3,m2=0.7,l1=0.9,l2=1.6,g=2.5";
+  const std::string velocities = (dir / "qv.csv").string();
+  std::ofstream(velocities) << "q,v\n0.4,-0.3\n-0.7,1.1\n";
+  const State start = make_problem(base + ",initial=" + velocities)->initial_state();
+  const double c = std::cos(0.4 - -0.7);
+  EXPECT_NEAR(start.p[0], (m1 + m2) * l1 * l1 * -0.3 + m2 * l1 * l2 * c * 1.1, 1e-15);
+  EXPECT_NEAR(start.p[1], m2 * l1 * l2 * c * -0.3 + m2 * l2 * l2 * 1.1, 1e-15);
+
+  const auto own = make_problem(base);
+  const State own_start = own->initial_state();
+  const std::string momenta = (dir / "qp.csv").string();
+  std::ofstream(momenta) << fmt::format("q,p\n{:.17g},{:.17g}\n{:.17g},{:.17g}\n", own_start.q[0],
+                                        own_start.p[0], own_start.q[1], own_start.p[1]);
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 0.5;
+  config.timing_repeats = 0;
+  for (const char* method : {"del", "rk4", "cvode_bdf"}) {
+    const RunResult direct = run_one(base, method, config);
+    const RunResult from_file = run_one(base + ",initial=" + momenta, method, config);
+    ASSERT_TRUE(direct.ok && from_file.ok) << method << ": " << from_file.record.status;
+    EXPECT_TRUE(from_file.final_state.q == direct.final_state.q) << method;
+    EXPECT_TRUE(from_file.final_state.p == direct.final_state.p) << method;
+    EXPECT_EQ(from_file.record.metrics.at("energy_err_max"),
+              direct.record.metrics.at("energy_err_max"))
+        << method;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
