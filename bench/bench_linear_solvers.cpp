@@ -37,7 +37,7 @@ std::string bar_spec(const benchmark::State& state) {
          ",nz=" + std::to_string(size.n);
 }
 
-// h = 0.011 at 10⁵ tetrahedra (issue 9), scaled with the cell size below.
+// h = 0.011 at 10⁵ tetrahedra, scaled with the cell size below.
 double step_size(const benchmark::State& state) { return 0.011 * 16.0 / kSizes[state.range(0)].n; }
 
 SparseMatrix newton_matrix(const benchmark::State& state) {

@@ -1,4 +1,4 @@
-// Per-step cost against problem size (issue 9 item 4; docs/METHODS.md "Scale"): Störmer–Verlet and
+// Per-step cost against problem size (docs/METHODS.md "Scale"): Störmer–Verlet and
 // the HP midpoint step (Kharevych et al. 2006; hp:alpha=0.5) on spring_chain (10²…10⁶ dof) and on
 // elastic_bar (10²…2·10⁵ tets, HP per linear solver), with the fitted exponent of cost against dof,
 // the gradient's element throughput and the process's peak RSS. `--csv FILE` runs the reduced
@@ -70,7 +70,7 @@ std::vector<Size> bar_sizes(double largest_tets) {
   return sizes;
 }
 
-// The simplicial LDLᵀ stops where one step takes minutes (343 s at 10⁵ tets, issue 9), CHOLMOD
+// The simplicial LDLᵀ stops where one step takes minutes (343 s at 10⁵ tets), CHOLMOD
 // at 10⁵ tets (10 s per step); CG goes to 2·10⁵.
 std::vector<Series> all_series() {
   return {

@@ -1,7 +1,7 @@
 // Cost of the Integrator interface (docs/DESIGN.md §2): a Störmer–Verlet step (GNI §I.1.4) on
 // Kepler and on a 128-dof spring net through Problem/Integrator, against hand-written loops doing
 // the same kick–drift–kick arithmetic with one gradient per step (first same as last). Interface
-// = Integrator::advance over a grid, the path of the harness's timing pass (issue 9 item 3);
+// = Integrator::advance over a grid, the path of the harness's timing pass;
 // StepCall = one virtual step() per step, the path of the metric pass. Prints the ratios.
 #include <benchmark/benchmark.h>
 

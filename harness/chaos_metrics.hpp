@@ -1,4 +1,4 @@
-// Chaos indicators of a run (issue 27 item 5; docs/CHAOS.md): the finite-time maximal Lyapunov
+// Chaos indicators of a run (docs/CHAOS.md): the finite-time maximal Lyapunov
 // exponent and MEGNO (Cincotta & Simó 2000, A&AS 147, 205, eqs. 2–3) from a tangent vector
 // propagated along the computed trajectory, and the valid time against the reference.
 #pragma once
@@ -76,7 +76,7 @@ std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& method, const
                                               const std::vector<std::string>& names,
                                               ChaosTangent kind);
 
-// The relative error at which a chaotic run stops being a trajectory (issue 27 item 5).
+// The relative error at which a chaotic run stops being a trajectory.
 inline constexpr double kValidTimeErrorThreshold = 1e-2;
 
 // The run's observer for `valid_time` (nullptr when not asked for, or when the problem has

@@ -1,4 +1,4 @@
-// The black-box symplecticity defect of the computed one-step map (issue 27, item 1; GNI §VI.2,
+// The black-box symplecticity defect of the computed one-step map (GNI §VI.2,
 // Def. 2.2): ‖JᵀΩJ − Ω‖_F/‖Ω‖_F with J the Richardson-extrapolated central-difference Jacobian of
 // Φ_h: (q, p) ↦ (q', p') as the method's real steps (and nonlinear solves) compute it.
 #pragma once

@@ -1,4 +1,4 @@
-// Speed regressions as a statistical test (issue 30, item 4; docs/PERF.md): the repeated
+// Speed regressions as a statistical test (docs/PERF.md): the repeated
 // measurements of two Google Benchmark JSON files (or folders of them, as `make perf` writes)
 // compared per benchmark with a one-sided Mann–Whitney U test (Mann & Whitney 1947) and a
 // relative threshold on the medians.

@@ -112,7 +112,7 @@ TEST(PerfCompare, SlowdownSpeedupAndNoise) {
         .at(0)
         .verdict;
   };
-  EXPECT_EQ(verdict(100, 130), "slower");  // the seeded 30 % slowdown of issue 30
+  EXPECT_EQ(verdict(100, 130), "slower");  // a seeded 30 % slowdown
   EXPECT_EQ(verdict(130, 100), "faster");
   EXPECT_EQ(verdict(100, 100), "same");
   // Within the noise: a 2 % shift under ±3 % noise is not significant at p < 0.01.

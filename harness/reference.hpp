@@ -1,4 +1,4 @@
-// Reference solutions for problems without an exact solution (issue 5; docs/METHOD.md): where
+// Reference solutions for problems without an exact solution (docs/METHOD.md): where
 // the files live, the loader, and the observer that measures a run's error against them. The
 // files are written by harness/reference_generator.hpp.
 #pragma once

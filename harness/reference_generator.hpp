@@ -1,4 +1,4 @@
-// Reference generator for problems without an exact solution (issue 5): Gauss–Legendre
+// Reference generator for problems without an exact solution: Gauss–Legendre
 // collocation, s = 3 (order 6; Hairer–Lubich–Wanner, GNI §II.1.3), with a long double state and
 // a Kahan-compensated update, checked against an independent run at twice the step.
 #pragma once

@@ -1,4 +1,4 @@
-// Reference solutions (issue 5): the generator reproduces exact solutions to its own error
+// Reference solutions: the generator reproduces exact solutions to its own error
 // estimate, the harness measures errors against a reference file and names it, and missing or
 // malformed files are InputErrors that name the file.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// `geomint report` (issue 28 item 2, docs/REPORT.md): the results site. Every page is written
+// `geomint report` (docs/REPORT.md): the results site. Every page is written
 // from the tables as committed (their `# key: value` provenance, docs/DESIGN.md §5) and the gates
 // of results/gates.toml run through check_gates, so the site cannot disagree with `make gates`.
 #include "harness/report.hpp"
@@ -361,7 +361,7 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
       const int ra = table_rank(a.stem().string()), rb = table_rank(b.stem().string());
       return ra != rb ? ra < rb : a.filename() < b.filename();
     });
-    // A figure drawn as both PNG and SVG is shown once, as SVG (sharp at any zoom; issue 28).
+    // A figure drawn as both PNG and SVG is shown once, as SVG (sharp at any zoom).
     std::sort(page.images.begin(), page.images.end());
     page.image_files = page.images;  // README.md may link either form
     const std::vector<std::string>& all_images = page.image_files;

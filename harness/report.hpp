@@ -1,4 +1,4 @@
-// `geomint report` (issue 28 item 2, docs/REPORT.md): a static HTML site built from the committed
+// `geomint report` (docs/REPORT.md): a static HTML site built from the committed
 // result tables — one page per results/<scene>/ with its narrative, tables, figures, gate verdicts
 // (results/gates.toml, checked in-process), provenance and citation, and an index. No JavaScript.
 #pragma once

@@ -1,4 +1,4 @@
-// A run's inputs as validated objects (issue 24): the problem, a factory of fresh integrators and
+// A run's inputs as validated objects: the problem, a factory of fresh integrators and
 // the RunConfig (time grid and outputs). Spec strings are parsed once, at the command line or the
 // scene reader; RunSpec::validate() lists every error at once, as Ceres' Solver::Options::IsValid.
 #pragma once

@@ -1,5 +1,5 @@
-// Sharded sweeps and `geomint merge` (harness/shard.hpp, docs/CLUSTER.md "Running on a cluster",
-// issue 16): a scene swept in 4 shards and merged writes the bytes of a single-machine sweep (date
+// Sharded sweeps and `geomint merge` (harness/shard.hpp, docs/CLUSTER.md "Running on a cluster"):
+// a scene swept in 4 shards and merged writes the bytes of a single-machine sweep (date
 // line aside; after --timing-only, wall_s too), and merge refuses a missing, a foreign and a
 // duplicated shard, naming them and the resubmission command.
 #include "harness/shard.hpp"

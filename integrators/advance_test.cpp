@@ -1,4 +1,4 @@
-// Integrator::advance (issue 9 item 3; docs/DESIGN.md §2): every fixed-step method's run over a
+// Integrator::advance (docs/DESIGN.md §2): every fixed-step method's run over a
 // grid, with or without a visitor, ends bit for bit where step() called once per grid step ends,
 // with the same counters; the explicit methods' loops allocate nothing per step.
 #include <gtest/gtest.h>
@@ -136,7 +136,7 @@ TEST(Advance, VisitorStopsTheRun) {
 
 #if GEOMINT_COUNT_ALLOCATIONS
 // After a first run has sized every buffer, a second run of the explicit loops allocates nothing
-// (issue 9: no per-step allocation or string construction on the hot path).
+// (no per-step allocation or string construction on the hot path).
 TEST(Advance, ExplicitLoopsDoNotAllocate) {
   for (const char* method_spec :
        {"stormer_verlet", "position_verlet", "symplectic_euler_a", "symplectic_euler_b", "rk4"}) {

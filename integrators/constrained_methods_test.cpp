@@ -1,4 +1,4 @@
-// Methods on constrained problems (docs/METHOD.md §3, issue 10): every registered constrained
+// Methods on constrained problems (docs/METHOD.md §3): every registered constrained
 // method follows the cartesian pendulum, IDA at index 2 and 3 on the DAE itself (drift of the
 // velocity constraint at index 3), and the penalty contrast (error ~ 1/k, stiffness ~ √k).
 #include <gtest/gtest.h>

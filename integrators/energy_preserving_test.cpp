@@ -1,5 +1,5 @@
-// The energy-preserving contrasts (integrators/avf.cpp, integrators/projection.cpp; issue 27 item
-// 4): energy to round-off at non-unit masses and scales, symmetry of the symmetric variants, and
+// The energy-preserving contrasts (integrators/avf.cpp, integrators/projection.cpp):
+// energy to round-off at non-unit masses and scales, symmetry of the symmetric variants, and
 // the controls (Gauss without projection drifts; the standard projection is not symmetric).
 // Orders come from the registry-driven order tests (tests/methods_test.cpp).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The step loop explicit methods run inside Integrator::advance (issue 9 item 3; docs/DESIGN.md
+// The step loop explicit methods run inside Integrator::advance (docs/DESIGN.md
 // §2): the grid of harness/run.cpp with a step body that the compiler can inline, no status
 // object per step, and the visitor called only when there is one.
 #pragma once

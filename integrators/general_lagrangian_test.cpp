@@ -173,7 +173,8 @@ TEST(GeneralStep, DoublePendulumOrdersMatchTheDeclaredOnes) {
         << spec << " p errors " << ::testing::PrintToString(p_errors);
     fitted_specs.push_back(spec);
   }
-  // Issue 25's list (hp is hp:alpha=0.5, gauss is gauss:s=2) must be among the fitted specs.
+  // The methods whose orders docs/MECHANICS_GENERAL.md quotes (hp is hp:alpha=0.5, gauss is
+  // gauss:s=2) must be among the fitted specs.
   for (const char* required : {"del", "hp", "implicit_midpoint", "gauss", "gauss:s=3",
                                "generalized_leapfrog", "tao", "tao:order=4,omega=5", "rk4"}) {
     EXPECT_NE(std::find(fitted_specs.begin(), fitted_specs.end(), required), fitted_specs.end())
@@ -269,7 +270,7 @@ TEST(GeneralStep, PolarKeplerKeepsAngularMomentumToRoundOff) {
 }
 
 // The same scheme and step in the two coordinate systems, position errors against the exact orbit
-// after one period (e = 0.3, h = 2π/400). Issue 25 expected them within a factor 2 of each
+// after one period (e = 0.3, h = 2π/400). One might expect them within a factor 2 of each
 // other; measured, polar is far more accurate (del and implicit_midpoint 4.3e-5 against 3.1e-3,
 // rk4 2.1e-9 against 7.0e-8): the motion is nearly uniform in (r, φ). What holds, and is checked,
 // is that the polar formulation is never worse than twice the Cartesian one.

@@ -184,7 +184,7 @@ class Integrator {
   // Runs the fixed-step grid from state (at grid.t0) to grid.time(grid.n), calling `visit` after
   // every step, with the same arithmetic, counters and final state as step() once per grid step
   // (integrators/integrator.cpp, the default). Explicit methods override it to dispatch once
-  // per run to a loop without per-step status objects, cache checks or allocation (issue 9).
+  // per run to a loop without per-step status objects, cache checks or allocation.
   virtual AdvanceOutcome advance(const Problem& problem, State& state, const StepGrid& grid,
                                  StepVisitor visit);
   // Adaptive methods (flag kAdaptive): take one internal, error-controlled step without passing

@@ -14,8 +14,8 @@ namespace geomint {
 
 class Params;
 
-// Which solver factorises (or iterates on) a symmetric Newton matrix (docs/METHODS.md "Scale";
-// issue 9). Non-symmetric Jacobians always go to SparseLU.
+// Which solver factorises (or iterates on) a symmetric Newton matrix (docs/METHODS.md "Scale").
+// Non-symmetric Jacobians always go to SparseLU.
 //  - kLdlt: Eigen SimplicialLDLT, AMD ordering (bit-identical to the results committed before the
 //    choice existed); kLdltMetis: the same with METIS nested-dissection ordering.
 //  - kCholmod: CHOLMOD supernodal LLᵀ (METIS ordering, dense supernodes through the BLAS).
@@ -32,7 +32,7 @@ enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol 
 //     --method hp:linear_solver=cg --dt 0.022 --t-end 0.022 --timing-repeats 0
 // (and ldlt, cholmod; nx=65,ny=16,nz=16 with --dt 0.011; bench/bench_linear_solvers.cpp).
 // 960 tets (825 dof): all three 0.05 s; 9 984 tets (6 561 dof): ldlt 0.80, cholmod 0.44, cg 0.23;
-// 99 840 tets (56 355 dof, h = 0.011): cholmod 10.3, cg 1.7 (ldlt: 343 s, issue 9).
+// 99 840 tets (56 355 dof, h = 0.011): cholmod 10.3, cg 1.7 (ldlt: 343 s).
 inline constexpr long kAutoIterativeFrom = 6000;
 
 struct LinearSolverOptions {

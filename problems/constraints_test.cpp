@@ -1,4 +1,4 @@
-// Registry-driven checks of the holonomic-constraint capability (docs/METHOD.md §3, issue 10):
+// Registry-driven checks of the holonomic-constraint capability (docs/METHOD.md §3):
 // for every problem spec with `constraints`, G = ∂g/∂q, the curvature c(q, v) = d/dt(G(q)v) and
 // the Hessian of λᵀg against finite differences, consistent initial states, and bad states named.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Gradients of the few-dof problems as inlineable functors, shared by their Problem::gradient and
-// by the statically typed step loops of the explicit methods (issue 9 item 3; docs/DESIGN.md §2).
+// by the statically typed step loops of the explicit methods (docs/DESIGN.md §2).
 // One formula per problem, templated on the vector type, so both paths round identically.
 #pragma once
 

@@ -89,8 +89,8 @@ class SeparableLagrangian final : public LagrangianSystem {
 // energy() is H(q, p) and first_order_rhs() Hamilton's equations (problems/problem.cpp), and only
 // methods flagged kGeneralLagrangian run it (applicable()). The accessor and the flag live here
 // and in integrators/general_step.hpp so that this first step leaves problem.hpp and
-// integrator.hpp, which every file includes, unchanged; issue 25's interface split makes them a
-// Problem member and a MethodFlag.
+// integrator.hpp, which every file includes, unchanged; splitting the Problem interface by kind
+// would make them a Problem member and a MethodFlag.
 inline const LagrangianSystem* general_lagrangian(const Problem& problem) {
   return dynamic_cast<const LagrangianSystem*>(&problem);
 }

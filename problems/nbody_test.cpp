@@ -1,6 +1,6 @@
 // nbody (problems/nbody.cpp): the outer_solar_system alias is the same problem bit for bit, the
 // parameter, CSV and preset routes agree, the centre-of-mass frame, and bad input; then the
-// catalogue additions of issue 11 that start problems elsewhere (initial=FILE, chain init=node)
+// catalogue additions that start problems elsewhere (initial=FILE, chain init=node)
 // and the time-dependent parametric oscillator.
 #include <gtest/gtest.h>
 

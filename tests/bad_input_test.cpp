@@ -1,4 +1,4 @@
-// The bad-input suite (issue 14; docs/DESIGN.md §4, docs/USAGE.md "Exit codes"): a registry of
+// The bad-input suite (docs/DESIGN.md §4, docs/USAGE.md "Exit codes"): a registry of
 // command lines and scene files, each with the exit code it must give, a word its message must
 // contain and the files it may leave behind (none, for bad input). Every case runs the built
 // `geomint` under `timeout` (the hang guard): a case that runs past its limit fails as a hang, not
@@ -113,14 +113,14 @@ const std::vector<Case>& cases() {
        "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
       {"QuaternionUnknownBase",
        "run --problem rigid_body --method quaternion:base=rk5 --dt 0.1 --t-end 1", 2, "rk4"},
-      // --- holonomic constraints (applicable(), issue 10): the message names what applies ---
+      // --- holonomic constraints (applicable()): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
        "holonomic constraints, which problem 'rod_chain' has; methods that do:"},
       {"ConstrainedMethodOnUnconstrainedProblem",
        "run --problem pendulum --method rattle --dt 0.1 --t-end 1", 2,
        "problem 'pendulum' has none"},
-      // --- the general Lagrangian kind (is_non_separable, issue 25): separable-only methods
+      // --- the general Lagrangian kind (is_non_separable): separable-only methods
       // refused ---
       {"VerletOnNonSeparableProblem",
        "run --problem double_pendulum --method stormer_verlet --dt 0.01 --t-end 1", 2,
@@ -145,7 +145,7 @@ const std::vector<Case>& cases() {
       {"HpLeftRuleOnNonSeparableProblem",
        "run --problem double_pendulum --method hp:alpha=0,solver=newton --dt 0.01 --t-end 1", 2,
        "assumes a separable Lagrangian"},
-      // --- the generalized leapfrog and Tao's method (issue 25) ---
+      // --- the generalized leapfrog and Tao's method ---
       {"TaoOrderThree", "run --problem double_pendulum --method tao:order=3 --dt 0.01 --t-end 1", 2,
        "order='3' is not allowed (allowed: 2, 4)"},
       {"TaoNegativeCoupling",
@@ -162,7 +162,7 @@ const std::vector<Case>& cases() {
       {"LeapfrogZeroIterations",
        "run --problem double_pendulum --method generalized_leapfrog:max_iter=0 --dt 0.01 --t-end 1",
        2, "max_iter=0 is out of range"},
-      // --- the charged particle and the Boris pusher (issue 25) ---
+      // --- the charged particle and the Boris pusher ---
       {"BorisOnAnotherProblem", "run --problem double_pendulum --method boris --dt 0.01 --t-end 1",
        2, "integrates charged particles only"},
       {"VerletOnChargedParticle",
@@ -717,7 +717,7 @@ const std::vector<Case>& cases() {
        {"scene.toml", "summary.csv", "table.md", "series", "series/a",
         "series/a/odeint_dopri5_max_steps_100.csv", "series/a/rk4.csv"},
        60},
-      // --- issue 23 (tables, shards, debris) ---
+      // --- tables, shards, debris ---
       // A damaged table is refused whole, naming the file and the line: the intact row
       // "a,12.5" fails the band, the same row cut inside its number passes it.
       {"GateTableCutInsideANumber",
@@ -889,7 +889,7 @@ const std::vector<Case>& cases() {
         {"hosts.csv.2147483646.1.tmp", "partial"}},
        {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
        60},
-      // --- issue 23 (paths, Slurm scripts, CLI messages) ---
+      // --- paths, Slurm scripts, CLI messages ---
       // The same file spelled two ways (the run is in {dir}): a relative name and "./name", or a
       // path through "..", is still one file.
       {"SeriesIsOutSpelledWithDotSlash",
@@ -1035,7 +1035,7 @@ const std::vector<Case>& cases() {
        "run takes: --problem, --method"},
       {"CliExtraArgumentPointsToTheVerbsHelp", "sweep {dir}/a.toml {dir}/b.toml", 2,
        "see geomint sweep --help"},
-      // --- issue 23 (failure rows, budgets, order fit) ---
+      // --- failure rows, budgets, order fit ---
       // The force kick's fixed point diverges (h·c/m = 8): the advance() path, which the run
       // takes, once dropped the status and reported `ok` after 100 force evaluations per step.
       {"PositionVerletForceKickFailureIsARow",

@@ -1,4 +1,4 @@
-// Bit-identical reruns (issue 13, part 6; docs/DESIGN.md §3 "accuracy runs may run in parallel"):
+// Bit-identical reruns (docs/DESIGN.md §3 "accuracy runs may run in parallel"):
 // the built `geomint sweep` on tests/scenes/rerun/scene.toml, run twice with --jobs 1 and once
 // with --jobs 2, writes the same bytes in every CSV (summary, order, order_points, stability,
 // series/), except the timing column wall_s and the provenance lines that may legitimately

@@ -1,4 +1,4 @@
-// Integrator runs on the issue-4 catalogue problems: Störmer–Verlet converges to the linear
+// Integrator runs on the catalogue problems: Störmer–Verlet converges to the linear
 // spring chain's normal-mode solution, the variational integrators keep the stiff FPU chain's
 // oscillatory energy I near 1 (GNI §I.5.1, §XIII), and the outer solar system's momenta.
 #include <gtest/gtest.h>
@@ -85,7 +85,7 @@ TEST(FpuRuns, VariationalIntegratorsKeepTheOscillatoryEnergyNearOne) {
   // hω = 0.5 (ω = 50), t = 200, I sampled at every step. I is an adiabatic invariant,
   // I(t) = I(0) + O(ω⁻¹): the exact flow itself wanders by max |I − 1| = 0.065 (RK4 at
   // h = 5e-4, hω = 0.025). Measured at hω = 0.5: stormer_verlet 0.089 (I(200) = 0.984),
-  // del:rule=midpoint and hp:alpha=0.5 0.077 (I(200) = 0.999). The bound 0.1 (the issue's "near
+  // del:rule=midpoint and hp:alpha=0.5 0.077 (I(200) = 0.999). The bound 0.1 ("near
   // 1"; 0.05 is below the exact flow's own excursion) separates them from the dissipative
   // methods, whose I decays (I(200): implicit Euler 6e-8, RK4 0.022).
   const double h = 0.01, t_end = 200;
@@ -123,7 +123,7 @@ TEST(SolarSystemRuns, SymplecticMethodsKeepAngularMomentumAndBoundEnergy) {
 }
 
 TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
-  // Issue 4: every registered variational method keeps the free, spinning bar's linear and
+  // Every registered variational method keeps the free, spinning bar's linear and
   // angular momentum to solver tolerance; implicit Euler (not variational) is the negative
   // control. Absolute errors; |L0| is O(1) for the default spin.
   const std::string problem = "elastic_bar:nx=4,ny=1,nz=1,clamp=none";

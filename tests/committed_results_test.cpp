@@ -87,7 +87,7 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
                               " / dt=" + (committed.count("dt") ? committed.at("dt") : "-");
     for (const auto& [column, value] : to_row(rerun.record)) {
       // Timing columns are machine noise; `family` is a label derived from the method's flags
-      // (issue 29) that tables written before it do not have yet.
+      // that tables written before it do not have yet.
       if (column.find("wall") != std::string::npos || column == "family") continue;
       ASSERT_TRUE(committed.count(column))
           << where << ": column " << column << " is not in the committed table; regenerate";

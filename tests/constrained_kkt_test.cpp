@@ -1,4 +1,4 @@
-// The constrained hp / del:rule=midpoint step (docs/METHOD.md §3, issue 10): the KKT solve with
+// The constrained hp / del:rule=midpoint step (docs/METHOD.md §3): the KKT solve with
 // the multiplier force at q_k and the momentum projection, checked against RATTLE, across its two
 // solvers, for order 2 (4 composed) on the cartesian pendulum, and for its iteration budget.
 #include <gtest/gtest.h>
@@ -126,7 +126,7 @@ TEST(ConstrainedKkt, MinimiseAndNewtonSolversAgree) {
   EXPECT_LT(distance(minimise, newton), 1e-9);
 }
 
-// Order 2 (±0.15, the done-when of issue 10) for the constrained HP midpoint under both solvers
+// Order 2 (±0.15) for the constrained HP midpoint under both solvers
 // and for del:rule=midpoint, 4 (±0.3) for its Suzuki composition, on the cartesian pendulum.
 TEST(ConstrainedKkt, OrderOnTheCartesianPendulum) {
   const std::string problem = "cartesian_pendulum:theta0=1.2";

@@ -1,4 +1,4 @@
-// Registry-driven suites for holonomic constraints (docs/METHOD.md §3, issue 10): every
+// Registry-driven suites for holonomic constraints (docs/METHOD.md §3): every
 // fixed-step method that enforces constraints × every constrained problem of the registry keeps
 // the constraint (position and velocity level) to round-off, and its declared flags and order are
 // verified on the manifold; the negative control rattle:velocity_projection=false must fail the
@@ -184,7 +184,7 @@ TEST(NegativeControl, ShakeVelocitiesLeaveTheVelocityConstraintAtFirstOrder) {
 }
 
 // Order on a nonlinear constrained problem with an exact solution (the conical spherical
-// pendulum at non-unit length, gravity and mass): rattle 2 (±0.15, the done-when of issue 10),
+// pendulum at non-unit length, gravity and mass): rattle 2 (±0.15),
 // the compositions their scheme's order (±0.3, docs/DESIGN.md §7).
 TEST(Constraints, DeclaredOrderOnTheConicalSphericalPendulum) {
   const std::string problem = "spherical_pendulum:length=2.5,gravity=3,mass=0.4,theta0=0.7";

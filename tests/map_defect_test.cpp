@@ -1,4 +1,4 @@
-// The black-box symplecticity defect of the computed map (harness/map_defect.hpp; issue 27): at
+// The black-box symplecticity defect of the computed map (harness/map_defect.hpp): at
 // the finite-difference floor for every declared-symplectic method, O(h^{p+1}) above it for the
 // non-symplectic ones, and an error estimate that bounds the difference to the exact DΦ.
 #include "harness/map_defect.hpp"
@@ -300,7 +300,7 @@ TEST(MapDefect, ANonSymplecticMapThatKeepsTheConstraintsIsFlagged) {
   }
 }
 
-// Issue 27's "every method has a symplecticity_defect_map value or a stated reason why not": each
+// Every method has a symplecticity_defect_map value or a stated reason why not: each
 // registered method on the first problem it applies to among an unconstrained one, a constrained
 // one, a free rigid body and a charged particle, at h = 0.02 from the initial state.
 TEST(MapDefect, EveryRegisteredMethodHasAValueOrAReason) {

@@ -1,4 +1,4 @@
-// The free rigid body under the constrained variational methods (issue 26; MECHANICS.md §6): RATTLE
+// The free rigid body under the constrained variational methods (MECHANICS.md §6): RATTLE
 // (the Moser–Veselov discrete body, GNI §VII.5) and the constrained HP step keep the spatial
 // angular momentum to round-off and QᵀQ = I to their solve's tolerance, and converge at order 2 on
 // the body angular momentum Π against the elliptic solution (Landau–Lifshitz §37).

@@ -1,4 +1,4 @@
-// Issue 14 at the library level: every run ends as a row (step budgets of the adaptive wrappers,
+// Robustness at the library level: every run ends as a row (step budgets of the adaptive wrappers,
 // the configurable divergence rule, t_reached), a sweep survives runs that throw, the warm start
 // of the partitioned Runge–Kutta methods is used on every continuing step, and every committed
 // scene passes the stricter scene checks. The command-line side is tests/bad_input_test.cpp.

@@ -90,7 +90,7 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
 double conserved_momentum_error(const std::string& method, const std::string& problem, double h,
                                 int steps);
 
-// The general Lagrangian kind (docs/MECHANICS_GENERAL.md; issue 25, item 5): for a method flagged
+// The general Lagrangian kind (docs/MECHANICS_GENERAL.md): for a method flagged
 // kGeneralLagrangian the same properties on problems whose mass depends on q or whose Lagrangian
 // has a term linear in v, kept cheap (a few 1e4 steps each):
 //   declared_order_general       the Kepler ladder in polar coordinates (kepler:e=0.6,

@@ -19,7 +19,7 @@ const bool kRegistered = (user::register_all(), true);
 GEOMINT_VERIFY_METHOD(UserPositionVerlet, "user_position_verlet");
 
 // A method that claims the general Lagrangian kind: every check, the four *_general ones on polar
-// Kepler, the double pendulum and the charged particle included (issue 25, item 5).
+// Kepler, the double pendulum and the charged particle included.
 GEOMINT_VERIFY_METHOD(UserGeneralMidpoint, "user_general_midpoint");
 
 TEST(UserPositionVerlet, SecondOrderOnTheUserProblem) {

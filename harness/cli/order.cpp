@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "harness/cli/verbs.hpp"
+#include "harness/metrics.hpp"
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
 #include "harness/table.hpp"
@@ -44,8 +45,9 @@ int run_order(OrderOptions options, const Context& context) {
   for (const auto& run_result : study.runs) {
     const Row row = to_row(run_result.record);
     inform(context,
-           fmt::format("dt={:<12} status={:<8} error_final={}", row.at("dt"), row.at("status"),
-                       row.count("error_final") ? row.at("error_final") : "-"));
+           fmt::format(
+               "dt={:<12} status={:<8} error_final={}", row.at("dt"), row.at("status"),
+               row.count(metric::error_final.key()) ? row.at(metric::error_final.key()) : "-"));
   }
   if (!options.out_path.empty()) {
     std::vector<RunRecord> records;

@@ -1,5 +1,5 @@
-// The verify kit judges what a method computes, not the flags it declares (verify/verify.hpp;
-// issue 27, item 6): a "velocity Verlet" with a stale force that claims symplectic fails the
+// The verify kit judges what a method computes, not the flags it declares (verify/verify.hpp):
+// a "velocity Verlet" with a stale force that claims symplectic fails the
 // black-box symplectic_map check, stormer_verlet passes it. Its own executable: registering a
 // method changes the process-wide registry the other suites iterate.
 #include <gtest/gtest.h>
@@ -68,7 +68,7 @@ TEST(SymplecticMapCheck, SkippedWhenNotDeclared) {
   EXPECT_FALSE(verify::run_check("rk4", "symplectic_map").applies);
 }
 
-// Issue 25, item 5: a method flagged kGeneralLagrangian is also checked on the general kind
+// A method flagged kGeneralLagrangian is also checked on the general kind
 // (polar Kepler, the double pendulum, the charged particle); one without the flag is not run there.
 TEST(GeneralChecks, ImplicitMidpointPassesEveryGeneralCheck) {
   for (const char* name : {"declared_order_general", "energy_without_drift_general",
