@@ -26,10 +26,12 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# Fast suites (< 10 minutes on 2 cores; long runs carry the CTest label "slow"), then what a
-# user's CI does: the CI-sized scenes, gated; then geomint installed into a temporary prefix and
+# The mutation list checked against the code (a `find` text the code no longer has fails here, in a
+# second, not in CI's mutation stage); fast suites (< 10 minutes on 2 cores; long runs carry the
+# CTest label "slow"), then what a user's CI does: the CI-sized scenes, gated; then geomint installed into a temporary prefix and
 # examples/external_method built and tested against it (docs/VERIFY.md "Verify your own integrator").
 test: build
+	@/usr/bin/python3 scripts/mutation.py --check
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 	@$(MAKE) --no-print-directory gate-quick
 	@$(MAKE) --no-print-directory report-quick SITE=$(BUILD_DIR)/site-quick
