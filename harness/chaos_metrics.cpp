@@ -213,4 +213,22 @@ std::unique_ptr<Observer> make_valid_time_observer(
   return std::make_unique<ValidTimeObserver>(std::move(reference));
 }
 
+void add_chaos_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.ran_spec == nullptr) return;
+  if (auto observer = make_chaos_observer(*context.ran_spec, context.problem, context.metrics)) {
+    observers.push_back(std::move(observer));
+  }
+}
+
+// Against the exact solution where there is one, else against a loaded reference.
+void add_valid_time_observer(const ObserverContext& context, ObserverList& observers) {
+  const Problem& problem = context.problem;
+  std::shared_ptr<const ReferenceSolution> reference =
+      problem.has(kExact) ? nullptr : context.reference;
+  if (!problem.has(kExact) && !reference) return;
+  if (auto observer = make_valid_time_observer(problem, reference, context.metrics)) {
+    observers.push_back(std::move(observer));
+  }
+}
+
 }  // namespace geomint

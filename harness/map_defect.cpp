@@ -9,8 +9,8 @@
 #include <limits>
 
 #include "harness/metrics.hpp"
-#include "integrators/constrained_step.hpp"
 #include "harness/run_spec.hpp"
+#include "integrators/constrained_step.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -405,6 +405,14 @@ std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
   if (!requested(names, metric::symplecticity_defect_map)) return nullptr;
   if (!map_defect_not_applicable(method.prototype(), problem, h).empty()) return nullptr;
   return std::make_unique<MapDefectObserver>(method, h, method.adaptive());
+}
+
+void add_map_defect_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.ran_spec == nullptr) return;
+  if (auto observer = make_map_defect_observer(*context.ran_spec, context.problem, context.dt,
+                                               context.metrics)) {
+    observers.push_back(std::move(observer));
+  }
 }
 
 }  // namespace geomint

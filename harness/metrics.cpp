@@ -6,41 +6,13 @@
 namespace geomint {
 
 const std::vector<const MetricDecl*>& metric_table() {
-  using namespace metric;
-  static const std::vector<const MetricDecl*> table = {&energy_err_max,
-                                                       &energy_err_final,
-                                                       &energy_drift,
-                                                       &modified_energy_err_max,
-                                                       &modified_energy_err_slope,
-                                                       &energy_err_slope,
-                                                       &energy_growth_exponent,
-                                                       &momentum_err_max,
-                                                       &angular_momentum_err_max,
-                                                       &casimir_err_max,
-                                                       &constraint_err_max,
-                                                       &constraint_vel_err_max,
-                                                       &orthogonality_err_max,
-                                                       &magnetic_moment_err_max,
-                                                       &symplecticity_defect,
-                                                       &symplecticity_defect_map,
-                                                       &symplecticity_defect_map_fd_err,
-                                                       &symplecticity_defect_map_slope,
-                                                       &lyapunov_max,
-                                                       &megno,
-                                                       &megno_final,
-                                                       &chaos_tangent_fd,
-                                                       &valid_time,
-                                                       &valid_time_reached,
-                                                       &mode_freq_err_max,
-                                                       &mode_damping_max,
-                                                       &error_final,
-                                                       &error_max,
-                                                       &scd,
-                                                       &phase_err,
-                                                       &period_err,
-                                                       &period_measured,
-                                                       &period_err_rel,
-                                                       &perihelion_err};
+  static const std::vector<const MetricDecl*> table = {
+#define GEOMINT_METRIC(name, option_rank, companion_of, computed_by) &metric::name,
+#define GEOMINT_METRIC_OBSERVED(name, option_rank, factory, computed_by) &metric::name,
+#include "harness/metrics.def"
+#undef GEOMINT_METRIC
+#undef GEOMINT_METRIC_OBSERVED
+  };
   return table;
 }
 

@@ -37,6 +37,19 @@ TEST(MetricTable, CompanionsBelongToAnOptionOfTheTable) {
   }
 }
 
+// Every column has a writer: a row without an observer factory is written by the observer of a
+// row above it, and no factory is declared twice (make_observers would call it twice).
+TEST(MetricTable, EveryColumnComesAfterTheRowOfItsObserver) {
+  const auto& table = metric_table();
+  ASSERT_FALSE(table.empty());
+  EXPECT_NE(table.front()->observer, nullptr) << table.front()->name;
+  std::set<ObserverFactory> factories;
+  for (const MetricDecl* decl : table) {
+    if (decl->observer == nullptr) continue;
+    EXPECT_TRUE(factories.insert(decl->observer).second) << decl->name;
+  }
+}
+
 // The metric part of the standard columns is the table, in its order, between `steps` and
 // `order`; the run record's schema writes those columns in that order.
 TEST(MetricTable, StandardColumnsAndRecordSchemaComeFromTheTable) {

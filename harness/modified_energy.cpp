@@ -162,4 +162,12 @@ std::unique_ptr<Observer> make_modified_energy_observer(const MethodFactory& met
       method, *modified_energy_correction(method.info().name), h);
 }
 
+void add_modified_energy_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.integrator == nullptr) return;
+  if (auto observer = make_modified_energy_observer(*context.integrator, context.problem,
+                                                    context.dt, context.metrics)) {
+    observers.push_back(std::move(observer));
+  }
+}
+
 }  // namespace geomint

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness/metrics.hpp"
+#include "harness/reference.hpp"
 #include "integrators/newton.hpp"
 #include "problems/charged_particle.hpp"
 #include "problems/rigid_body.hpp"
@@ -466,41 +467,94 @@ bool has_energy_reference(const Problem& problem) {
   return !problem.has(kForce) || problem.has(kExact);
 }
 
-std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem,
-                                                             double diverge_factor) {
-  std::vector<std::unique_ptr<Observer>> observers;
+void add_energy_observers(const ObserverContext& context, ObserverList& observers) {
+  const Problem& problem = context.problem;
   if (has_energy_reference(problem)) {
-    observers.push_back(std::make_unique<EnergyObserver>(problem, diverge_factor));
+    observers.push_back(std::make_unique<EnergyObserver>(problem, context.diverge_factor));
   }
   const bool conservative = !problem.has(kForce) && !problem.has(kFirstOrderOnly);
-  if (divergence_rule_on(diverge_factor) && !conservative) {
+  if (divergence_rule_on(context.diverge_factor) && !conservative) {
     observers.push_back(std::make_unique<StateNormRule>());
   }
-  if (problem.has(kLinearMomentum)) {
-    observers.push_back(
-        std::make_unique<MomentumObserver>(&Problem::linear_momentum, metric::momentum_err_max));
+}
+
+void add_linear_momentum_observer(const ObserverContext& context, ObserverList& observers) {
+  if (!context.problem.has(kLinearMomentum)) return;
+  observers.push_back(
+      std::make_unique<MomentumObserver>(&Problem::linear_momentum, metric::momentum_err_max));
+}
+
+void add_angular_momentum_observer(const ObserverContext& context, ObserverList& observers) {
+  if (!context.problem.has(kAngularMomentum)) return;
+  observers.push_back(std::make_unique<MomentumObserver>(&Problem::angular_momentum,
+                                                         metric::angular_momentum_err_max));
+}
+
+void add_casimir_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
+}
+
+void add_constraint_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.problem.has(kConstraints)) {
+    observers.push_back(std::make_unique<ConstraintObserver>());
   }
-  if (problem.has(kAngularMomentum)) {
-    observers.push_back(std::make_unique<MomentumObserver>(&Problem::angular_momentum,
-                                                           metric::angular_momentum_err_max));
-  }
-  if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
-  if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
-  if (attitude_problem(problem) != nullptr) {
+}
+
+void add_orthogonality_observer(const ObserverContext& context, ObserverList& observers) {
+  if (attitude_problem(context.problem) != nullptr) {
     observers.push_back(std::make_unique<OrthogonalityObserver>());
   }
-  if (const auto* particle = charged_particle_structure(problem)) {
+}
+
+void add_magnetic_moment_observer(const ObserverContext& context, ObserverList& observers) {
+  if (const auto* particle = charged_particle_structure(context.problem)) {
     observers.push_back(std::make_unique<MagneticMomentObserver>(*particle));
   }
+}
+
+// error_final/error_max/scd against an end reference, the exact solution or a loaded reference.
+void add_error_observers(const ObserverContext& context, ObserverList& observers) {
+  const Problem& problem = context.problem;
   if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
-  if (problem.has(kExact)) observers.push_back(std::make_unique<ExactErrorObserver>());
-  if (problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce)) {
+  if (problem.has(kExact)) {
+    observers.push_back(std::make_unique<ExactErrorObserver>());
+  } else if (context.reference) {
+    observers.push_back(make_reference_observer(context.reference));
+  }
+}
+
+namespace {
+bool periodic_with_exact_solution(const Problem& problem) {
+  return problem.has(kExact) && problem.has(kPeriod) && !problem.has(kForce);
+}
+}  // namespace
+
+void add_phase_observer(const ObserverContext& context, ObserverList& observers) {
+  if (periodic_with_exact_solution(context.problem)) {
     observers.push_back(std::make_unique<PhaseObserver>());
-    if (problem.has(kAngularMomentum) && problem.dof() == 2) {
-      observers.push_back(std::make_unique<PericentreObserver>());
-    }
+  }
+}
+
+void add_pericentre_observer(const ObserverContext& context, ObserverList& observers) {
+  const Problem& problem = context.problem;
+  if (periodic_with_exact_solution(problem) && problem.has(kAngularMomentum) &&
+      problem.dof() == 2) {
+    observers.push_back(std::make_unique<PericentreObserver>());
+  }
+}
+
+ObserverList make_observers(const ObserverContext& context) {
+  ObserverList observers;
+  for (const MetricDecl* decl : metric_table()) {
+    if (decl->observer != nullptr) decl->observer(context, observers);
   }
   return observers;
+}
+
+ObserverList make_metric_observers(const Problem& problem, double diverge_factor) {
+  static const std::vector<std::string> kNoOptionalMetric;
+  return make_observers(
+      {.problem = problem, .metrics = kNoOptionalMetric, .diverge_factor = diverge_factor});
 }
 
 double least_squares_slope(const std::vector<double>& x, const std::vector<double>& y) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/metrics.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 
@@ -26,12 +27,34 @@ class Observer {
   virtual void finish(std::map<std::string, double>& metrics) const = 0;
 };
 
-// The metric observers that apply to `problem`. A `diverge_factor` that is > 0 and finite
-// (RunConfig::diverge_factor) adds the divergence rule: the energy observer stops a conservative
-// run whose |H − H₀|/|H₀| exceeds it (with the energy it evaluates for its metric, once per step
-// point), a state-norm observer any other run whose max(|q|∞, |p|∞) exceeds kDivergedStateNorm.
-std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& problem,
-                                                             double diverge_factor = 0);
+struct ReferenceSolution;
+
+// What an observer factory (harness/metrics.def) may look at: the problem, the optional metrics
+// asked for, the step, the divergence rule and, on a run, its method and reference.
+struct ObserverContext {
+  const Problem& problem;
+  const std::vector<std::string>& metrics;  // RunConfig::extra_metrics
+  double dt = 0;                            // the run's step (the first one of an adaptive run)
+  // > 0 and finite (RunConfig::diverge_factor): the divergence rule. The energy observer stops a
+  // conservative run whose |H − H₀|/|H₀| exceeds it (with the energy it evaluates for its metric,
+  // once per step point), a state-norm rule any other run whose max(|q|∞, |p|∞) exceeds
+  // kDivergedStateNorm.
+  double diverge_factor = 0;
+  // The metric pass's integrator and its spec as given and as run (spec_on); nullptr: no metric
+  // that reads the method applies.
+  const Integrator* integrator = nullptr;
+  const std::string* method_spec = nullptr;
+  const std::string* ran_spec = nullptr;
+  // A loaded reference whose rows reach t_end (error_max/error_final, valid_time), or nullptr.
+  std::shared_ptr<const ReferenceSolution> reference = nullptr;
+};
+
+// The observers of every row of the metric table that applies in `context`, in table order.
+ObserverList make_observers(const ObserverContext& context);
+
+// The observers that need no method: the metrics computed whenever they apply to `problem`, with
+// the divergence rule for `diverge_factor` (tests, and runs without optional metrics).
+ObserverList make_metric_observers(const Problem& problem, double diverge_factor = 0);
 
 // A forced or first-order run whose state passes this norm has blown up.
 constexpr double kDivergedStateNorm = 1e100;

@@ -172,7 +172,7 @@ struct [[nodiscard]] LoopOutcome {
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
 // Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
 // only when dt does not divide t_end. With `checked`, a step point must be finite and pass
-// `admit(state)` (the observers' divergence rule, make_metric_observers) before it is visited;
+// `admit(state)` (the observers' divergence rule, add_energy_observers) before it is visited;
 // `checked` = false (timing pass) skips both, and `visit` for fixed-step methods: the metric
 // pass has already established that the run succeeds.
 template <typename Admit, typename Visit>
@@ -418,44 +418,26 @@ RunResult run_one(const RunSpec& spec) {
   if (!adaptive) record.dt = config.dt;
   record.t_end = config.t_end;
 
-  auto observers = make_metric_observers(*problem, config.diverge_factor);
-  check_optional_metrics(config.extra_metrics, "--metric");
-  for (auto& observer : make_optional_observers(*problem, config.extra_metrics)) {
-    observers.push_back(std::move(observer));
-  }
-  if (auto map_defect =
-          make_map_defect_observer(ran_spec, *problem, config.dt, config.extra_metrics)) {
-    observers.push_back(std::move(map_defect));
-  }
-  if (auto modified =
-          make_modified_energy_observer(*integrator, *problem, config.dt, config.extra_metrics)) {
-    observers.push_back(std::move(modified));
-  }
-  if (auto step_map = make_step_map_observer(*integrator, method_spec, *problem, config.dt,
-                                             config.extra_metrics)) {
-    observers.push_back(std::move(step_map));
-  }
-  if (auto chaos = make_chaos_observer(ran_spec, *problem, config.extra_metrics)) {
-    observers.push_back(std::move(chaos));
-  }
-  if (problem->has(kExact)) {
-    if (auto valid = make_valid_time_observer(*problem, nullptr, config.extra_metrics)) {
-      observers.push_back(std::move(valid));
-    }
-  }
+  // A reference applies when its rows reach t_end (error_max/error_final, valid_time).
+  std::shared_ptr<const ReferenceSolution> reference;
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
     const std::string path = reference_path(config.reference_dir, problem->spec());
     if (std::filesystem::exists(path)) {
-      auto reference = load_reference(path, *problem);  // InputError when malformed
-      if (reference->row_at(problem->initial_state().t + config.t_end) >= 0) {
-        if (auto valid = make_valid_time_observer(*problem, reference, config.extra_metrics)) {
-          observers.push_back(std::move(valid));
-        }
-        observers.push_back(make_reference_observer(std::move(reference)));
+      auto loaded = load_reference(path, *problem);  // InputError when malformed
+      if (loaded->row_at(problem->initial_state().t + config.t_end) >= 0) {
+        reference = std::move(loaded);
         record.reference = std::filesystem::path(path).filename().string();
       }
     }
   }
+  ObserverList observers = make_observers({.problem = *problem,
+                                           .metrics = config.extra_metrics,
+                                           .dt = config.dt,
+                                           .diverge_factor = config.diverge_factor,
+                                           .integrator = integrator.get(),
+                                           .method_spec = &method_spec,
+                                           .ran_spec = &ran_spec,
+                                           .reference = reference});
   std::unique_ptr<SeriesWriter> series;
   if (!config.series_path.empty()) {
     series = std::make_unique<SeriesWriter>(*problem, config, ran_spec);

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "harness/paths.hpp"
+#include "harness/structure_metrics.hpp"
 
 namespace geomint {
 
@@ -26,6 +27,11 @@ std::vector<std::string> RunSpec::validate() const {
   // The path checks throw InputError; their messages join the list.
   try {
     check_run_outputs(config);
+  } catch (const InputError& error) {
+    errors.emplace_back(error.what());
+  }
+  try {
+    check_optional_metrics(config.extra_metrics, "--metric");
   } catch (const InputError& error) {
     errors.emplace_back(error.what());
   }

@@ -314,7 +314,8 @@ std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
 void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics) {
-  if (!requested(names, metric::mode_freq_err_max) && !requested(names, metric::mode_damping_max)) return;
+  if (!requested(names, metric::mode_freq_err_max) && !requested(names, metric::mode_damping_max))
+    return;
   add_normal_mode_metrics(MethodFactory(method_spec), problem, h, names, metrics);
 }
 
@@ -340,16 +341,18 @@ void add_normal_mode_metrics(const MethodFactory& factory, const Problem& proble
   if (damping) metrics[metric::mode_damping_max.key()] = damping_error;
 }
 
-std::vector<std::unique_ptr<Observer>> make_optional_observers(
-    const Problem& problem, const std::vector<std::string>& names) {
-  std::vector<std::unique_ptr<Observer>> observers;
-  if (requested(names, metric::period_measured) && !problem.has(kForce) && problem.dof() >= 1) {
+void add_period_observer(const ObserverContext& context, ObserverList& observers) {
+  const Problem& problem = context.problem;
+  if (requested(context.metrics, metric::period_measured) && !problem.has(kForce) &&
+      problem.dof() >= 1) {
     observers.push_back(std::make_unique<ZeroCrossingPeriodObserver>());
   }
-  if (requested(names, metric::energy_growth_exponent) && !problem.has(kForce)) {
+}
+
+void add_energy_growth_observer(const ObserverContext& context, ObserverList& observers) {
+  if (requested(context.metrics, metric::energy_growth_exponent) && !context.problem.has(kForce)) {
     observers.push_back(std::make_unique<EnergyGrowthObserver>());
   }
-  return observers;
 }
 
 namespace {
@@ -395,6 +398,14 @@ std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
       requested(names, metric::mode_freq_err_max) || requested(names, metric::mode_damping_max);
   if (!defect && !modes) return nullptr;
   return std::make_unique<StepMapObserver>(problem, method_spec, h, names, defect);
+}
+
+void add_step_map_observer(const ObserverContext& context, ObserverList& observers) {
+  if (context.integrator == nullptr) return;
+  if (auto observer = make_step_map_observer(*context.integrator, *context.method_spec,
+                                             context.problem, context.dt, context.metrics)) {
+    observers.push_back(std::move(observer));
+  }
 }
 
 }  // namespace geomint

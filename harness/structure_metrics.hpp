@@ -90,8 +90,4 @@ std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
                                                  const Problem& problem, double h,
                                                  const std::vector<std::string>& names);
 
-// Observers for the requested optional trajectory metrics that apply to `problem`.
-std::vector<std::unique_ptr<Observer>> make_optional_observers(
-    const Problem& problem, const std::vector<std::string>& names);
-
 }  // namespace geomint

@@ -25,6 +25,7 @@
 #include "harness/order.hpp"
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/shard_files.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/integrator.hpp"
@@ -43,6 +44,8 @@ struct Job {
   int timing_repeats = 0;
   RunRecord record;
   bool ok = true;
+  // The parsed run, kept from the accuracy pass for the timing pass of a timed job.
+  std::optional<RunSpec> spec = std::nullopt;
 };
 
 // The sweep's progress on stderr, counted in expected steps (expected_steps()), not in units: a
@@ -156,9 +159,10 @@ Record error_record(const std::string& problem, const std::string& method,
   return record;
 }
 
-// Why `method` cannot run on `problem` (applicable(): constraints, a needed Hessian), if so.
-std::optional<std::string> inapplicable(const std::string& problem, const std::string& method) {
-  const Applicability fit = applicable(*make_integrator(method), *make_problem(problem));
+// Why the run's method cannot run on its problem (applicable(): constraints, a needed Hessian),
+// if so.
+std::optional<std::string> inapplicable(const RunSpec& spec) {
+  const Applicability fit = applicable(spec.method.prototype(), *spec.problem);
   if (fit.ok) return std::nullopt;
   return fit.reason;
 }
@@ -533,7 +537,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (i < jobs.size()) {
       Job& job = jobs[i];
       try {
-        if (const auto reason = inapplicable(job.problem, job.method)) {
+        RunSpec spec = RunSpec::parse(job.problem, job.method, job.config);
+        if (const auto reason = inapplicable(spec)) {
           // A scene's problems × methods product may pair an unconstrained method with a
           // constrained problem (or the reverse): a row that says why, not a run.
           job.record = error_record(job.problem, job.method, short_specs_in(*reason, job.method));
@@ -543,9 +548,10 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
           progress.tick(unit);
           return;
         }
-        RunResult result = run_one(job.problem, job.method, job.config);
+        RunResult result = run_one(spec);
         job.record = std::move(result.record);
         job.ok = result.ok;
+        if (timing && job.timing_repeats > 0 && job.ok) job.spec = std::move(spec);
       } catch (const std::exception& error) {
         job.record = error_record(job.problem, job.method, error.what());
         job.ok = false;
@@ -581,8 +587,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (!timing || job.timing_repeats == 0) continue;
     if (job.ok) {
       try {
-        record_timing(time_run(job.problem, job.method, job.config, job.timing_repeats),
-                      job.record);
+        record_timing(time_run(*job.spec, job.timing_repeats), job.record);
       } catch (const std::exception& error) {
         job.record.message = fmt::format("timing pass failed: {}", error.what());
       }

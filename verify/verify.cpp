@@ -58,8 +58,13 @@ Ladder pendulum_ladder() { return {"pendulum:theta0=1.5", 0.1, 7, 5.0}; }
 Ladder kepler_ladder() { return {"kepler:e=0.6", 0.02, 7, 5.0}; }
 
 CheckResult declared_order(const std::string& method, const Ladder& ladder, double tolerance) {
-  CheckResult result = start("declared_order", method, ladder.problem);
-  const MethodFactory factory(method);
+  CheckResult result = declared_order(MethodFactory(method), ladder, tolerance);
+  result.method = method;
+  return result;
+}
+
+CheckResult declared_order(const MethodFactory& factory, const Ladder& ladder, double tolerance) {
+  CheckResult result = start("declared_order", factory.spec(), ladder.problem);
   const int declared = factory.info().order;
   result.bound = declared;
   // On Kepler the round-off plateau sits near 1e-13, above the fit's plateau floor, so a finest
@@ -85,14 +90,21 @@ CheckResult declared_order(const std::string& method, const Ladder& ladder, doub
 
 CheckResult energy_without_drift(const std::string& method, const std::string& problem,
                                  double steps) {
-  CheckResult result = start("energy_without_drift", method, problem);
+  CheckResult result = energy_without_drift(MethodFactory(method), parse_problem(problem), steps);
+  result.method = method;
+  result.problem = problem;
+  return result;
+}
+
+CheckResult energy_without_drift(const MethodFactory& factory, const ProblemPtr& problem,
+                                 double steps) {
+  CheckResult result = start("energy_without_drift", factory.spec(), problem->spec());
   result.bound = 0.1;
   // Orders >= 6 keep the energy error near 1e-13 at dt = 0.05, where round-off random-walks and
   // looks like drift: check them at dt = 0.2, where truncation dominates (still 1e5 steps).
-  const MethodFactory factory(method);
   const double dt = factory.info().order >= 6 ? 0.2 : 0.05;
   const double t_end = steps * dt;
-  const RunResult run = run_untimed(parse_problem(problem), factory, dt, t_end);
+  const RunResult run = run_untimed(problem, factory, dt, t_end);
   if (!run.ok) {
     result.measured = INFINITY;
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
@@ -108,10 +120,15 @@ CheckResult energy_without_drift(const std::string& method, const std::string& p
 }
 
 CheckResult symplectic_map(const std::string& method, const std::string& problem_spec, double h) {
-  CheckResult result = start("symplectic_map", method, problem_spec);
+  CheckResult result = symplectic_map(MethodFactory(method), parse_problem(problem_spec), h);
+  result.method = method;
+  result.problem = problem_spec;
+  return result;
+}
+
+CheckResult symplectic_map(const MethodFactory& factory, const ProblemPtr& problem, double h) {
+  CheckResult result = start("symplectic_map", factory.spec(), problem->spec());
   result.bound = 1;
-  const auto problem = parse_problem(problem_spec);
-  const MethodFactory factory(method);
   auto integrator = factory.make();
   if (const std::string why = map_defect_not_applicable(*integrator, *problem, h); !why.empty()) {
     result.applies = false;
@@ -156,8 +173,12 @@ CheckResult symplectic_map(const std::string& method, const std::string& problem
 
 double reversibility_defect(const std::string& method, const std::string& problem_spec, double h,
                             int steps) {
-  const auto problem = parse_problem(problem_spec);
-  auto integrator = MethodFactory(method).make();
+  return reversibility_defect(MethodFactory(method), parse_problem(problem_spec), h, steps);
+}
+
+double reversibility_defect(const MethodFactory& method, const ProblemPtr& problem, double h,
+                            int steps) {
+  auto integrator = method.make();
   const State initial = problem->initial_state();
   State state = initial;
   integrator->reset(*problem, state, h);
@@ -175,7 +196,15 @@ double reversibility_defect(const std::string& method, const std::string& proble
 
 CheckResult reversible(const std::string& method, const std::string& problem, double h,
                        double bound) {
-  CheckResult result = start("reversible", method, problem);
+  CheckResult result = reversible(MethodFactory(method), parse_problem(problem), h, bound);
+  result.method = method;
+  result.problem = problem;
+  return result;
+}
+
+CheckResult reversible(const MethodFactory& method, const ProblemPtr& problem, double h,
+                       double bound) {
+  CheckResult result = start("reversible", method.spec(), problem->spec());
   result.bound = bound;
   result.measured = reversibility_defect(method, problem, h);
   result.passed = result.measured < bound;
@@ -186,8 +215,12 @@ CheckResult reversible(const std::string& method, const std::string& problem, do
 
 MomentumErrors momentum_errors(const std::string& method, const std::string& problem_spec, double h,
                                int steps) {
-  const auto problem = parse_problem(problem_spec);
-  auto integrator = MethodFactory(method).make();
+  return momentum_errors(MethodFactory(method), parse_problem(problem_spec), h, steps);
+}
+
+MomentumErrors momentum_errors(const MethodFactory& method, const ProblemPtr& problem, double h,
+                               int steps) {
+  auto integrator = method.make();
   State state = problem->initial_state();
   const Vec linear0 = problem->linear_momentum(state.q, state.p);
   const Vec angular0 = problem->angular_momentum(state.q, state.p);
@@ -210,7 +243,16 @@ MomentumErrors momentum_errors(const std::string& method, const std::string& pro
 
 CheckResult momentum_maps_kept(const std::string& method, const std::string& problem, double h,
                                int steps, double bound) {
-  CheckResult result = start("momentum_maps_kept", method, problem);
+  CheckResult result =
+      momentum_maps_kept(MethodFactory(method), parse_problem(problem), h, steps, bound);
+  result.method = method;
+  result.problem = problem;
+  return result;
+}
+
+CheckResult momentum_maps_kept(const MethodFactory& method, const ProblemPtr& problem, double h,
+                               int steps, double bound) {
+  CheckResult result = start("momentum_maps_kept", method.spec(), problem->spec());
   result.bound = bound;
   const MomentumErrors errors = momentum_errors(method, problem, h, steps);
   result.measured = std::max(errors.linear, errors.angular);
@@ -224,9 +266,17 @@ CheckResult momentum_maps_kept(const std::string& method, const std::string& pro
 
 CheckResult constraint_kept(const std::string& method, const std::string& problem_spec,
                             double steps_per_unit, double units, double bound) {
-  CheckResult result = start("constraint_kept", method, problem_spec);
+  CheckResult result = constraint_kept(MethodFactory(method), parse_problem(problem_spec),
+                                       steps_per_unit, units, bound);
+  result.method = method;
+  result.problem = problem_spec;
+  return result;
+}
+
+CheckResult constraint_kept(const MethodFactory& method, const ProblemPtr& problem,
+                            double steps_per_unit, double units, double bound) {
+  CheckResult result = start("constraint_kept", method.spec(), problem->spec());
   result.bound = bound;
-  const auto problem = parse_problem(problem_spec);
   const State initial = problem->initial_state();
   // g is a length error and G M⁻¹p a rate of one: measured against the configuration's size and
   // the speed (set by gravity, length per 100 default steps, when released from rest).
@@ -235,8 +285,7 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
       std::max(problem->inverse_mass().cwiseProduct(initial.p).lpNorm<Eigen::Infinity>(),
                length / (problem->default_dt() * 100));
   const double unit = length / speed;
-  const RunResult run =
-      run_untimed(problem, MethodFactory(method), unit / steps_per_unit, unit * units);
+  const RunResult run = run_untimed(problem, method, unit / steps_per_unit, unit * units);
   if (!run.ok) {
     result.measured = INFINITY;
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
@@ -253,8 +302,12 @@ CheckResult constraint_kept(const std::string& method, const std::string& proble
 
 double conserved_momentum_error(const std::string& method, const std::string& problem_spec,
                                 double h, int steps) {
-  const auto problem = parse_problem(problem_spec);
-  auto integrator = MethodFactory(method).make();
+  return conserved_momentum_error(MethodFactory(method), parse_problem(problem_spec), h, steps);
+}
+
+double conserved_momentum_error(const MethodFactory& method, const ProblemPtr& problem, double h,
+                                int steps) {
+  auto integrator = method.make();
   State state = problem->initial_state();
   std::vector<Vec (Problem::*)(const Vec&, const Vec&) const> maps;
   if (problem->has(kLinearMomentum)) maps.push_back(&Problem::linear_momentum);

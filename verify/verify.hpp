@@ -9,9 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "harness/run_spec.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint::verify {
+
+// Each check takes the method and the problem as objects (parsed once by the caller: a
+// MethodFactory, a problem from parse_problem or a user's own) or as spec strings, a thin wrapper
+// that parses them and reports them as given.
+using ProblemPtr = std::shared_ptr<const Problem>;
 
 struct CheckResult {
   std::string check;    // "declared_order", "energy_without_drift", "reversible", ...
@@ -40,6 +46,8 @@ Ladder kepler_ladder();    // kepler:e=0.6, dt0 0.02, 7 levels, t_end 5
 // over >= 3 asymptotic points). High orders reach the round-off plateau sooner, so the ladder
 // starts ×4 larger from order 4 and ×16 from order 8, and orders >= 6 use two levels fewer.
 CheckResult declared_order(const std::string& method, const Ladder& ladder, double tolerance = 0.3);
+CheckResult declared_order(const MethodFactory& method, const Ladder& ladder,
+                           double tolerance = 0.3);
 
 // Symplectic ⇒ bounded energy error without drift: over `steps` (1e5) steps on `problem` (dt 0.05,
 // or 0.2 from order 6 where round-off would look like drift), |trend of the per-window maxima| × T
@@ -47,6 +55,8 @@ CheckResult declared_order(const std::string& method, const Ladder& ladder, doub
 // Euler, a non-symplectic "Verlet") has trend × T ≈ err_max. measured = drift·T / err_max.
 CheckResult energy_without_drift(const std::string& method,
                                  const std::string& problem = "pendulum:theta0=1.5",
+                                 double steps = 1e5);
+CheckResult energy_without_drift(const MethodFactory& method, const ProblemPtr& problem,
                                  double steps = 1e5);
 
 // Symplectic ⇒ the map the method computes is symplectic: the black-box defect ‖JᵀΩJ − Ω‖_F/‖Ω‖_F
@@ -56,12 +66,17 @@ CheckResult energy_without_drift(const std::string& method,
 // "Verlet" with a stale force has a defect O(h²) far above the floor. measured = the largest
 // defect / floor ratio (bound 1).
 CheckResult symplectic_map(const std::string& method, const std::string& problem, double h);
+CheckResult symplectic_map(const MethodFactory& method, const ProblemPtr& problem, double h);
 
 // Symmetric ⇒ reversible: `steps` steps of h, then as many of −h, must return to the start
 // (distance relative to |(q₀, p₀)|; +inf when a step fails).
 double reversibility_defect(const std::string& method, const std::string& problem, double h,
                             int steps = 20);
+double reversibility_defect(const MethodFactory& method, const ProblemPtr& problem, double h,
+                            int steps = 20);
 CheckResult reversible(const std::string& method, const std::string& problem, double h,
+                       double bound);
+CheckResult reversible(const MethodFactory& method, const ProblemPtr& problem, double h,
                        double bound);
 
 // Variational (with an invariant discrete Lagrangian) ⇒ discrete Noether: the linear and angular
@@ -74,20 +89,28 @@ struct MomentumErrors {
 };
 MomentumErrors momentum_errors(const std::string& method, const std::string& problem, double h,
                                int steps);
+MomentumErrors momentum_errors(const MethodFactory& method, const ProblemPtr& problem, double h,
+                               int steps);
 CheckResult momentum_maps_kept(const std::string& method,
                                const std::string& problem = "spring_net:nx=4,ny=4", double h = 0.01,
                                int steps = 10000, double bound = 1e-12);
+CheckResult momentum_maps_kept(const MethodFactory& method, const ProblemPtr& problem, double h,
+                               int steps, double bound);
 
 // Constrained ⇒ the position and velocity constraint residuals (constraint_err_max,
 // constraint_vel_err_max of a run) stay below bound × the start's largest |q| and |v| (or
 // |q|/(100 default steps) when released from rest). measured = the larger relative residual.
 CheckResult constraint_kept(const std::string& method, const std::string& problem,
                             double steps_per_unit = 20, double units = 50, double bound = 1e-13);
+CheckResult constraint_kept(const MethodFactory& method, const ProblemPtr& problem,
+                            double steps_per_unit = 20, double units = 50, double bound = 1e-13);
 
 // max_k |J(q_k, p_k) − J₀| / |J₀| over the conserved momentum maps `problem` offers (linear
 // and/or angular; p_φ of polar Kepler, the canonical angular momentum of a charged particle about
 // B), over `steps` steps of h; +inf when a step fails.
 double conserved_momentum_error(const std::string& method, const std::string& problem, double h,
+                                int steps);
+double conserved_momentum_error(const MethodFactory& method, const ProblemPtr& problem, double h,
                                 int steps);
 
 // The general Lagrangian kind (docs/MECHANICS_GENERAL.md): for a method flagged
