@@ -14,9 +14,11 @@ std::vector<Verb> add_verbs(CLI::App& app, bool& quiet) {
       "disk. A numerical failure is a row whose status says what happened; a sweep exits 0 with "
       "its failures as rows.");
   // The order of `geomint --help`.
-  std::vector<Verb> verbs = {add_list(app),  add_run(app),    add_order(app),       add_sweep(app),
-                             add_merge(app), add_slurm(app),  add_reference(app),   add_modes(app),
-                             add_gate(app),  add_report(app), add_perf_compare(app)};
+  std::vector<Verb> verbs = {
+#define GEOMINT_VERB(verb) add_##verb(app),
+#include "harness/cli/verbs.def"
+#undef GEOMINT_VERB
+  };
   for (const Verb& verb : verbs) {
     verb.command->add_flag("--quiet", quiet,
                            "no progress and no informational lines on stderr (errors are still "
