@@ -18,7 +18,7 @@ do for [format in "png pdf svg"] {
   do for [measure in "cpu eval"] {
     set output (measure eq "cpu" ? "work_stability." : "work_stability_evals.").format
     set multiplot layout 1,2 title (measure eq "cpu" ? \
-      "Simulated time per CPU-second at the largest stable step (capped at h = 0.3); bars: timing IQR" : \
+      "Simulated time per CPU-second at the largest stable step (capped at h = 0.3); fastest of 5 timed repeats, bars down by the IQR" : \
       "Simulated time per force + Hessian evaluation at the largest stable step (capped at h = 0.3)")
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     set xlabel "stiffness (dimensionless)"
