@@ -381,6 +381,13 @@ def sweep_scenes(geomint: Path, src: Path, scenes: list[str], jobs: int, timeout
         if outcome.code != 0:
             broken.append(f"{scene}: sweep exit {outcome.code}")
             continue
+        # The scene's post-processing, as scripts/reproduce.sh runs it (its tables are gated too).
+        post = src / "scripts" / f"{scene}.py"
+        if post.exists():
+            outcome = run(["/usr/bin/python3", str(post), str(folder)], src, timeout, log_path)
+            if outcome.code != 0:
+                broken.append(f"{scene}: {post.name} exit {outcome.code}")
+                continue
         if keep is not None:
             if (keep / scene).exists():
                 shutil.rmtree(keep / scene)

@@ -24,6 +24,11 @@ for scene in "$@"; do
     (cd "$root" && "$geomint" sweep "results/$scene/scene.toml" --jobs "$jobs")
     out="$folder"
   fi
+  # A scene's post-processing (scripts/<scene>.py, when there is one) derives its extra tables
+  # from the sweep's CSVs, before the figures and the gates read them.
+  if [ -f "$root/scripts/$scene.py" ]; then
+    /usr/bin/python3 "$root/scripts/$scene.py" "$out"
+  fi
   if [ "${PLOTS:-1}" = 1 ] && [ -f "$root/scripts/$scene.gp" ]; then
     # The figure footer names the build that computed the numbers: the `# geomint:` provenance
     # line of the scene's summary.csv (or of its first CSV), e.g. "0.1.0 (cd4c0e47a208)".
