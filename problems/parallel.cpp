@@ -1,0 +1,87 @@
+// The thread count setting of problems/parallel.hpp (issue 30 item 2).
+#include "problems/parallel.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <thread>
+
+#include "problems/spec.hpp"
+
+namespace geomint {
+namespace {
+
+int hardware_threads() {
+  const unsigned reported = std::thread::hardware_concurrency();  // 0 when unknown
+  return std::clamp(static_cast<int>(reported), 1, kMaxThreads);
+}
+
+// GEOMINT_THREADS, or 0 when unset; InputError when malformed.
+int environment_threads() {
+  const char* text = std::getenv("GEOMINT_THREADS");
+  if (text == nullptr) return 0;
+  char* end = nullptr;
+  errno = 0;
+  const long value = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno != 0 || value < 1 || value > kMaxThreads) {
+    throw InputError(fmt::format(
+        "environment variable GEOMINT_THREADS='{}' is not allowed: use an integer in [1, {}] "
+        "(threads for the element loops), or unset it for the hardware's {}",
+        text, kMaxThreads, hardware_threads()));
+  }
+  return static_cast<int>(value);
+}
+
+// 0 until chosen. Atomic because the threads of a sweep read it; relaxed order suffices for a
+// single value that is chosen before any loop runs.
+std::atomic<int> chosen_threads{0};
+std::atomic<bool> chosen_by_environment{false};
+
+}  // namespace
+
+void apply_thread_count_from_environment() {
+  const int from_environment = environment_threads();
+  if (from_environment == 0) return;
+  chosen_threads.store(from_environment, std::memory_order_relaxed);
+  chosen_by_environment.store(true, std::memory_order_relaxed);
+}
+
+int thread_count() {
+  int chosen = chosen_threads.load(std::memory_order_relaxed);
+  if (chosen == 0) {
+    // A program that did not call apply_thread_count_from_environment (a benchmark, a test)
+    // still honours the variable.
+    apply_thread_count_from_environment();
+    chosen = chosen_threads.load(std::memory_order_relaxed);
+  }
+  return chosen > 0 ? chosen : hardware_threads();
+}
+
+void set_thread_count(int n) {
+  if (n < 1 || n > kMaxThreads) {
+    throw InputError(
+        fmt::format("thread count {} is not allowed: use an integer in [1, {}]", n, kMaxThreads));
+  }
+  chosen_threads.store(n, std::memory_order_relaxed);
+  chosen_by_environment.store(false, std::memory_order_relaxed);
+}
+
+std::string thread_count_description() {
+  const int count = thread_count();
+  const bool configured = chosen_threads.load(std::memory_order_relaxed) > 0;
+  return fmt::format("{} ({})", count,
+                     chosen_by_environment.load(std::memory_order_relaxed) ? "GEOMINT_THREADS"
+                     : configured                                          ? "set by the program"
+                                                                           : "hardware");
+}
+
+int chunk_count(std::size_t items, std::size_t min_items_per_chunk) {
+  const std::size_t most =
+      std::max<std::size_t>(1, items / std::max<std::size_t>(1, min_items_per_chunk));
+  return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(thread_count()), most));
+}
+
+}  // namespace geomint
