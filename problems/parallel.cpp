@@ -84,4 +84,50 @@ int chunk_count(std::size_t items, std::size_t min_items_per_chunk) {
   return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(thread_count()), most));
 }
 
+namespace {
+
+// Below this many non-zeros per chunk a thread costs more than it saves (docs/PERF.md).
+constexpr std::size_t kMinNonZerosPerChunk = 1 << 16;
+
+}  // namespace
+
+void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y) {
+  if (!A.isCompressed()) {  // the loops below need a compressed column layout
+    y = A * x;
+    return;
+  }
+  const Eigen::Index n = A.outerSize();
+  y.resize(n);
+  const double* values = A.valuePtr();
+  const int* rows = A.innerIndexPtr();
+  const int* outer = A.outerIndexPtr();
+  const auto multiply = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index column = first; column < last; ++column) {
+      double sum = 0;
+      for (int k = outer[column]; k < outer[column + 1]; ++k) sum += values[k] * x[rows[k]];
+      y[column] = sum;
+    }
+  };
+  const auto nonzeros = static_cast<std::size_t>(outer[n] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  if (chunks == 1) {
+    multiply(0, n);
+    return;
+  }
+  // Chunk c covers the columns whose first non-zero lies in the c-th equal share of them.
+  std::vector<Eigen::Index> first_column(static_cast<std::size_t>(chunks) + 1, n);
+  first_column[0] = 0;
+  for (int chunk = 1; chunk < chunks; ++chunk) {
+    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
+    first_column[static_cast<std::size_t>(chunk)] =
+        std::lower_bound(outer, outer + n, target) - outer;
+  }
+  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
+                 [&](int chunk, std::size_t, std::size_t) {
+                   multiply(first_column[static_cast<std::size_t>(chunk)],
+                            first_column[static_cast<std::size_t>(chunk) + 1]);
+                 });
+}
+
 }  // namespace geomint

@@ -3,6 +3,8 @@
 // one std::thread per chunk, so a loop's split depends only on its length and the setting.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <exception>
 #include <string>
@@ -61,5 +63,12 @@ void for_each_chunk(int chunks, std::size_t items, const Body& body) {
     if (error) std::rethrow_exception(error);
   }
 }
+
+// y = A x for a symmetric A stored in full (both triangles, column-major, as the Hessians of
+// problems are): y_i = (column i)·x, summed in row order, which is the order in which Eigen's
+// A * x adds into y_i, so the result has the same bits as A * x at any thread count. Rows are
+// split into chunks of equal non-zero counts. A must be square with x.size() columns.
+void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y);
 
 }  // namespace geomint
