@@ -6,13 +6,16 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "integrators/integrator.hpp"
 #include "problems/elastic_bar.hpp"
+#include "problems/parallel.hpp"
 #include "problems/problem.hpp"
 
 namespace {
@@ -119,6 +122,81 @@ void BM_HpMidpointStep(benchmark::State& state) {
   state.counters["newton_per_step"] = static_cast<double>(newton_iterations) / steps;
   state.counters["failed_steps"] = static_cast<double>(failures);
 }
+
+// Threads (issue 30 item 2, docs/PERF.md "Threads"): the energy, gradient and Hessian of the
+// neo-Hookean bar and the product H x, at size index range(0) and range(1) threads (the thread
+// setting is restored afterwards). "eigen_spmv" is Eigen's serial H * x, the reference of
+// geomint::symmetric_product ("spmv"), which gives the same bits.
+// The fastest repetition: the least disturbed by other processes on a shared machine.
+double fastest(const std::vector<double>& times) {
+  return *std::min_element(times.begin(), times.end());
+}
+
+enum class Kernel { kEnergy, kGradient, kHessian, kSpmv, kEigenSpmv };
+
+void BM_Threads(benchmark::State& state, Kernel kernel) {
+  const int saved_threads = geomint::thread_count();
+  geomint::set_thread_count(static_cast<int>(state.range(1)));
+  const auto problem = make_bar(state, "neohookean");
+  const Vec q = deformed(*problem);
+  SparseMatrix H;
+  problem->hessian(q, H);
+  Vec out;
+  double energy = 0;
+  for (auto _ : state) {
+    switch (kernel) {
+      case Kernel::kEnergy:
+        energy = problem->potential(q);
+        benchmark::DoNotOptimize(energy);
+        break;
+      case Kernel::kGradient:
+        problem->gradient(q, out);
+        break;
+      case Kernel::kHessian:
+        problem->hessian(q, H);
+        break;
+      case Kernel::kSpmv:
+        geomint::symmetric_product(H, q, out);
+        break;
+      case Kernel::kEigenSpmv:
+        out.noalias() = H * q;
+        break;
+    }
+    benchmark::DoNotOptimize(out.data());
+    benchmark::DoNotOptimize(H.valuePtr());
+    benchmark::ClobberMemory();
+  }
+  state.counters["threads"] = static_cast<double>(state.range(1));
+  state.counters["tets"] = static_cast<double>(tetrahedra(state));
+  state.counters["hessian_nnz"] = static_cast<double>(H.nonZeros());
+  geomint::set_thread_count(saved_threads);
+}
+
+BENCHMARK_CAPTURE(BM_Threads, energy, Kernel::kEnergy)
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
+BENCHMARK_CAPTURE(BM_Threads, gradient, Kernel::kGradient)
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
+BENCHMARK_CAPTURE(BM_Threads, hessian, Kernel::kHessian)
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
+BENCHMARK_CAPTURE(BM_Threads, spmv, Kernel::kSpmv)
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
+BENCHMARK_CAPTURE(BM_Threads, eigen_spmv, Kernel::kEigenSpmv)
+    ->ArgsProduct({{1, 2}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
 
 // One iteration each: at 10⁵ tetrahedra a step is minutes, almost all of it in the simplicial
 // sparse LDLᵀ factorisations of the Newton steps (3 per step measured on 2026-12-01).

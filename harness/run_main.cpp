@@ -10,6 +10,7 @@
 
 #include "harness/cli/verbs.hpp"
 #include "harness/table.hpp"
+#include "problems/parallel.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -50,6 +51,7 @@ int run_main(int argc, char** argv) {
 
   const Context context{program, joined_command_line(argc, argv), quiet};
   try {
+    apply_thread_count_from_environment();  // a bad GEOMINT_THREADS stops before any output
     for (const Verb& verb : verbs) {
       if (verb.command->parsed()) return verb.run(context);
     }

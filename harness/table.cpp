@@ -28,6 +28,7 @@
 
 #include "harness/blas.hpp"
 #include "harness/metrics.hpp"
+#include "problems/parallel.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -83,6 +84,8 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
                    EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, GSL_VERSION, SUNDIALS_VERSION,
                    BOOST_VERSION / 100000, BOOST_VERSION / 100 % 1000, FMT_VERSION)},
       {"cpu", cpu_model()},
+      // Threads of the element loops; results do not depend on it (docs/PERF.md "Threads").
+      {"threads", thread_count_description()},
       {"date", fmt::format("{:%Y-%m-%dT%H:%M:%SZ}",
                            fmt::gmtime(std::chrono::system_clock::to_time_t(now)))},
       {"command", command_line},

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/parallel.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -221,31 +222,45 @@ class ElasticBar final : public Problem {
 
   State initial_state() const override { return initial_; }
 
+  // The element energies are computed in chunks, then summed in element order on one thread:
+  // the same sum to the bit at any thread count.
   double potential(const Vec& q) const override {
+    const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
     double elastic = 0;
-    for (const Tet& tet : tets_) {
-      const double w = energy_density(displacement_gradient(tet, q));
-      if (!(w < kInf)) return kInf;  // inverted neo-Hookean element: outside the domain of V
-      elastic += tet.volume * w;
+    if (chunks == 1) {
+      for (const Tet& tet : tets_) {
+        const double w = energy_density(displacement_gradient(tet, q));
+        if (!(w < kInf)) return kInf;  // inverted neo-Hookean element: outside the domain of V
+        elastic += tet.volume * w;
+      }
+      return elastic + gravity_potential(q);
+    }
+    std::vector<double> element_energy(tets_.size());
+    for_each_chunk(chunks, tets_.size(), [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t e = begin; e < end; ++e) {
+        const Tet& tet = tets_[e];
+        element_energy[e] = tet.volume * energy_density(displacement_gradient(tet, q));
+      }
+    });
+    for (const double energy : element_energy) {
+      if (!(energy < kInf)) return kInf;
+      elastic += energy;
     }
     return elastic + gravity_potential(q);
   }
 
   // g = Σ_e vol P G ᵀ (the columns are the forces on the 4 nodes) + the gravity load m_i g e_z.
   void gradient(const Vec& q, Vec& g) const override {
-    g.setZero(dof());
-    for (const Tet& tet : tets_) {
-      Mat3 P;
-      Mat34 nodal;
-      if (stress(displacement_gradient(tet, q), P)) {
-        nodal = tet.volume * P * tet.G.transpose();
-      } else {
-        nodal.setConstant(kNaN);  // inverted neo-Hookean element: the harness reports "nan"
-      }
-      for (int a = 0; a < 4; ++a) {
-        if (tet.dof[a] >= 0) g.segment<3>(tet.dof[a]) += nodal.col(a);
-      }
-    }
+    assemble_nodal(
+        [this, &q](const Tet& tet, Mat34& nodal) {
+          Mat3 P;
+          if (stress(displacement_gradient(tet, q), P)) {
+            nodal = tet.volume * P * tet.G.transpose();
+          } else {
+            nodal.setConstant(kNaN);  // inverted neo-Hookean element: the harness reports "nan"
+          }
+        },
+        g);
     if (config_.gravity != 0) {
       for (int i = 2; i < dof(); i += 3) g[i] += config_.gravity * mass()[i];
     }
@@ -276,19 +291,17 @@ class ElasticBar final : public Problem {
   // in place of Ė: equal at small strain, and both are C = νK at rest (docs/METHOD.md §6). Ė is
   // used because it keeps D an exact quadratic form in v (a constant, PSD C) at any F.
   void force(const Vec& q, const Vec& v, double, Vec& f) const override {
-    f.setZero(dof());
     const double nu = config_.damping;
-    for (const Tet& tet : tets_) {
-      const Mat3 F = Mat3::Identity() + displacement_gradient(tet, q);
-      const Mat3 Fdot = gather(tet, v, nullptr) * tet.G;
-      const Mat3 FtFdot = F.transpose() * Fdot;
-      const Mat3 Edot = 0.5 * (FtFdot + FtFdot.transpose());
-      const Mat3 S = 2 * mu_ * Edot + lambda_ * Edot.trace() * Mat3::Identity();
-      const Mat34 nodal = (-nu * tet.volume) * (F * S) * tet.G.transpose();
-      for (int a = 0; a < 4; ++a) {
-        if (tet.dof[a] >= 0) f.segment<3>(tet.dof[a]) += nodal.col(a);
-      }
-    }
+    assemble_nodal(
+        [this, &q, &v, nu](const Tet& tet, Mat34& nodal) {
+          const Mat3 F = Mat3::Identity() + displacement_gradient(tet, q);
+          const Mat3 Fdot = gather(tet, v, nullptr) * tet.G;
+          const Mat3 FtFdot = F.transpose() * Fdot;
+          const Mat3 Edot = 0.5 * (FtFdot + FtFdot.transpose());
+          const Mat3 S = 2 * mu_ * Edot + lambda_ * Edot.trace() * Mat3::Identity();
+          nodal = (-nu * tet.volume) * (F * S) * tet.G.transpose();
+        },
+        f);
   }
 
   // D is a quadratic form in Ḟ, so C = ∂²D/∂v² = vol Bᵀ A_d B is constant in v, symmetric PSD,
@@ -397,7 +410,8 @@ class ElasticBar final : public Problem {
            static_cast<std::size_t>(rest_q_.size() + initial_.q.size() + initial_.p.size() +
                                     2 * dof()) *
                sizeof(double) +
-           (free_node_.capacity() + tip_dofs_.capacity()) * sizeof(int) +
+           (free_node_.capacity() + tip_dofs_.capacity() + first_element_.capacity()) *
+               sizeof(int) +
            static_cast<std::size_t>(pattern_.nonZeros()) * (sizeof(double) + sizeof(int)) +
            static_cast<std::size_t>(pattern_.outerSize() + 1) * sizeof(int);
   }
@@ -458,6 +472,53 @@ class ElasticBar final : public Problem {
     return config_.gravity * sum;
   }
 
+  // Threads (problems/parallel.hpp): the element list is cut into contiguous chunks, and every
+  // sum over elements is formed in element order whatever the chunk count, so results are the
+  // same to the bit at any thread count. A chunk adds into an entry directly unless an earlier
+  // chunk may touch it too, i.e. unless both of the entry's nodes occur in an earlier element
+  // (first_element_); such contributions are queued in element order and added after all chunks
+  // have finished, chunk by chunk. The earlier chunks' contributions to the entry are then all in,
+  // and no two chunks ever write one entry at the same time. The queued entries are those of the
+  // node layers shared by neighbouring chunks, a few per cent at 10⁴ elements.
+  // Below this many elements per chunk a thread costs more than it saves (docs/PERF.md).
+  static constexpr std::size_t kMinElementsPerChunk = 2048;
+
+  // Whether chunk `chunk` starting at element `begin` must queue its additions to the node pair's
+  // entries (or, with b = a, to node a's vector entries).
+  bool shared_with_earlier_chunk(int chunk, std::size_t begin, int dof_a, int dof_b) const {
+    return chunk > 0 && static_cast<std::size_t>(
+                            std::max(first_element_[static_cast<std::size_t>(dof_a / 3)],
+                                     first_element_[static_cast<std::size_t>(dof_b / 3)])) < begin;
+  }
+
+  // Σ_e of the 3×4 nodal vectors `element(tet, nodal)` into `out` (size dof(), zeroed first).
+  template <class ElementFn>
+  void assemble_nodal(const ElementFn& element, Vec& out) const {
+    out.setZero(dof());
+    const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
+    std::vector<std::vector<std::pair<int, double>>> queued(static_cast<std::size_t>(chunks));
+    for_each_chunk(chunks, tets_.size(), [&](int chunk, std::size_t begin, std::size_t end) {
+      auto& later = queued[static_cast<std::size_t>(chunk)];
+      Mat34 nodal;
+      for (std::size_t e = begin; e < end; ++e) {
+        const Tet& tet = tets_[e];
+        element(tet, nodal);
+        for (int a = 0; a < 4; ++a) {
+          const int d = tet.dof[a];
+          if (d < 0) continue;
+          if (shared_with_earlier_chunk(chunk, begin, d, d)) {
+            for (int k = 0; k < 3; ++k) later.emplace_back(d + k, nodal(k, a));
+          } else {
+            out.segment<3>(d) += nodal.col(a);
+          }
+        }
+      }
+    });
+    for (const auto& later : queued) {
+      for (const auto& [index, value] : later) out[index] += value;
+    }
+  }
+
   // One pass over the elements, adding each K_e straight into the values of the fixed sparsity
   // pattern (built once with setFromTriplets, which merged the duplicate entries). Every node owns
   // 3 consecutive columns with identical row sets, so one offset per node pair locates the 3×3
@@ -469,20 +530,36 @@ class ElasticBar final : public Problem {
     out = pattern_;
     double* values = out.valuePtr();
     const int* outer = out.outerIndexPtr();
-    Mat12 K;
-    for (const Tet& tet : tets_) {
-      element(tet, displacement_gradient(tet, q), K);
-      for (int b = 0; b < 4; ++b) {
-        if (tet.dof[b] < 0) continue;
-        for (int l = 0; l < 3; ++l) {
-          const int column_start = outer[tet.dof[b] + l];
+    const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
+    std::vector<std::vector<std::pair<std::ptrdiff_t, double>>> queued(
+        static_cast<std::size_t>(chunks));
+    for_each_chunk(chunks, tets_.size(), [&](int chunk, std::size_t begin, std::size_t end) {
+      auto& later = queued[static_cast<std::size_t>(chunk)];
+      Mat12 K;
+      for (std::size_t e = begin; e < end; ++e) {
+        const Tet& tet = tets_[e];
+        element(tet, displacement_gradient(tet, q), K);
+        for (int b = 0; b < 4; ++b) {
+          if (tet.dof[b] < 0) continue;
           for (int a = 0; a < 4; ++a) {
             if (tet.dof[a] < 0) continue;
-            double* block = values + column_start + tet.slot[4 * b + a];
-            for (int k = 0; k < 3; ++k) block[k] += K(3 * a + k, 3 * b + l);
+            const bool queue = shared_with_earlier_chunk(chunk, begin, tet.dof[a], tet.dof[b]);
+            for (int l = 0; l < 3; ++l) {
+              const std::ptrdiff_t block = outer[tet.dof[b] + l] + tet.slot[4 * b + a];
+              for (int k = 0; k < 3; ++k) {
+                if (queue) {
+                  later.emplace_back(block + k, K(3 * a + k, 3 * b + l));
+                } else {
+                  values[block + k] += K(3 * a + k, 3 * b + l);
+                }
+              }
+            }
           }
         }
       }
+    });
+    for (const auto& later : queued) {
+      for (const auto& [index, value] : later) values[index] += value;
     }
   }
 
@@ -522,6 +599,12 @@ class ElasticBar final : public Problem {
     }
     outer[dof()] = position;
     std::fill_n(pattern_.valuePtr(), entries, 0.0);
+    first_element_.assign(static_cast<std::size_t>(nodes), std::numeric_limits<int>::max());
+    for (std::size_t e = tets_.size(); e-- > 0;) {
+      for (int d : tets_[e].dof) {
+        if (d >= 0) first_element_[static_cast<std::size_t>(d / 3)] = static_cast<int>(e);
+      }
+    }
     for (Tet& tet : tets_) {
       for (int b = 0; b < 4; ++b) {
         for (int a = 0; a < 4; ++a) {
@@ -669,8 +752,9 @@ class ElasticBar final : public Problem {
   std::vector<int> free_node_;                   // free index → mesh node
   std::vector<int> tip_dofs_;                    // first dof of each node on the face x = length
   std::vector<int> pinned_nodes_, pinned_dofs_;  // nodes held by constraints, their first dof
-  Vec rest_q_;            // rest positions of the free nodes, laid out like q
-  SparseMatrix pattern_;  // structure of K with zero values
+  Vec rest_q_;                      // rest positions of the free nodes, laid out like q
+  SparseMatrix pattern_;            // structure of K with zero values
+  std::vector<int> first_element_;  // per free node, the first element that holds it
   State initial_;
 };
 

@@ -10,7 +10,7 @@ commit="${version##*(}"; commit="${commit%)}"
 cxx="$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
 compiler="$("${cxx:-c++}" --version 2>/dev/null | head -1 | tr ',' ' ' || echo '?')"
 cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1 | tr ',' ' ')"
-threads="${OMP_NUM_THREADS:-1}"
+threads="${GEOMINT_THREADS:-$(nproc)}"  # the default of problems/parallel.hpp
 mkdir -p "$out"
 ran=0
 for program in "$build"/bench/bench_*; do

@@ -38,7 +38,8 @@ struct Case {
   std::vector<std::pair<std::string, std::string>> setup = {};
   // Files the run may leave in {dir} (relative paths, directories included). Bad input: none.
   std::set<std::string> outputs = {};
-  int timeout_s = 30;  // hang guard
+  int timeout_s = 30;            // hang guard
+  std::string environment = {};  // "NAME=value ..." set for the run (env(1)), e.g. GEOMINT_THREADS
 };
 
 std::ostream& operator<<(std::ostream& out, const Case& c) { return out << c.name; }
@@ -1167,6 +1168,31 @@ const std::vector<Case>& cases() {
       {"OrderFromErrorsAboveTheSolutionIsNoFit",
        "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,
        "not small against the solution"},
+      // The thread count of the element loops (problems/parallel.hpp): refused before any output.
+      {"ThreadsZero",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --out {dir}/a.csv",
+       2,
+       "GEOMINT_THREADS='0' is not allowed: use an integer in [1, 256]",
+       {},
+       {},
+       30,
+       "GEOMINT_THREADS=0"},
+      {"ThreadsNotANumber",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --out {dir}/a.csv",
+       2,
+       "GEOMINT_THREADS='two'",
+       {},
+       {},
+       30,
+       "GEOMINT_THREADS=two"},
+      {"ThreadsTooMany",
+       "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --out {dir}/a.csv",
+       2,
+       "GEOMINT_THREADS='257' is not allowed",
+       {},
+       {},
+       30,
+       "GEOMINT_THREADS=257"},
   };
   return all;
 }
@@ -1181,9 +1207,10 @@ std::string binary() {
 // Run in the case's folder: a relative output path, and results/references/, are the case's
 // own, and a relative output that escapes the checks is caught as a stray file.
 std::string fmt_command(const Case& c, const fs::path& dir) {
-  return "cd " + dir.string() + " && timeout -k 5 " + std::to_string(c.timeout_s) + " " +
-         fs::absolute(binary()).string() + " " + replace_all(c.arguments, "{dir}", dir.string()) +
-         " 2>&1";
+  return "cd " + dir.string() + " && " +
+         (c.environment.empty() ? "" : "env " + c.environment + " ") + "timeout -k 5 " +
+         std::to_string(c.timeout_s) + " " + fs::absolute(binary()).string() + " " +
+         replace_all(c.arguments, "{dir}", dir.string()) + " 2>&1";
 }
 
 class BadInput : public testing::TestWithParam<Case> {};

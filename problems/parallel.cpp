@@ -1,0 +1,133 @@
+// The thread count setting of problems/parallel.hpp (issue 30 item 2).
+#include "problems/parallel.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <thread>
+
+#include "problems/spec.hpp"
+
+namespace geomint {
+namespace {
+
+int hardware_threads() {
+  const unsigned reported = std::thread::hardware_concurrency();  // 0 when unknown
+  return std::clamp(static_cast<int>(reported), 1, kMaxThreads);
+}
+
+// GEOMINT_THREADS, or 0 when unset; InputError when malformed.
+int environment_threads() {
+  const char* text = std::getenv("GEOMINT_THREADS");
+  if (text == nullptr) return 0;
+  char* end = nullptr;
+  errno = 0;
+  const long value = std::strtol(text, &end, 10);
+  if (end == text || *end != '\0' || errno != 0 || value < 1 || value > kMaxThreads) {
+    throw InputError(fmt::format(
+        "environment variable GEOMINT_THREADS='{}' is not allowed: use an integer in [1, {}] "
+        "(threads for the element loops), or unset it for the hardware's {}",
+        text, kMaxThreads, hardware_threads()));
+  }
+  return static_cast<int>(value);
+}
+
+// 0 until chosen. Atomic because the threads of a sweep read it; relaxed order suffices for a
+// single value that is chosen before any loop runs.
+std::atomic<int> chosen_threads{0};
+std::atomic<bool> chosen_by_environment{false};
+
+}  // namespace
+
+void apply_thread_count_from_environment() {
+  const int from_environment = environment_threads();
+  if (from_environment == 0) return;
+  chosen_threads.store(from_environment, std::memory_order_relaxed);
+  chosen_by_environment.store(true, std::memory_order_relaxed);
+}
+
+int thread_count() {
+  int chosen = chosen_threads.load(std::memory_order_relaxed);
+  if (chosen == 0) {
+    // A program that did not call apply_thread_count_from_environment (a benchmark, a test)
+    // still honours the variable.
+    apply_thread_count_from_environment();
+    chosen = chosen_threads.load(std::memory_order_relaxed);
+  }
+  return chosen > 0 ? chosen : hardware_threads();
+}
+
+void set_thread_count(int n) {
+  if (n < 1 || n > kMaxThreads) {
+    throw InputError(
+        fmt::format("thread count {} is not allowed: use an integer in [1, {}]", n, kMaxThreads));
+  }
+  chosen_threads.store(n, std::memory_order_relaxed);
+  chosen_by_environment.store(false, std::memory_order_relaxed);
+}
+
+std::string thread_count_description() {
+  const int count = thread_count();
+  const bool configured = chosen_threads.load(std::memory_order_relaxed) > 0;
+  return fmt::format("{} ({})", count,
+                     chosen_by_environment.load(std::memory_order_relaxed) ? "GEOMINT_THREADS"
+                     : configured                                          ? "set by the program"
+                                                                           : "hardware");
+}
+
+int chunk_count(std::size_t items, std::size_t min_items_per_chunk) {
+  const std::size_t most =
+      std::max<std::size_t>(1, items / std::max<std::size_t>(1, min_items_per_chunk));
+  return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(thread_count()), most));
+}
+
+namespace {
+
+// Below this many non-zeros per chunk a thread costs more than it saves (docs/PERF.md).
+constexpr std::size_t kMinNonZerosPerChunk = 1 << 16;
+
+}  // namespace
+
+void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y) {
+  if (!A.isCompressed()) {  // the loops below need a compressed column layout
+    y = A * x;
+    return;
+  }
+  const Eigen::Index n = A.outerSize();
+  y.resize(n);
+  const double* values = A.valuePtr();
+  const int* rows = A.innerIndexPtr();
+  const int* outer = A.outerIndexPtr();
+  const auto multiply = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index column = first; column < last; ++column) {
+      double sum = 0;
+      for (int k = outer[column]; k < outer[column + 1]; ++k) sum += values[k] * x[rows[k]];
+      y[column] = sum;
+    }
+  };
+  const auto nonzeros = static_cast<std::size_t>(outer[n] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  if (chunks == 1) {
+    multiply(0, n);
+    return;
+  }
+  // Chunk c covers the columns whose first non-zero lies in the c-th equal share of them.
+  std::vector<Eigen::Index> first_column(static_cast<std::size_t>(chunks) + 1, n);
+  first_column[0] = 0;
+  for (int chunk = 1; chunk < chunks; ++chunk) {
+    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
+    first_column[static_cast<std::size_t>(chunk)] =
+        std::lower_bound(outer, outer + n, target) - outer;
+  }
+  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
+                 [&](int chunk, std::size_t, std::size_t) {
+                   multiply(first_column[static_cast<std::size_t>(chunk)],
+                            first_column[static_cast<std::size_t>(chunk) + 1]);
+                 });
+}
+
+}  // namespace geomint

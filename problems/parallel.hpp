@@ -1,0 +1,74 @@
+// Threads for the element loops of problems (issue 30 item 2, docs/PERF.md "Threads"): the thread
+// count setting (GEOMINT_THREADS) and a fixed partition of an index range into contiguous chunks,
+// one std::thread per chunk, so a loop's split depends only on its length and the setting.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstddef>
+#include <exception>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace geomint {
+
+// Largest accepted thread count; more than the cores of any machine this suite targets.
+constexpr int kMaxThreads = 256;
+
+// Threads the element loops may use (≥ 1). Defaults to the hardware's concurrency (2 on the
+// measured machine, where 2 is fastest: docs/PERF.md), or GEOMINT_THREADS when it is set.
+int thread_count();
+// Sets the count for the rest of the process; InputError unless 1 ≤ n ≤ kMaxThreads.
+void set_thread_count(int n);
+// Applies GEOMINT_THREADS if set: an InputError naming it and the allowed values when it is not
+// an integer in [1, kMaxThreads]. geomint calls it before any command runs (exit 2 when bad);
+// thread_count() calls it on first use in programs that did not.
+void apply_thread_count_from_environment();
+// How the count was chosen, for provenance: e.g. "2 (GEOMINT_THREADS)" or "2 (hardware)".
+std::string thread_count_description();
+
+// Chunks for `items` independent pieces of work: one per thread, but never fewer than
+// `min_items_per_chunk` items per chunk, since starting a thread costs tens of microseconds.
+int chunk_count(std::size_t items, std::size_t min_items_per_chunk);
+
+// First index of chunk `chunk` of `chunks` over [0, items): chunk c is [begin(c), begin(c+1)).
+inline std::size_t chunk_begin(std::size_t items, int chunk, int chunks) {
+  return items * static_cast<std::size_t>(chunk) / static_cast<std::size_t>(chunks);
+}
+
+// Calls body(chunk, begin, end) for every chunk of [0, items), chunk 0 on the calling thread and
+// each other chunk on a thread of its own; returns after all have finished. An exception thrown
+// by a chunk is rethrown here (the first chunk's first) once every thread has joined.
+template <class Body>
+void for_each_chunk(int chunks, std::size_t items, const Body& body) {
+  if (chunks <= 1) {
+    body(0, std::size_t{0}, items);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(chunks));
+  const auto run = [&](int chunk) {
+    try {
+      body(chunk, chunk_begin(items, chunk, chunks), chunk_begin(items, chunk + 1, chunks));
+    } catch (...) {
+      errors[static_cast<std::size_t>(chunk)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> workers;
+  workers.reserve(static_cast<std::size_t>(chunks - 1));
+  for (int chunk = 1; chunk < chunks; ++chunk) workers.emplace_back(run, chunk);
+  run(0);
+  for (std::thread& worker : workers) worker.join();
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+}
+
+// y = A x for a symmetric A stored in full (both triangles, column-major, as the Hessians of
+// problems are): y_i = (column i)·x, summed in row order, which is the order in which Eigen's
+// A * x adds into y_i, so the result has the same bits as A * x at any thread count. Rows are
+// split into chunks of equal non-zero counts. A must be square with x.size() columns.
+void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y);
+
+}  // namespace geomint

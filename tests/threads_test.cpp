@@ -1,0 +1,178 @@
+// Threaded element loops (issue 30 item 2, problems/parallel.hpp, docs/PERF.md "Threads"): the
+// elastic bar's energy, gradient, Hessian and damping, and the product H x, give the same bits
+// at 1, 2, 3 and 4 threads, and implicit steps repeated at 2 threads and at 1 give the same bytes;
+// the chunking covers every item once and passes exceptions on; the setting refuses what it cannot
+// use.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+#include "problems/parallel.hpp"
+#include "problems/problem.hpp"
+#include "problems/spec.hpp"
+#include "tests/test_util.hpp"
+
+namespace geomint {
+namespace {
+
+// 24·8·8 cells = 9216 tets: 4 chunks at 4 threads (2048 elements per chunk at least), so every
+// thread count below is really used. Non-unit sizes and moduli; damping for force/C.
+const char* const kBar =
+    "elastic_bar:nx=24,ny=8,nz=8,length=2.5,width=0.4,height=0.3,young=3e6,density=700,"
+    "damping=0.02";
+
+// Restores the thread count the process had when a test ends.
+class ThreadCountGuard {
+ public:
+  ThreadCountGuard() : saved_(thread_count()) {}
+  ~ThreadCountGuard() { set_thread_count(saved_); }
+
+ private:
+  int saved_;
+};
+
+bool same_bits(const Vec& a, const Vec& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
+}
+bool same_bits(const SparseMatrix& a, const SparseMatrix& b) {
+  const auto bytes = [](const SparseMatrix& m) {
+    return sizeof(double) * static_cast<std::size_t>(m.nonZeros());
+  };
+  return a.nonZeros() == b.nonZeros() && std::memcmp(a.valuePtr(), b.valuePtr(), bytes(a)) == 0 &&
+         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), bytes(a) / 2) == 0;
+}
+
+struct Evaluations {
+  double energy = 0;
+  Vec gradient, force;
+  SparseMatrix hessian, damping_jacobian;
+};
+
+Evaluations evaluate(const Problem& bar, const Vec& q, const Vec& v) {
+  Evaluations out;
+  out.energy = bar.potential(q);
+  bar.gradient(q, out.gradient);
+  bar.hessian(q, out.hessian);
+  bar.force(q, v, 0.0, out.force);
+  bar.force_jacobian_v(q, v, 0.0, out.damping_jacobian);
+  return out;
+}
+
+TEST(ElasticBarThreads, EvaluationsAreBitIdenticalAtAnyThreadCount) {
+  ThreadCountGuard guard;
+  const auto bar = make_problem(kBar);
+  ASSERT_EQ(bar->dof(), 3 * 24 * 9 * 9);  // the face x = 0 is clamped
+  // A deformed state of 1e-2 relative size, and a velocity: every element matrix differs.
+  const State start = bar->initial_state();
+  const Vec q = start.q + 1e-2 * test::random_vector(bar->dof(), 7);
+  const Vec v = 0.3 * test::random_vector(bar->dof(), 8);
+  set_thread_count(1);
+  ASSERT_EQ(chunk_count(9216, 2048), 1);
+  const Evaluations serial = evaluate(*bar, q, v);
+  ASSERT_TRUE(serial.gradient.allFinite());
+  for (int threads : {2, 2, 3, 4}) {
+    set_thread_count(threads);
+    ASSERT_EQ(chunk_count(9216, 2048), threads);
+    const Evaluations threaded = evaluate(*bar, q, v);
+    EXPECT_EQ(std::memcmp(&threaded.energy, &serial.energy, sizeof(double)), 0)
+        << threads << " threads: energy " << threaded.energy - serial.energy << " off";
+    EXPECT_TRUE(same_bits(threaded.gradient, serial.gradient))
+        << threads << " threads: gradient off by "
+        << (threaded.gradient - serial.gradient).lpNorm<Eigen::Infinity>();
+    EXPECT_TRUE(same_bits(threaded.force, serial.force)) << threads << " threads: damping force";
+    EXPECT_TRUE(same_bits(threaded.hessian, serial.hessian))
+        << threads << " threads: Hessian off by "
+        << SparseMatrix(threaded.hessian - serial.hessian).coeffs().cwiseAbs().maxCoeff();
+    EXPECT_TRUE(same_bits(threaded.damping_jacobian, serial.damping_jacobian))
+        << threads << " threads: damping Jacobian";
+    // The threaded H x against Eigen's serial product (~2.3·10⁵ non-zeros: 3 chunks at 3 and
+    // 4 threads).
+    // NaN first: a row the product skipped stays visible.
+    Vec product = Vec::Constant(bar->dof(), std::numeric_limits<double>::quiet_NaN());
+    symmetric_product(serial.hessian, v, product);
+    const Vec reference = serial.hessian * v;
+    EXPECT_TRUE(same_bits(product, reference))
+        << threads << " threads: H x off by " << (product - reference).lpNorm<Eigen::Infinity>();
+  }
+}
+
+// One step of the HP integrator (Newton with CG on the threaded Hessian and gradient) from a
+// twisted bar: twice at 2 threads and once at 1, the same bytes.
+TEST(ElasticBarThreads, ImplicitStepsAreBitIdenticalAtOneAndTwoThreads) {
+  ThreadCountGuard guard;
+  // 12·8·8 cells = 4608 tets: 2 chunks at 2 threads.
+  const auto bar = make_problem(
+      "elastic_bar:nx=12,ny=8,nz=8,length=1.5,width=0.4,height=0.3,young=3e6,density=700,"
+      "damping=0.02,init=twist,twist=0.2");
+  const auto run = [&bar](int threads) {
+    set_thread_count(threads);
+    const auto method = make_integrator("hp:alpha=0.5,solver=newton,linear_solver=cg");
+    State state = bar->initial_state();
+    const double h = 2e-4;
+    method->reset(*bar, state, h);
+    for (int k = 0; k < 1; ++k) {
+      EXPECT_TRUE(method->step(*bar, state, h).ok) << "step " << k << " at " << threads;
+    }
+    return state;
+  };
+  const State first = run(2), second = run(2), serial = run(1);
+  EXPECT_GT((first.q - bar->initial_state().q).norm(), 0);
+  EXPECT_TRUE(same_bits(first.q, second.q) && same_bits(first.p, second.p));
+  EXPECT_TRUE(same_bits(first.q, serial.q) && same_bits(first.p, serial.p))
+      << "1 vs 2 threads: q off by " << (first.q - serial.q).lpNorm<Eigen::Infinity>();
+}
+
+TEST(ParallelChunks, CoverEveryItemOnceInContiguousRanges) {
+  for (int chunks : {1, 2, 3, 7}) {
+    for (std::size_t items : {0, 1, 5, 1000}) {
+      std::vector<std::atomic<int>> hits(items);
+      std::vector<std::size_t> begins(static_cast<std::size_t>(chunks), items + 1);
+      for_each_chunk(chunks, items, [&](int chunk, std::size_t begin, std::size_t end) {
+        begins[static_cast<std::size_t>(chunk)] = begin;
+        EXPECT_EQ(end, chunk_begin(items, chunk + 1, chunks));
+        for (std::size_t i = begin; i < end; ++i) ++hits[i];
+      });
+      for (std::size_t i = 0; i < items; ++i) EXPECT_EQ(hits[i].load(), 1) << i;
+      for (int c = 0; c < chunks; ++c) {
+        EXPECT_EQ(begins[static_cast<std::size_t>(c)], chunk_begin(items, c, chunks));
+      }
+    }
+  }
+}
+
+TEST(ParallelChunks, AnExceptionOfAnyChunkReachesTheCaller) {
+  for (int failing : {0, 2}) {
+    EXPECT_THROW(for_each_chunk(3, 30,
+                                [failing](int chunk, std::size_t, std::size_t) {
+                                  if (chunk == failing) throw std::runtime_error("chunk failed");
+                                }),
+                 std::runtime_error)
+        << failing;
+  }
+}
+
+TEST(ThreadSetting, RefusesCountsOutsideItsRangeAndLimitsChunks) {
+  ThreadCountGuard guard;
+  const auto set_text = [](const std::string& text) { set_thread_count(std::stoi(text)); };
+  EXPECT_TRUE(test::input_error_names(set_text, "0",
+                                      std::vector<std::string>{"thread count 0", "[1, 256]"}));
+  EXPECT_TRUE(test::input_error_names(set_text, "257",
+                                      std::vector<std::string>{"thread count 257", "[1, 256]"}));
+  set_thread_count(3);
+  EXPECT_EQ(thread_count(), 3);
+  EXPECT_EQ(chunk_count(10, 2048), 1);        // too little work to share
+  EXPECT_EQ(chunk_count(2 * 2048, 2048), 2);  // two chunks' worth
+  EXPECT_EQ(chunk_count(100 * 2048, 2048), 3);
+  EXPECT_EQ(thread_count_description(), "3 (set by the program)");
+}
+
+}  // namespace
+}  // namespace geomint
