@@ -21,9 +21,8 @@ constexpr Size kSizes[] = {{10, 4}, {26, 8}, {65, 16}};
 
 SparseMatrix midpoint_matrix(int size) {
   const Size s = kSizes[size];
-  const auto problem = geomint::make_problem(
-      "elastic_bar:nx=" + std::to_string(s.nx) + ",ny=" + std::to_string(s.n) +
-      ",nz=" + std::to_string(s.n));
+  const auto problem = geomint::make_problem("elastic_bar:nx=" + std::to_string(s.nx) + ",ny=" +
+                                             std::to_string(s.n) + ",nz=" + std::to_string(s.n));
   SparseMatrix H;
   problem->hessian(problem->initial_state().q, H);
   const double h = 0.011 * 16.0 / s.n;
@@ -39,11 +38,17 @@ class AmgPreconditioner {
   template <class M>
   explicit AmgPreconditioner(const M&) {}
   template <class M>
-  AmgPreconditioner& analyzePattern(const M&) { return *this; }
+  AmgPreconditioner& analyzePattern(const M&) {
+    return *this;
+  }
   template <class M>
-  AmgPreconditioner& factorize(const M&) { return *this; }
+  AmgPreconditioner& factorize(const M&) {
+    return *this;
+  }
   template <class M>
-  AmgPreconditioner& compute(const M&) { return *this; }
+  AmgPreconditioner& compute(const M&) {
+    return *this;
+  }
   Vec solve(const Vec& r) const { return amg_->solve(r); }
   Eigen::ComputationInfo info() const { return Eigen::Success; }
   geomint::BoomerAmg* amg_ = nullptr;

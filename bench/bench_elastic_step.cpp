@@ -32,9 +32,9 @@ double peak_rss_mb() {
 void BM_Step(benchmark::State& state, const std::string& method) {
   const int size = static_cast<int>(state.range(0));
   const Size cells = kSizes[size];
-  const auto problem = geomint::make_problem("elastic_bar:nx=" + std::to_string(cells.nx) +
-                                             ",ny=" + std::to_string(cells.n) +
-                                             ",nz=" + std::to_string(cells.n));
+  const auto problem =
+      geomint::make_problem("elastic_bar:nx=" + std::to_string(cells.nx) +
+                            ",ny=" + std::to_string(cells.n) + ",nz=" + std::to_string(cells.n));
   const auto integrator = geomint::make_integrator(method);
   geomint::State s = problem->initial_state();
   const double h = step_size(size);
@@ -67,8 +67,8 @@ void sizes(benchmark::internal::Benchmark* b, int first, int last) {
   for (int size = first; size <= last; ++size) b->Arg(size);
 }
 
-#define GEOMINT_STEP(label, method, first, last)                               \
-  BENCHMARK_CAPTURE(BM_Step, label, std::string(method))                      \
+#define GEOMINT_STEP(label, method, first, last)                                \
+  BENCHMARK_CAPTURE(BM_Step, label, std::string(method))                        \
       ->Apply([](benchmark::internal::Benchmark* b) { sizes(b, first, last); }) \
       ->Iterations(3)
 

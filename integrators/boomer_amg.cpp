@@ -96,7 +96,9 @@ BoomerAmg::BoomerAmg(BoomerAmgOptions options)
 BoomerAmg::~BoomerAmg() = default;
 
 bool BoomerAmg::ready() const { return hierarchy_->ready; }
-Eigen::Index BoomerAmg::rows() const { return static_cast<Eigen::Index>(hierarchy_->indices.size()); }
+Eigen::Index BoomerAmg::rows() const {
+  return static_cast<Eigen::Index>(hierarchy_->indices.size());
+}
 
 bool BoomerAmg::setup(const SparseMatrix& lower) {
   ensure_mpi_initialised();

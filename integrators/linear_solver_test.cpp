@@ -15,8 +15,8 @@
 namespace geomint {
 namespace {
 
-const std::vector<std::string> kSolvers = {"ldlt",     "ldlt_metis", "cholmod",
-                                           "cg",       "cg_ichol",   "cg_amg"};
+const std::vector<std::string> kSolvers = {"ldlt", "ldlt_metis", "cholmod",
+                                           "cg",   "cg_ichol",   "cg_amg"};
 
 struct Trajectory {
   State state;
@@ -144,9 +144,8 @@ TEST(LinearSolvers, IndefiniteMatrixWithoutSafeguardFallsBackToLdlt) {
   // xᵢ = π, where J = −I + c·(graph Laplacian) is negative definite: CHOLMOD and CG cannot
   // factorise or iterate on it; they fall back to LDLT and reach the same root as LDLT does.
   Vec reference;
-  for (LinearSolverKind kind :
-       {LinearSolverKind::kLdlt, LinearSolverKind::kCholmod, LinearSolverKind::kCg,
-        LinearSolverKind::kCgAmg}) {
+  for (LinearSolverKind kind : {LinearSolverKind::kLdlt, LinearSolverKind::kCholmod,
+                                LinearSolverKind::kCg, LinearSolverKind::kCgAmg}) {
     NewtonSystem system = cosine_chain(6, 0.1);
     system.objective = nullptr;
     NewtonOptions options;
@@ -244,6 +243,9 @@ TEST(LinearSolvers, AutoPicksByTheNumberOfUnknowns) {
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom),
             LinearSolverKind::kCg);
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kCg, 3), LinearSolverKind::kCg);
+  // cg_amg from 200 000 unknowns (integrators/newton.cpp kAutoAmgFrom, docs/PERF.md §3).
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 199999), LinearSolverKind::kCg);
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 200000), LinearSolverKind::kCgAmg);
 }
 
 TEST(LinearSolvers, OptionIsLeftOutOfTheCanonicalSpecAtItsDefault) {
@@ -263,7 +265,8 @@ TEST(LinearSolvers, BadValueIsAnInputErrorNamingTheAllowedValues) {
     } catch (const InputError& error) {
       const std::string message = error.what();
       EXPECT_NE(message.find("linear_solver"), std::string::npos) << message;
-      EXPECT_NE(message.find("auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol, cg_amg"), std::string::npos)
+      EXPECT_NE(message.find("auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol, cg_amg"),
+                std::string::npos)
           << message;
     }
   }

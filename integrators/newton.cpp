@@ -64,9 +64,16 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
 
 }  // namespace
 
+// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md §3, CPU s of a
+// steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
+// unknowns cg 0.535 against cg_amg 0.697; at 544 320 unknowns cg 11.4 against cg_amg 9.9. The
+// threshold sits near the geometric middle of the two sizes; sizes between were not measured.
+constexpr long kAutoAmgFrom = 200000;
+
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
-  return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
+  if (unknowns < kAutoIterativeFrom) return LinearSolverKind::kLdlt;
+  return unknowns < kAutoAmgFrom ? LinearSolverKind::kCg : LinearSolverKind::kCgAmg;
 }
 
 const char* linear_solver_name(LinearSolverKind kind) {
@@ -90,18 +97,18 @@ const char* linear_solver_name(LinearSolverKind kind) {
 }
 
 LinearSolverOptions read_linear_solver_option(Params& params) {
-  static const LinearSolverKind kinds[] = {
-      LinearSolverKind::kAuto,    LinearSolverKind::kLdlt, LinearSolverKind::kLdltMetis,
-      LinearSolverKind::kCholmod, LinearSolverKind::kCg,   LinearSolverKind::kCgIchol,
-      LinearSolverKind::kCgAmg};
+  static const LinearSolverKind kinds[] = {LinearSolverKind::kAuto,      LinearSolverKind::kLdlt,
+                                           LinearSolverKind::kLdltMetis, LinearSolverKind::kCholmod,
+                                           LinearSolverKind::kCg,        LinearSolverKind::kCgIchol,
+                                           LinearSolverKind::kCgAmg};
   std::vector<std::string> names;
   for (LinearSolverKind kind : kinds) names.push_back(linear_solver_name(kind));
   LinearSolverOptions options;
   const std::string name = params.choice(
       "linear_solver", "auto", names,
       fmt::format("solver of the symmetric Newton systems (auto: ldlt below {} unknowns, "
-                  "else cg)",
-                  kAutoIterativeFrom));
+                  "cg below {}, else cg_amg)",
+                  kAutoIterativeFrom, kAutoAmgFrom));
   for (LinearSolverKind kind : kinds) {
     if (name == linear_solver_name(kind)) options.kind = kind;
   }

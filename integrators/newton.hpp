@@ -23,7 +23,8 @@ class Params;
 //    preconditioner), solved to a residual tied to the Newton threshold, so the Newton stopping
 //    test — and with it every conservation result — is unchanged.
 //  - kCgAmg: the same CG with one BoomerAMG V-cycle as preconditioner (integrators/boomer_amg.hpp),
-//    its set-up reused across Newton iterations and steps (LinearSolverOptions::amg_refresh_growth).
+//    its set-up reused across Newton iterations and steps
+//    (LinearSolverOptions::amg_refresh_growth).
 //  - kAuto: by the number of unknowns, from the measurements next to kAutoIterativeFrom.
 enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol, kCgAmg };
 
@@ -212,8 +213,8 @@ struct NewtonResult {
   // Numeric factorisations (or preconditioner set-ups, for CG) of any kind, shifted ones included;
   // below `iterations` under modified Newton.
   int factorizations = 0;
-  int amg_setups = 0;     // BoomerAMG set-ups (cg_amg; also counted in factorizations)
-  int cg_iterations = 0;  // CG iterations of every solve (cg, cg_ichol, cg_amg)
+  int amg_setups = 0;       // BoomerAMG set-ups (cg_amg; also counted in factorizations)
+  int cg_iterations = 0;    // CG iterations of every solve (cg, cg_ichol, cg_amg)
   double last_shift = 0.0;  // μ of the last shifted iteration
   bool polished = false;    // the polishing correction was taken (NewtonOptions::polish)
   // Converged because the Newton correction fell below kRoundoffFloor·‖x‖: x cannot be resolved
