@@ -243,7 +243,8 @@ TEST(LinearSolvers, AutoPicksByTheNumberOfUnknowns) {
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom),
             LinearSolverKind::kCg);
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kCg, 3), LinearSolverKind::kCg);
-  // cg_amg from 200 000 unknowns (integrators/newton.cpp kAutoAmgFrom, docs/PERF.md §3).
+  // cg_amg from 200 000 unknowns (integrators/newton.cpp kAutoAmgFrom, docs/PERF.md "Implicit
+  // step").
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 199999), LinearSolverKind::kCg);
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 200000), LinearSolverKind::kCgAmg);
 }

@@ -64,8 +64,8 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
 
 }  // namespace
 
-// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md §3, CPU s of a
-// steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
+// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md "Implicit step", CPU s of
+// a steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
 // unknowns cg 0.535 against cg_amg 0.697; at 544 320 unknowns cg 11.4 against cg_amg 9.9. The
 // threshold sits near the geometric middle of the two sizes; sizes between were not measured.
 constexpr long kAutoAmgFrom = 200000;
