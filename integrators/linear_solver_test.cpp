@@ -15,7 +15,8 @@
 namespace geomint {
 namespace {
 
-const std::vector<std::string> kSolvers = {"ldlt", "ldlt_metis", "cholmod", "cg", "cg_ichol"};
+const std::vector<std::string> kSolvers = {"ldlt", "ldlt_metis", "cholmod",
+                                           "cg",   "cg_ichol",   "cg_amg"};
 
 struct Trajectory {
   State state;
@@ -65,6 +66,10 @@ TEST_P(SameTrajectory, EverySolverMatchesLdltToTheNewtonTolerance) {
         EXPECT_LE(relative_difference(other.state.p, reference.state.p), 1e-9) << bar << method;
         EXPECT_GT(other.counters.factorizations, 0) << method;
         if (std::string(modified) == "true" && solver.rfind("cg", 0) != 0) {
+          EXPECT_LT(other.counters.factorizations, other.counters.newton_iters) << method;
+        }
+        // cg_amg reuses its multigrid set-up across iterations and steps, modified or not.
+        if (solver == "cg_amg") {
           EXPECT_LT(other.counters.factorizations, other.counters.newton_iters) << method;
         }
       }
@@ -123,7 +128,7 @@ NewtonSystem cosine_chain(int n, double c) {
 TEST(LinearSolvers, SpdSafeguardShiftsWithEverySolver) {
   for (LinearSolverKind kind :
        {LinearSolverKind::kLdlt, LinearSolverKind::kLdltMetis, LinearSolverKind::kCholmod,
-        LinearSolverKind::kCg, LinearSolverKind::kCgIchol}) {
+        LinearSolverKind::kCg, LinearSolverKind::kCgIchol, LinearSolverKind::kCgAmg}) {
     NewtonOptions options;
     options.linear.kind = kind;
     Vec x = Vec::Constant(8, 2.0);
@@ -139,8 +144,8 @@ TEST(LinearSolvers, IndefiniteMatrixWithoutSafeguardFallsBackToLdlt) {
   // xᵢ = π, where J = −I + c·(graph Laplacian) is negative definite: CHOLMOD and CG cannot
   // factorise or iterate on it; they fall back to LDLT and reach the same root as LDLT does.
   Vec reference;
-  for (LinearSolverKind kind :
-       {LinearSolverKind::kLdlt, LinearSolverKind::kCholmod, LinearSolverKind::kCg}) {
+  for (LinearSolverKind kind : {LinearSolverKind::kLdlt, LinearSolverKind::kCholmod,
+                                LinearSolverKind::kCg, LinearSolverKind::kCgAmg}) {
     NewtonSystem system = cosine_chain(6, 0.1);
     system.objective = nullptr;
     NewtonOptions options;
@@ -156,12 +161,92 @@ TEST(LinearSolvers, IndefiniteMatrixWithoutSafeguardFallsBackToLdlt) {
   }
 }
 
+// R(x) = A x − b on a 31 × 31 grid (961 unknowns, not a multiple of 3: scalar AMG), with
+// A = M + a·Lₓ + Lᵧ, M = I, L the 1-D second-difference operators scaled by 10⁴: isotropic for
+// a = 1; for a = 10⁴ the x couplings dominate, which an isotropic hierarchy does not coarsen along,
+// so CG needs far more iterations with it (the textbook case for rebuilding AMG).
+NewtonSystem anisotropic_grid(const double& anisotropy) {
+  constexpr int kSide = 31;
+  NewtonSystem system;
+  system.symmetric = true;
+  auto matrix = [&anisotropy] {
+    std::vector<Eigen::Triplet<double>> t;
+    const auto index = [](int i, int j) { return i * kSide + j; };
+    for (int i = 0; i < kSide; ++i) {
+      for (int j = 0; j < kSide; ++j) {
+        const double ax = 1e4 * anisotropy, ay = 1e4;
+        t.emplace_back(index(i, j), index(i, j), 1.0 + 2 * ax + 2 * ay);
+        if (i + 1 < kSide) {
+          t.emplace_back(index(i, j), index(i + 1, j), -ax);
+          t.emplace_back(index(i + 1, j), index(i, j), -ax);
+        }
+        if (j + 1 < kSide) {
+          t.emplace_back(index(i, j), index(i, j + 1), -ay);
+          t.emplace_back(index(i, j + 1), index(i, j), -ay);
+        }
+      }
+    }
+    SparseMatrix A(kSide * kSide, kSide * kSide);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+  };
+  system.residual = [matrix](const Vec& x, Vec& r) { r = matrix() * x - Vec::Ones(x.size()); };
+  system.jacobian = [matrix](const Vec&, SparseMatrix& J) { J = matrix(); };
+  return system;
+}
+
+TEST(LinearSolvers, AmgSetUpIsReusedUntilCgSlowsDown) {
+  // Three solves with one solver (as across steps): isotropic, then twice strongly anisotropic.
+  // The first anisotropic Newton iteration runs on the isotropic set-up and needs many more CG
+  // iterations, which marks the set-up worn out; the next Jacobian gets a new one.
+  const auto three_solves = [](double refresh_growth) {
+    NewtonOptions options;
+    options.linear.kind = LinearSolverKind::kCgAmg;
+    options.linear.amg_refresh_growth = refresh_growth;
+    NewtonSolver solver(options);
+    double anisotropy = 1.0;
+    const NewtonSystem system = anisotropic_grid(anisotropy);
+    std::vector<NewtonResult> results;
+    for (double a : {1.0, 1e4, 1e4}) {
+      anisotropy = a;
+      Vec x = Vec::Zero(31 * 31);
+      results.push_back(solver.solve(system, x, 1.0));
+      EXPECT_TRUE(results.back().converged) << describe(results.back());
+      EXPECT_EQ(results.back().factorizations, results.back().amg_setups);
+    }
+    return results;
+  };
+  const auto setups = [](const std::vector<NewtonResult>& results) {
+    std::vector<int> out;
+    for (const NewtonResult& r : results) out.push_back(r.amg_setups);
+    return out;
+  };
+  // Default rule: one set-up for the first solve (reused by its later iterations); the second
+  // solve's first iteration on the old set-up is slow, its second iteration gets a new set-up,
+  // which the third solve reuses.
+  const std::vector<NewtonResult> refreshed = three_solves(2.0);
+  EXPECT_EQ(setups(refreshed), (std::vector<int>{1, 1, 0}));
+  EXPECT_GE(refreshed[0].iterations, 2);
+  EXPECT_GE(refreshed[1].iterations, 2);
+  // Never refreshed (an unbounded growth allowance): the first set-up serves all three solves,
+  // and the last one pays for it in CG iterations.
+  const std::vector<NewtonResult> kept = three_solves(1e9);
+  EXPECT_EQ(setups(kept), (std::vector<int>{1, 0, 0}));
+  EXPECT_GT(kept[2].cg_iterations, 2 * refreshed[2].cg_iterations + kAmgRefreshSlack);
+  // growth 0: a set-up for every Jacobian.
+  for (const NewtonResult& r : three_solves(0.0)) EXPECT_EQ(r.amg_setups, r.iterations);
+}
+
 TEST(LinearSolvers, AutoPicksByTheNumberOfUnknowns) {
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom - 1),
             LinearSolverKind::kLdlt);
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, kAutoIterativeFrom),
             LinearSolverKind::kCg);
   EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kCg, 3), LinearSolverKind::kCg);
+  // cg_amg from 200 000 unknowns (integrators/newton.cpp kAutoAmgFrom, docs/PERF.md "Implicit
+  // step").
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 199999), LinearSolverKind::kCg);
+  EXPECT_EQ(resolve_linear_solver(LinearSolverKind::kAuto, 200000), LinearSolverKind::kCgAmg);
 }
 
 TEST(LinearSolvers, OptionIsLeftOutOfTheCanonicalSpecAtItsDefault) {
@@ -181,7 +266,8 @@ TEST(LinearSolvers, BadValueIsAnInputErrorNamingTheAllowedValues) {
     } catch (const InputError& error) {
       const std::string message = error.what();
       EXPECT_NE(message.find("linear_solver"), std::string::npos) << message;
-      EXPECT_NE(message.find("auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol"), std::string::npos)
+      EXPECT_NE(message.find("auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol, cg_amg"),
+                std::string::npos)
           << message;
     }
   }

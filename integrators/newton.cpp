@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/boomer_amg.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -35,7 +36,9 @@ enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
 
 template <class Preconditioner>
 CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& preconditioner,
-                            const Vec& b, double target, int max_iterations, Vec& x) {
+                            const Vec& b, double target, int max_iterations, Vec& x,
+                            int& iterations) {
+  iterations = 0;
   x = Vec::Zero(b.size());
   Vec r = b;
   if (robust_norm(r) <= target) return CgOutcome::kConverged;
@@ -43,6 +46,7 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
   Vec p = z, Ap;
   double rz = r.dot(z);
   for (int k = 0; k < max_iterations; ++k) {
+    ++iterations;
     Ap.noalias() = A.selfadjointView<Eigen::Lower>() * p;
     const double curvature = p.dot(Ap);
     if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
@@ -60,9 +64,16 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
 
 }  // namespace
 
+// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md "Implicit step", CPU s of
+// a steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
+// unknowns cg 0.535 against cg_amg 0.697; at 544 320 unknowns cg 11.4 against cg_amg 9.9. The
+// threshold sits near the geometric middle of the two sizes; sizes between were not measured.
+constexpr long kAutoAmgFrom = 200000;
+
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
-  return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
+  if (unknowns < kAutoIterativeFrom) return LinearSolverKind::kLdlt;
+  return unknowns < kAutoAmgFrom ? LinearSolverKind::kCg : LinearSolverKind::kCgAmg;
 }
 
 const char* linear_solver_name(LinearSolverKind kind) {
@@ -79,22 +90,25 @@ const char* linear_solver_name(LinearSolverKind kind) {
       return "cg";
     case LinearSolverKind::kCgIchol:
       return "cg_ichol";
+    case LinearSolverKind::kCgAmg:
+      return "cg_amg";
   }
   return "auto";
 }
 
 LinearSolverOptions read_linear_solver_option(Params& params) {
-  static const LinearSolverKind kinds[] = {
-      LinearSolverKind::kAuto,    LinearSolverKind::kLdlt, LinearSolverKind::kLdltMetis,
-      LinearSolverKind::kCholmod, LinearSolverKind::kCg,   LinearSolverKind::kCgIchol};
+  static const LinearSolverKind kinds[] = {LinearSolverKind::kAuto,      LinearSolverKind::kLdlt,
+                                           LinearSolverKind::kLdltMetis, LinearSolverKind::kCholmod,
+                                           LinearSolverKind::kCg,        LinearSolverKind::kCgIchol,
+                                           LinearSolverKind::kCgAmg};
   std::vector<std::string> names;
   for (LinearSolverKind kind : kinds) names.push_back(linear_solver_name(kind));
   LinearSolverOptions options;
   const std::string name = params.choice(
       "linear_solver", "auto", names,
       fmt::format("solver of the symmetric Newton systems (auto: ldlt below {} unknowns, "
-                  "else cg)",
-                  kAutoIterativeFrom));
+                  "cg below {}, else cg_amg)",
+                  kAutoIterativeFrom, kAutoAmgFrom));
   for (LinearSolverKind kind : kinds) {
     if (name == linear_solver_name(kind)) options.kind = kind;
   }
@@ -114,6 +128,16 @@ struct NewtonSolver::Factorisation {
   Eigen::DiagonalPreconditioner<double> diagonal;
   Eigen::IncompleteCholesky<double, Eigen::Lower> ichol;
   Eigen::SparseLU<SparseMatrix> lu;
+  BoomerAmg amg;
+  // CG iterations of the first solve after the last AMG set-up (−1: none yet), and whether the
+  // next factorise() must rebuild it (LinearSolverOptions::amg_refresh_growth).
+  int amg_baseline_iterations = -1;
+  bool amg_refresh = false;
+  double amg_refresh_growth = 2.0;
+  // Counters of the solve in progress (set by NewtonSolver::solve).
+  int* factorizations_counter = nullptr;
+  int* amg_setups_counter = nullptr;
+  int* cg_iterations_counter = nullptr;
   SparseMatrix jacobian;
   LinearSolverKind kind = LinearSolverKind::kLdlt;  // resolved for the current system
   // The factorisation held is of this matrix (CG: the matrix itself, kept for the iteration).
@@ -177,7 +201,8 @@ struct NewtonSolver::Factorisation {
     has_factor = false;
     direct_fallback = false;
     const bool analyse = !reuse_symbolic || !same_pattern(matrix, symmetric);
-    ++factorizations;
+    // A reused AMG set-up is no new preconditioner: setup_amg() counts the set-ups.
+    if (!symmetric || kind != LinearSolverKind::kCgAmg) ++factorizations;
     bool ok = false;
     if (!symmetric) {
       ok = analyse_and_factorise(lu, matrix, analyse);
@@ -198,6 +223,11 @@ struct NewtonSolver::Factorisation {
           break;
         case LinearSolverKind::kCgIchol:
           ok = analyse_and_factorise(ichol, matrix, analyse);
+          break;
+        case LinearSolverKind::kCgAmg:
+          ok = (amg.ready() && amg.rows() == matrix.rows() && !amg_refresh &&
+                amg_refresh_growth > 0) ||
+               setup_amg(matrix);
           break;
         case LinearSolverKind::kAuto:
           break;  // resolved before
@@ -222,9 +252,40 @@ struct NewtonSolver::Factorisation {
     return has_factor;
   }
 
+  bool setup_amg(const SparseMatrix& matrix) {
+    ++*factorizations_counter;
+    ++*amg_setups_counter;
+    amg_baseline_iterations = -1;
+    amg_refresh = false;
+    return amg.setup(matrix);
+  }
+
   bool is_cg() const {
     return !direct_fallback &&
-           (kind == LinearSolverKind::kCg || kind == LinearSolverKind::kCgIchol);
+           (kind == LinearSolverKind::kCg || kind == LinearSolverKind::kCgIchol ||
+            kind == LinearSolverKind::kCgAmg);
+  }
+
+  // CG preconditioned by the held AMG set-up; an old set-up that fails (a matrix that moved too
+  // far from it) is rebuilt from the current matrix and the solve repeated once. Tracks the
+  // refresh rule of LinearSolverOptions::amg_refresh_growth.
+  CgOutcome amg_cg(const Vec& rhs, int max_cg, Vec& out) {
+    int iterations = 0;
+    const bool fresh = amg_baseline_iterations < 0;
+    CgOutcome outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+    *cg_iterations_counter += iterations;
+    if (outcome == CgOutcome::kNoConvergence && !fresh) {
+      if (!setup_amg(factored)) return outcome;
+      outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+      *cg_iterations_counter += iterations;
+    }
+    if (outcome != CgOutcome::kConverged) return outcome;
+    if (amg_baseline_iterations < 0) {
+      amg_baseline_iterations = iterations;
+    } else if (iterations > amg_refresh_growth * amg_baseline_iterations + kAmgRefreshSlack) {
+      amg_refresh = true;
+    }
+    return outcome;
   }
 
   // The held factorisation is of a positive definite matrix. LDLT: every pivot of D positive
@@ -257,6 +318,7 @@ struct NewtonSolver::Factorisation {
     }
     const int max_cg = static_cast<int>(std::min<Eigen::Index>(10 * rhs.size() + 100, 100000));
     CgOutcome outcome = CgOutcome::kConverged;
+    int iterations = 0;
     switch (kind) {
       case LinearSolverKind::kLdlt:
         out = ldlt.solve(rhs);
@@ -268,10 +330,15 @@ struct NewtonSolver::Factorisation {
         out = cholmod.solve(rhs);
         break;
       case LinearSolverKind::kCg:
-        outcome = preconditioned_cg(factored, diagonal, rhs, cg_target, max_cg, out);
+        outcome = preconditioned_cg(factored, diagonal, rhs, cg_target, max_cg, out, iterations);
+        *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgIchol:
-        outcome = preconditioned_cg(factored, ichol, rhs, cg_target, max_cg, out);
+        outcome = preconditioned_cg(factored, ichol, rhs, cg_target, max_cg, out, iterations);
+        *cg_iterations_counter += iterations;
+        break;
+      case LinearSolverKind::kCgAmg:
+        outcome = amg_cg(rhs, max_cg, out);
         break;
       case LinearSolverKind::kAuto:
         break;
@@ -398,6 +465,10 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   result.threshold = std::max(relative_tolerance * residual_scale, kSubnormalResidual);
   double scale = residual_scale;
   Factorisation& f = *factorisation_;
+  f.factorizations_counter = &result.factorizations;
+  f.amg_setups_counter = &result.amg_setups;
+  f.cg_iterations_counter = &result.cg_iterations;
+  f.amg_refresh_growth = options_.linear.amg_refresh_growth;
 
   Vec residual;
   auto evaluate = [&](const Vec& at, Vec& r) {

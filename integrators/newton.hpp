@@ -22,8 +22,11 @@ class Params;
 //  - kCg, kCgIchol: preconditioned conjugate gradients (diagonal or incomplete-Cholesky
 //    preconditioner), solved to a residual tied to the Newton threshold, so the Newton stopping
 //    test — and with it every conservation result — is unchanged.
+//  - kCgAmg: the same CG with one BoomerAMG V-cycle as preconditioner (integrators/boomer_amg.hpp),
+//    its set-up reused across Newton iterations and steps
+//    (LinearSolverOptions::amg_refresh_growth).
 //  - kAuto: by the number of unknowns, from the measurements next to kAutoIterativeFrom.
-enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol };
+enum class LinearSolverKind { kAuto, kLdlt, kLdltMetis, kCholmod, kCg, kCgIchol, kCgAmg };
 
 // `auto` picks kLdlt below this many unknowns (every committed result, bit for bit) and kCg from
 // it on. Measured (docs/METHODS.md "Scale", CPU s of a whole one-step run, 2-core machine under
@@ -41,7 +44,17 @@ struct LinearSolverOptions {
   // least kModifiedNewtonContraction per iteration, across iterations and steps (a new Jacobian
   // is factorised as soon as it does not). Direct solvers only; CG always uses the current matrix.
   bool modified_newton = false;
+  // cg_amg keeps its multigrid set-up (built from an earlier matrix: a preconditioner need not be
+  // of the current one) until a CG solve takes more than amg_refresh_growth × (the iterations of
+  // the first solve after that set-up) + kAmgRefreshSlack iterations, and rebuilds it on the next
+  // Jacobian; a CG failure with an old set-up rebuilds it at once and solves again. 0 rebuilds
+  // for every Jacobian.
+  double amg_refresh_growth = 2.0;
 };
+
+// Iterations a reused AMG set-up may add to a small baseline before it counts as worn out (a
+// baseline of 3 iterations rising to 7 is noise, not a worse preconditioner).
+inline constexpr int kAmgRefreshSlack = 4;
 
 // Largest ‖R_{k+1}‖/‖R_k‖ for which modified Newton keeps its factorisation.
 inline constexpr double kModifiedNewtonContraction = 0.25;
@@ -52,7 +65,7 @@ LinearSolverOptions read_linear_solver_option(Params& params);
 
 // The solver a LinearSolverOptions::kind resolves to for a system of `unknowns` unknowns.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns);
-// "ldlt", "ldlt_metis", "cholmod", "cg", "cg_ichol", "auto".
+// "ldlt", "ldlt_metis", "cholmod", "cg", "cg_ichol", "cg_amg", "auto".
 const char* linear_solver_name(LinearSolverKind kind);
 
 // Smallest relative residual the stopping test asks for: R sums a few terms, each rounded to
@@ -200,6 +213,8 @@ struct NewtonResult {
   // Numeric factorisations (or preconditioner set-ups, for CG) of any kind, shifted ones included;
   // below `iterations` under modified Newton.
   int factorizations = 0;
+  int amg_setups = 0;       // BoomerAMG set-ups (cg_amg; also counted in factorizations)
+  int cg_iterations = 0;    // CG iterations of every solve (cg, cg_ichol, cg_amg)
   double last_shift = 0.0;  // μ of the last shifted iteration
   bool polished = false;    // the polishing correction was taken (NewtonOptions::polish)
   // Converged because the Newton correction fell below kRoundoffFloor·‖x‖: x cannot be resolved

@@ -10,7 +10,7 @@ PACKAGES=(
   libeigen3-dev libsundials-dev libgsl-dev libboost-dev
   gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libsuitesparse-dev libmetis-dev libopenblas-dev
+  libsuitesparse-dev libmetis-dev libopenblas-dev libhypre-dev
   clang libclang-rt-14-dev python3 ccache
   libxml2-utils tidy chromium
 )

@@ -95,6 +95,10 @@ const std::vector<Case>& cases() {
        2, "theta0"},
       {"OutOfRangeParameter", "run --problem kepler:e=1.5 --method rk4 --dt 0.1 --t-end 1", 2,
        "e=1.5"},
+      {"UnknownLinearSolver",
+       "run --problem elastic_bar:nx=2,ny=1,nz=1 --method hp:linear_solver=cg_amgx --dt 0.01 "
+       "--t-end 0.01",
+       2, "auto, ldlt, ldlt_metis, cholmod, cg, cg_ichol, cg_amg"},
       {"RigidBodyTriangleInequality",
        "run --problem rigid_body:I1=1,I2=1.2,I3=2.5 --method rattle --dt 0.1 --t-end 1", 2,
        "I3 = 2.5 must be < I1 + I2 = 2.2 (triangle inequality"},

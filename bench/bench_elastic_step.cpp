@@ -1,0 +1,91 @@
+// Steady-state implicit step of the elastic bar per linear solver and per method (issue 30; the
+// table behind `linear_solver=auto` and paper claim 5 at scale, docs/PERF.md "Implicit step"):
+// after one warm-up step (first factorisation or AMG set-up, symbolic analysis), the wall and CPU
+// time of each further step of the same trajectory, at ~10³, 10⁴, 10⁵ and 10⁶ tetrahedra, with
+// the process's peak resident set (getrusage ru_maxrss) when the benchmark ends.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <string>
+
+#include "integrators/integrator.hpp"
+#include "problems/problem.hpp"
+
+namespace {
+
+// Cells nx × n × n, 6 tetrahedra each: 960, 9 984, 99 840 and 1 029 000 tetrahedra.
+struct Size {
+  int nx, n;
+};
+constexpr Size kSizes[] = {{10, 4}, {26, 8}, {65, 16}, {140, 35}};
+
+// h = 0.011 at 10⁵ tetrahedra (the step of issue 30's measurement), scaled with the cell size so
+// that every size takes the same number of steps per wave crossing a cell.
+double step_size(int size) { return 0.011 * 16.0 / kSizes[size].n; }
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+void BM_Step(benchmark::State& state, const std::string& method) {
+  const int size = static_cast<int>(state.range(0));
+  const Size cells = kSizes[size];
+  const auto problem =
+      geomint::make_problem("elastic_bar:nx=" + std::to_string(cells.nx) +
+                            ",ny=" + std::to_string(cells.n) + ",nz=" + std::to_string(cells.n));
+  const auto integrator = geomint::make_integrator(method);
+  geomint::State s = problem->initial_state();
+  const double h = step_size(size);
+  integrator->reset(*problem, s, h);
+  geomint::StepStatus status = integrator->step(*problem, s, h);  // warm-up
+  const geomint::Counters before = integrator->counters();
+  for (auto _ : state) {
+    status = integrator->step(*problem, s, h);
+    if (!status.ok) {
+      state.SkipWithError(status.message.c_str());
+      break;
+    }
+  }
+  const geomint::Counters& after = integrator->counters();
+  const auto per_step = [&](long geomint::Counters::*field) {
+    return benchmark::Counter(static_cast<double>(after.*field - before.*field),
+                              benchmark::Counter::kAvgIterations);
+  };
+  state.counters["tets"] = 6.0 * cells.nx * cells.n * cells.n;
+  state.counters["dof"] = problem->dof();
+  state.counters["newton_iters"] = per_step(&geomint::Counters::newton_iters);
+  state.counters["factorizations"] = per_step(&geomint::Counters::factorizations);
+  state.counters["hessian_evals"] = per_step(&geomint::Counters::hessian_evals);
+  state.counters["peak_rss_mb"] = peak_rss_mb();
+}
+
+// One benchmark per (method, sizes first..last); three timed steps, one at 10⁶ tetrahedra.
+void sizes(benchmark::internal::Benchmark* b, int first, int last) {
+  b->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+  for (int size = first; size <= last; ++size) b->Arg(size);
+}
+
+#define GEOMINT_STEP(label, method, first, last)                                \
+  BENCHMARK_CAPTURE(BM_Step, label, std::string(method))                        \
+      ->Apply([](benchmark::internal::Benchmark* b) { sizes(b, first, last); }) \
+      ->Iterations(3)
+
+// Linear solvers on the HP midpoint step (hp:alpha=0.5, the minimiser): `auto`'s table.
+// SimplicialLDLT takes minutes per step from 10⁵ tetrahedra, CHOLMOD's fill exceeds memory at 10⁶.
+GEOMINT_STEP(hp_ldlt, "hp:alpha=0.5,linear_solver=ldlt", 0, 1);
+GEOMINT_STEP(hp_cholmod, "hp:alpha=0.5,linear_solver=cholmod", 0, 2);
+GEOMINT_STEP(hp_cg, "hp:alpha=0.5,linear_solver=cg", 0, 3);
+GEOMINT_STEP(hp_cg_amg, "hp:alpha=0.5,linear_solver=cg_amg", 0, 3);
+GEOMINT_STEP(hp_auto, "hp:alpha=0.5", 0, 2);
+// Paper claim 5 at scale: minimiser, Newton on the momentum residual and implicit Euler with the
+// same linear solver and the same stopping rule (tol 1e-12 relative, every method's default).
+GEOMINT_STEP(hp_newton_cg_amg, "hp:alpha=0.5,solver=newton,linear_solver=cg_amg", 1, 3);
+GEOMINT_STEP(implicit_euler_cg_amg, "implicit_euler:linear_solver=cg_amg", 1, 3);
+GEOMINT_STEP(hp_newton_cg, "hp:alpha=0.5,solver=newton,linear_solver=cg", 1, 3);
+GEOMINT_STEP(implicit_euler_cg, "implicit_euler:linear_solver=cg", 1, 3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
