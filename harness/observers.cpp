@@ -166,7 +166,7 @@ class OrthogonalityObserver : public Observer {
     observe(problem, state);
   }
   void observe(const Problem& problem, const State& state) override {
-    const Eigen::Matrix3d Q = attitude_problem(problem)->attitude(state.q);
+    const Eigen::Matrix3d Q = problem.as_attitude()->attitude(state.q);
     err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
@@ -486,10 +486,10 @@ std::vector<std::unique_ptr<Observer>> make_metric_observers(const Problem& prob
   }
   if (problem.has(kCasimir)) observers.push_back(std::make_unique<CasimirObserver>());
   if (problem.has(kConstraints)) observers.push_back(std::make_unique<ConstraintObserver>());
-  if (attitude_problem(problem) != nullptr) {
+  if (problem.as_attitude() != nullptr) {
     observers.push_back(std::make_unique<OrthogonalityObserver>());
   }
-  if (const auto* particle = charged_particle_structure(problem)) {
+  if (const auto* particle = problem.as_charged_particle()) {
     observers.push_back(std::make_unique<MagneticMomentObserver>(*particle));
   }
   if (problem.has(kEndReference)) observers.push_back(std::make_unique<EndReferenceObserver>());
