@@ -40,7 +40,8 @@ std::string modified_energy_not_applicable(const Integrator& method, const Probl
   if (problem.has(kFirstOrderOnly)) return "first-order problem: no Hamiltonian";
   if (problem.has(kForce)) return "forced problem: no conserved Hamiltonian";
   if (problem.has(kConstraints)) return "constrained problem: the correction is for free motion";
-  if (is_non_separable(problem)) return "non-separable problem: the correction assumes ½pᵀM⁻¹p + V";
+  if (problem.kind() == ProblemKind::kLagrangian)
+    return "non-separable problem: the correction assumes ½pᵀM⁻¹p + V";
   if (!problem.has(kHessian)) return "problem has no Hessian ∇²V";
   return "";
 }

@@ -167,7 +167,7 @@ class OrthogonalityObserver : public Observer {
     observe(problem, state);
   }
   void observe(const Problem& problem, const State& state) override {
-    const Eigen::Matrix3d Q = attitude_problem(problem)->attitude(state.q);
+    const Eigen::Matrix3d Q = problem.as_attitude()->attitude(state.q);
     err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
@@ -501,13 +501,13 @@ void add_constraint_observer(const ObserverContext& context, ObserverList& obser
 }
 
 void add_orthogonality_observer(const ObserverContext& context, ObserverList& observers) {
-  if (attitude_problem(context.problem) != nullptr) {
+  if (context.problem.as_attitude() != nullptr) {
     observers.push_back(std::make_unique<OrthogonalityObserver>());
   }
 }
 
 void add_magnetic_moment_observer(const ObserverContext& context, ObserverList& observers) {
-  if (const auto* particle = charged_particle_structure(context.problem)) {
+  if (const auto* particle = context.problem.as_charged_particle()) {
     observers.push_back(std::make_unique<MagneticMomentObserver>(*particle));
   }
 }

@@ -30,7 +30,9 @@ constexpr int kMaxStageIterations = 100;
 class Field {
  public:
   explicit Field(const Problem& problem)
-      : problem_(problem), dof_(problem.dof()), non_separable_(is_non_separable(problem)) {
+      : problem_(problem),
+        dof_(problem.dof()),
+        non_separable_(problem.kind() == ProblemKind::kLagrangian) {
     inverse_mass_ = problem.inverse_mass().cast<Real>();
   }
   void operator()(Real t, const VecL& y, VecL& ydot) {

@@ -283,7 +283,7 @@ std::string series_section_error(const Problem& problem, long section) {
   if (section < 0) return {};
   // The crossing is interpolated with q̇ = M⁻¹p and ṗ = −∇V: canonical separable problems only.
   if (section >= problem.dof() || problem.has(kFirstOrderOnly) || problem.has(kForce) ||
-      problem.has(kConstraints) || is_non_separable(problem)) {
+      problem.has(kConstraints) || problem.kind() == ProblemKind::kLagrangian) {
     return fmt::format(
         "series_section = {}: a Poincare section needs a coordinate index in 0..{} of an "
         "unforced, unconstrained, separable problem (H = p^T M^-1 p/2 + V(q)); '{}' is not",

@@ -28,7 +28,7 @@ class Boris final : public ExplicitStepper<Boris> {
   // through A at the step's start and p written back through A at its end.
   void advance_by(const Problem& problem, State& state, double h) {
     // applicable() admits only problems that offer the structure.
-    const ChargedParticleStructure& particle = *charged_particle_structure(problem);
+    const ChargedParticleStructure& particle = *problem.as_charged_particle();
     const double mass = particle.particle_mass(), charge = particle.particle_charge();
     Vector3 x = state.q.head<3>();
     Vector3 v = (Vector3(state.p.head<3>()) - charge * particle.vector_potential(x)) / mass;

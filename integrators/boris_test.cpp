@@ -118,7 +118,7 @@ TEST(Boris, KeepsTheGyrationRadius) {
     const auto problem = make_problem(spec);
     const State start = problem->initial_state();
     const double omega = gyrofrequency(*problem);
-    const Vec v0 = general_lagrangian(*problem)->velocity(start.q, start.p);
+    const Vec v0 = problem->as_lagrangian()->velocity(start.q, start.p);
     const double radius = std::hypot(v0[0], v0[1]) / omega;
     // The circle's centre from the exact solution half a gyration apart (a diameter's ends).
     const Vec a = problem->exact(0).q, b = problem->exact(std::numbers::pi / omega).q;
@@ -221,7 +221,7 @@ TEST(Boris, RunsOnChargedParticlesOnly) {
   for (const auto& spec : problem_test_specs()) {
     const auto problem = make_problem(spec);
     const Applicability verdict = applicable(*boris, *problem);
-    const bool charged = charged_particle_structure(*problem) != nullptr;
+    const bool charged = problem->as_charged_particle() != nullptr;
     EXPECT_EQ(verdict.ok, charged) << spec;
     EXPECT_EQ(charged, problem->name() == "charged_particle") << spec;
     if (verdict.ok) {

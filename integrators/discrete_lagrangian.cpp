@@ -104,8 +104,8 @@ class DiscreteLagrangianVI final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
-    if (is_non_separable(problem)) {
-      return general_del_step(*general_lagrangian(problem), state, h, nodes_.front().a,
+    if (problem.kind() == ProblemKind::kLagrangian) {
+      return general_del_step(*problem.as_lagrangian(), state, h, nodes_.front().a,
                               {newton_.options().tolerance, newton_.options().max_iterations},
                               counters_);
     }

@@ -52,8 +52,9 @@ std::vector<std::string> separable_specs() {
   for (const auto& spec : problem_test_specs()) {
     const auto problem = make_problem(spec);
     if (problem->has(kHessian) && !problem->has(kForce) && !problem->has(kConstraints) &&
-        !problem->has(kFirstOrderOnly) && !is_non_separable(*problem) && problem->dof() <= 12 &&
-        problem->name() != "fpu_stiff" && problem->name() != "stiff_spring") {
+        !problem->has(kFirstOrderOnly) && problem->kind() != ProblemKind::kLagrangian &&
+        problem->dof() <= 12 && problem->name() != "fpu_stiff" &&
+        problem->name() != "stiff_spring") {
       specs.push_back(spec);
     }
   }

@@ -21,7 +21,7 @@ double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoe
 }  // namespace
 
 std::string spec_on(const Integrator& method, const Problem& problem) {
-  if (is_non_separable(problem)) {
+  if (problem.kind() == ProblemKind::kLagrangian) {
     if (const auto* resolves = dynamic_cast<const ResolvesOnGeneralLagrangian*>(&method)) {
       return resolves->general_lagrangian_spec();
     }

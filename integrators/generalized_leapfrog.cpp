@@ -144,8 +144,8 @@ class GeneralizedLeapfrog final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    if (!is_non_separable(problem)) return separable_step(problem, state, h);
-    return general_leapfrog_step(*general_lagrangian(problem), state, h,
+    if (problem.kind() != ProblemKind::kLagrangian) return separable_step(problem, state, h);
+    return general_leapfrog_step(*problem.as_lagrangian(), state, h,
                                  {newton_.tolerance, newton_.max_iterations}, counters_);
   }
 

@@ -124,8 +124,9 @@ class HamiltonPontryagin final : public Integrator,
     newton_.forget_pattern();
     damping_symmetric_.reset();
     dissipation_potential_.reset();
-    velocity_ = is_non_separable(problem) ? general_lagrangian(problem)->velocity(state.q, state.p)
-                                          : Vec(problem.inverse_mass().cwiseProduct(state.p));
+    velocity_ = problem.kind() == ProblemKind::kLagrangian
+                    ? problem.as_lagrangian()->velocity(state.q, state.p)
+                    : Vec(problem.inverse_mass().cwiseProduct(state.p));
   }
 
   // The HP velocity v_{k+1} = (q_{k+1} − q_k)/h of the last step (p_{k+1} ≠ M v_{k+1} unless α =
@@ -134,7 +135,7 @@ class HamiltonPontryagin final : public Integrator,
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
-    if (is_non_separable(problem)) return general_step(problem, state, h);
+    if (problem.kind() == ProblemKind::kLagrangian) return general_step(problem, state, h);
     const Vec& mass = problem.mass();
     const Vec& inverse_mass = problem.inverse_mass();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
@@ -203,7 +204,7 @@ class HamiltonPontryagin final : public Integrator,
   StepStatus general_step(const Problem& problem, State& state, double h) {
     const Vec q0 = state.q;
     const StepStatus status = general_del_step(
-        *general_lagrangian(problem), state, h, alpha_,
+        *problem.as_lagrangian(), state, h, alpha_,
         {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
     if (!status.ok) {
       return StepStatus::failure(

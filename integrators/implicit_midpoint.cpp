@@ -49,10 +49,10 @@ class ImplicitMidpoint final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    if (is_non_separable(problem)) {
+    if (problem.kind() == ProblemKind::kLagrangian) {
       // On z = (q, p) of the Hamiltonian view (docs/MECHANICS_GENERAL.md §3).
       return general_implicit_midpoint_step(
-          *general_lagrangian(problem), state, h,
+          *problem.as_lagrangian(), state, h,
           {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
     }
     const Vec& mass = problem.mass();

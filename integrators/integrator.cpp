@@ -201,73 +201,112 @@ void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatr
   }
 }
 
-Applicability applicable(const Integrator& method, const Problem& problem) {
-  const MethodInfo info = method.info();
-  // A free rigid body gives such a method all it reads (moments and the (Q, Π) view), be it the
-  // first-order rigid_body_euler or the constrained rigid_body.
-  if ((info.flags & kFreeRigidBodyOnly) && free_rigid_body(problem) != nullptr) return {};
-  // Likewise a charged particle gives the Boris pusher its m, q, E(x), B(x) and A(x).
-  if ((info.flags & kChargedParticleOnly) && charged_particle_structure(problem) != nullptr) {
-    return {};
+MethodNeeds method_needs(const MethodInfo& info) {
+  MethodNeeds needs;
+  if (info.flags & kFirstOrderCapable)
+    needs.kinds |= static_cast<unsigned>(ProblemKind::kFirstOrder);
+  if (info.flags & kGeneralLagrangian)
+    needs.kinds |= static_cast<unsigned>(ProblemKind::kLagrangian);
+  if (info.flags & kFreeRigidBodyOnly) needs.structure = MethodNeeds::Structure::kFreeRigidBody;
+  if (info.flags & kChargedParticleOnly) needs.structure = MethodNeeds::Structure::kChargedParticle;
+  needs.handles_constraints = (info.flags & kConstrained) != 0;
+  needs.handles_rheonomic = (info.flags & kRheonomic) != 0;
+  needs.needs_constraints = (info.flags & kConstraintsOnly) != 0;
+  needs.needs_conservative = (info.flags & kConservativeOnly) != 0;
+  needs.needs_hessian = (info.flags & kNeedsHessian) != 0;
+  return needs;
+}
+
+namespace {
+
+bool offers(const Problem& problem, MethodNeeds::Structure structure) {
+  switch (structure) {
+    case MethodNeeds::Structure::kNone:
+      return false;
+    case MethodNeeds::Structure::kFreeRigidBody:
+      return problem.as_free_rigid_body() != nullptr;
+    case MethodNeeds::Structure::kChargedParticle:
+      return problem.as_charged_particle() != nullptr;
   }
-  if (problem.has(kFirstOrderOnly)) {
-    if (info.flags & kFirstOrderCapable) return {};
+  return false;
+}
+
+std::string structure_refusal(const Integrator& method, const Problem& problem,
+                              MethodNeeds::Structure structure) {
+  if (structure == MethodNeeds::Structure::kFreeRigidBody) {
+    return fmt::format(
+        "method '{}' integrates free rigid bodies only (rigid_body, "
+        "rigid_body_euler, which offer their moments and (Q, Pi)); "
+        "problem '{}' is none",
+        method.spec(), problem.name());
+  }
+  return fmt::format(
+      "method '{}' integrates charged particles only (charged_particle, "
+      "which offers its mass, charge, fields and vector potential); "
+      "problem '{}' is none",
+      method.spec(), problem.name());
+}
+
+std::string lagrangian_kind_refusal(const Integrator& method, const Problem& problem) {
+  const auto* explains = dynamic_cast<const ExplainsGeneralRefusal*>(&method);
+  const std::string specific = explains ? explains->general_lagrangian_refusal() : "";
+  if (!specific.empty()) {
+    return fmt::format(
+        "method '{}' does not run problem '{}', which is non-separable "
+        "(a position-dependent mass M(q) or a gyroscopic term): {}; "
+        "methods that apply: {}",
+        method.spec(), problem.spec(), specific, fmt::join(general_lagrangian_methods(), ", "));
+  }
+  return fmt::format(
+      "method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "
+      "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
+      "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
+      "{}",
+      method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "));
+}
+
+}  // namespace
+
+Applicability applicable(const Integrator& method, const Problem& problem) {
+  const MethodNeeds needs = method_needs(method.info());
+  // A free rigid body gives such a method all it reads (moments and the (Q, Π) view), be it the
+  // first-order rigid_body_euler or the constrained rigid_body; a charged particle gives the
+  // Boris pusher its m, q, E(x), B(x) and A(x).
+  if (offers(problem, needs.structure)) return {};
+  const ProblemKind kind = problem.kind();
+  // A first-order system offers y' = f(t, y) only: a method that runs it needs nothing else.
+  if (kind == ProblemKind::kFirstOrder) {
+    if (needs.runs(kind)) return {};
     return {false,
             fmt::format("method '{}' integrates Lagrangian systems (q, p, M, grad V); "
                         "problem '{}' is a first-order ODE y' = f(t, y) only; methods "
                         "that apply: {}",
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
   }
-  if (info.flags & kFreeRigidBodyOnly) {
-    return {false, fmt::format("method '{}' integrates free rigid bodies only (rigid_body, "
-                               "rigid_body_euler, which offer their moments and (Q, Pi)); "
-                               "problem '{}' is none",
-                               method.spec(), problem.name())};
+  if (needs.structure != MethodNeeds::Structure::kNone) {
+    return {false, structure_refusal(method, problem, needs.structure)};
   }
-  if (info.flags & kChargedParticleOnly) {
-    return {false, fmt::format("method '{}' integrates charged particles only (charged_particle, "
-                               "which offers its mass, charge, fields and vector potential); "
-                               "problem '{}' is none",
-                               method.spec(), problem.name())};
-  }
-  if (is_non_separable(problem) && !(info.flags & kGeneralLagrangian)) {
-    const auto* explains = dynamic_cast<const ExplainsGeneralRefusal*>(&method);
-    const std::string specific = explains ? explains->general_lagrangian_refusal() : "";
-    if (!specific.empty()) {
-      return {false, fmt::format("method '{}' does not run problem '{}', which is non-separable "
-                                 "(a position-dependent mass M(q) or a gyroscopic term): {}; "
-                                 "methods that apply: {}",
-                                 method.spec(), problem.spec(), specific,
-                                 fmt::join(general_lagrangian_methods(), ", "))};
-    }
-    return {
-        false,
-        fmt::format("method '{}' assumes a separable Lagrangian ½vᵀMv − V(q) with a constant "
-                    "mass (its step uses M⁻¹p and ∇V); problem '{}' is non-separable (a "
-                    "position-dependent mass M(q) or a gyroscopic term); methods that apply: "
-                    "{}",
-                    method.spec(), problem.spec(), fmt::join(general_lagrangian_methods(), ", "))};
-  }
+  if (!needs.runs(kind)) return {false, lagrangian_kind_refusal(method, problem)};
   // On a non-separable problem the second derivatives come from its LagrangianSystem.
-  if ((info.flags & kNeedsHessian) && !problem.has(kHessian) && !is_non_separable(problem)) {
+  if (needs.needs_hessian && !problem.has(kHessian) && kind != ProblemKind::kLagrangian) {
     return {false, fmt::format("method '{}' needs a Hessian, which problem '{}' does not have",
-                               info.name, problem.name())};
+                               method.info().name, problem.name())};
   }
-  if (problem.has(kConstraints) && !(info.flags & kConstrained)) {
+  if (problem.has(kConstraints) && !needs.handles_constraints) {
     return {false,
             fmt::format("method '{}' does not handle holonomic constraints, which problem "
                         "'{}' has; methods that do: {}",
                         method.spec(), problem.name(), fmt::join(constrained_methods(), ", "))};
   }
-  if (problem.has(kTimeDependentConstraints) && !(info.flags & kRheonomic)) {
+  if (problem.has(kTimeDependentConstraints) && !needs.handles_rheonomic) {
     return {false, fmt::format("method '{}' handles only time-free constraints; problem '{}' has "
                                "time-dependent ones (rattle, hp, del:rule=midpoint, compositions "
                                "over rattle or hp_midpoint, ida:index=2 or ida:index=3 solve it)",
                                method.spec(), problem.name())};
   }
-  if ((info.flags & kConservativeOnly) && problem.has(kForce)) {
+  if (needs.needs_conservative && problem.has(kForce)) {
     // The flag says the step is the flow of a Hamiltonian with no term for a force; whether the
-    // method also needs a separable H is a different requirement (kGeneralLagrangian, above):
+    // method also needs a separable H is a different requirement (the kinds, above):
     // generalized_leapfrog and tao run non-separable H but no forced problem.
     return {false, fmt::format("method '{}' integrates conservative systems only (its step "
                                "follows a Hamiltonian H(q, p) and has no term for a force); "
@@ -276,7 +315,7 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                                "conservative_only take it",
                                method.spec(), problem.name())};
   }
-  if ((info.flags & kConstraintsOnly) && !problem.has(kConstraints)) {
+  if (needs.needs_constraints && !problem.has(kConstraints)) {
     return {false, fmt::format("method '{}' is for problems with holonomic constraints; problem "
                                "'{}' has none (use an unconstrained method)",
                                method.spec(), problem.name())};

@@ -36,13 +36,13 @@ enum MethodFlag : unsigned {
   // it a method assumes ½vᵀMv − V with a constant M, and applicable() refuses it there.
   kGeneralLagrangian = 1u << 12,
   // Runs on free rigid bodies only (the Lie–Poisson splitting): applicable() admits it exactly
-  // where free_rigid_body(problem) (problems/rigid_body.hpp) finds the structure it reads.
+  // where problem.as_free_rigid_body() (problems/rigid_body.hpp) finds the structure it reads.
   kFreeRigidBodyOnly = 1u << 13,
   // Keeps the energy H(q, p) of a conservative problem to round-off and solver tolerance by
   // construction (avf for polynomial V, projection): a contrast to symplecticity, not a kind of it.
   kEnergyPreserving = 1u << 14,
   // Runs on charged particles only (the Boris pusher): applicable() admits it exactly where
-  // charged_particle_structure(problem) (problems/charged_particle.hpp) finds m, q, E, B and A.
+  // problem.as_charged_particle() (problems/charged_particle.hpp) finds m, q, E, B and A.
   kChargedParticleOnly = 1u << 16,
 };
 std::vector<std::string> flag_names(unsigned flags);
@@ -53,6 +53,30 @@ struct MethodInfo {
   unsigned flags = 0;
   std::string reference;  // where the scheme is defined
 };
+
+// What a method needs of a problem (docs/DESIGN.md §2): the problem kinds it runs, the structure
+// it reads, and what it assumes of constraints and forces. Derived in one place, method_needs(),
+// from the flags the method declares (kFirstOrderCapable, kGeneralLagrangian, kFreeRigidBodyOnly,
+// kChargedParticleOnly, kConstrained, kRheonomic, kConstraintsOnly, kConservativeOnly,
+// kNeedsHessian), so that applicable() decides from requirements and never from method names.
+struct MethodNeeds {
+  // The ProblemKind bits the method runs: every method runs kSeparable problems (a
+  // structure-only method is admitted by its structure first), kFirstOrder with
+  // kFirstOrderCapable, kLagrangian with kGeneralLagrangian.
+  unsigned kinds = static_cast<unsigned>(ProblemKind::kSeparable);
+  // A structure the method reads and cannot run without (Problem::as_free_rigid_body(),
+  // Problem::as_charged_particle()); where the problem offers it the method runs, whatever its
+  // kind.
+  enum class Structure { kNone, kFreeRigidBody, kChargedParticle };
+  Structure structure = Structure::kNone;
+  bool handles_constraints = false;  // kConstrained
+  bool handles_rheonomic = false;    // kRheonomic
+  bool needs_constraints = false;    // kConstraintsOnly
+  bool needs_conservative = false;   // kConservativeOnly: no force F(q, v, t)
+  bool needs_hessian = false;        // kNeedsHessian (a kLagrangian problem always has one)
+  bool runs(ProblemKind kind) const { return (kinds & static_cast<unsigned>(kind)) != 0; }
+};
+MethodNeeds method_needs(const MethodInfo& info);
 
 // The method's family for work-precision fronts and the `family` column: adaptive_library
 // (SUNDIALS, GSL, Boost.Odeint error-controlled solvers), adaptive_geomint (this suite's own

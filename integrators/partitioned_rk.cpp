@@ -73,10 +73,10 @@ class ImplicitPartitionedRk final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    if (is_non_separable(problem)) {
+    if (problem.kind() == ProblemKind::kLagrangian) {
       // On (q, p) of the Hamiltonian view (../shared/MECHANICS.md §4).
       return general_partitioned_rk_step(
-          *general_lagrangian(problem), state, h, a_, a_hat_, b_,
+          *problem.as_lagrangian(), state, h, a_, a_hat_, b_,
           {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
     }
     const int n = problem.dof();

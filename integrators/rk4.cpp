@@ -55,7 +55,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
       advance_first_order(problem, state, h);
       return;
     }
-    if (is_non_separable(problem)) {
+    if (problem.kind() == ProblemKind::kLagrangian) {
       advance_general(problem, state, h);
       return;
     }

@@ -7,7 +7,7 @@ namespace geomint {
 
 bool tangent_applies(const Problem& problem) {
   return problem.has(kHessian) && !problem.has(kForce) && !problem.has(kConstraints) &&
-         !is_non_separable(problem);
+         problem.kind() != ProblemKind::kLagrangian;
 }
 
 Eigen::MatrixXd dense_hessian(const Problem& problem, const Vec& q) {

@@ -51,7 +51,7 @@ class Tao final : public Integrator {
       const double fastest = problem.has(kOmegaMax) ? problem.omega_max(state.q) : 0.0;
       omega_ = std::isfinite(fastest) && fastest > 0.0 ? kDefaultCoupling * fastest : 20.0;
     }
-    if (const LagrangianSystem* general = general_lagrangian(problem)) {
+    if (const LagrangianSystem* general = problem.as_lagrangian()) {
       DenseMatrix mass;
       general->mass_matrix(state.q, mass);
       weight_ = mass.diagonal();
@@ -62,7 +62,7 @@ class Tao final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     if (x_.size() != state.q.size()) reset(problem, state, h);
-    const LagrangianSystem* general = general_lagrangian(problem);
+    const LagrangianSystem* general = problem.as_lagrangian();
     if (order_ == 2) {
       strang(problem, general, state, h);
     } else {

@@ -22,10 +22,10 @@ class ChargedParticleStructure {
   virtual Eigen::Vector3d vector_potential(const Eigen::Vector3d& x) const = 0;
 };
 
-// The structure `problem` offers, or nullptr (every other problem, and a charged particle started
-// from an `initial=` file, whose wrapper drops the problem's own pieces).
+// The structure `problem` offers, or nullptr (every other problem); a charged particle started
+// from an `initial=` file keeps it. Compatibility shim for Problem::as_charged_particle().
 inline const ChargedParticleStructure* charged_particle_structure(const Problem& problem) {
-  return dynamic_cast<const ChargedParticleStructure*>(&problem);
+  return problem.as_charged_particle();
 }
 
 }  // namespace geomint

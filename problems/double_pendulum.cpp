@@ -13,6 +13,7 @@ namespace {
 
 class DoublePendulum final : public Problem, public LagrangianSystem {
  public:
+  const LagrangianSystem* as_lagrangian() const override { return this; }
   DoublePendulum(double m1, double m2, double l1, double l2, double g, Vec theta, Vec omega)
       : m1_(m1),
         m2_(m2),

@@ -68,6 +68,11 @@ class GivenInitialState : public Problem {
                              Vec& a_t) const override {
     base_->constraint_time_terms(t, q, v, g_t, a_t);
   }
+  // A charged particle's mass, charge, fields and vector potential do not depend on its start:
+  // the Boris pusher and the magnetic-moment metric keep them.
+  const ChargedParticleStructure* as_charged_particle() const override {
+    return base_->as_charged_particle();
+  }
   std::vector<std::string> series_names() const override { return base_->series_names(); }
   void series_values(const Vec& q, const Vec& p, std::vector<double>& values) const override {
     base_->series_values(q, p, values);
@@ -88,7 +93,8 @@ class GivenInitialLagrangian final : public GivenInitialState, public Lagrangian
  public:
   GivenInitialLagrangian(std::unique_ptr<Problem> base, State initial)
       : GivenInitialState(std::move(base), std::move(initial)),
-        system_(*general_lagrangian(GivenInitialState::base())) {}
+        system_(*GivenInitialState::base().as_lagrangian()) {}
+  const LagrangianSystem* as_lagrangian() const override { return this; }
 
   void mass_matrix(const Vec& q, DenseMatrix& M) const override { system_.mass_matrix(q, M); }
   void kinetic_gradient(const Vec& q, const Vec& v, Vec& T_q) const override {
@@ -189,7 +195,7 @@ State read_initial_state(const Problem& problem, const std::string& path) {
   state.q = Eigen::Map<const Vec>(first.data(), n);
   state.p = Eigen::Map<const Vec>(second.data(), n);
   // Canonical p = M(q)v + a(q) (a constant diagonal M and a = 0 on a separable problem).
-  if (const LagrangianSystem* system = general_lagrangian(problem)) {
+  if (const LagrangianSystem* system = problem.as_lagrangian()) {
     if (velocities) state.p = system->momentum(state.q, state.p);
     check_general_start(*system, problem, state, path);
   } else if (velocities) {
@@ -209,7 +215,7 @@ std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> proble
                     problem->name()));
   }
   State initial = read_initial_state(*problem, path);
-  if (is_non_separable(*problem)) {
+  if (problem->kind() == ProblemKind::kLagrangian) {
     return std::make_unique<GivenInitialLagrangian>(std::move(problem), std::move(initial));
   }
   return std::make_unique<GivenInitialState>(std::move(problem), std::move(initial));

@@ -130,6 +130,7 @@ class Kepler final : public Problem {
 // Polar coordinates q = (r, φ), p = (p_r, p_φ) = (ṙ, r²φ̇); unit mass and μ = 1 as Kepler.
 class KeplerPolar final : public Problem, public LagrangianSystem {
  public:
+  const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit KeplerPolar(double e) : cartesian_(e), e_(e) {
     set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is diag(1, r²) (is_non_separable)
     // p_φ is the angular momentum (φ is cyclic): the momentum observer reads it through

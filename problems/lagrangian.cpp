@@ -117,7 +117,7 @@ void SeparableLagrangian::potential_hessian(const Vec& q, DenseMatrix& K) const 
 }
 
 std::shared_ptr<const LagrangianSystem> lagrangian_view(const Problem& problem) {
-  if (const LagrangianSystem* own = general_lagrangian(problem)) {
+  if (const LagrangianSystem* own = problem.as_lagrangian()) {
     return std::shared_ptr<const LagrangianSystem>(own, [](const LagrangianSystem*) {});
   }
   if (problem.has(kFirstOrderOnly)) {

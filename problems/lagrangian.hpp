@@ -83,19 +83,13 @@ class SeparableLagrangian final : public LagrangianSystem {
   const Problem& problem_;
 };
 
-// How a Problem offers the general kind: its class derives from LagrangianSystem as well, and
-// this accessor finds it (nullptr for every constant diagonal mass problem). Such a problem is
-// non-separable: its mass() is a placeholder of ones that only sets dof(), p = M(q)v + a(q),
-// energy() is H(q, p) and first_order_rhs() Hamilton's equations (problems/problem.cpp), and only
-// methods flagged kGeneralLagrangian run it (applicable()). The accessor and the flag live here
-// and in integrators/general_step.hpp so that this first step leaves problem.hpp and
-// integrator.hpp, which every file includes, unchanged; splitting the Problem interface by kind
-// would make them a Problem member and a MethodFlag.
+// Compatibility shims for Problem::as_lagrangian() and Problem::kind() (problems/problem.hpp),
+// kept for code written against them.
 inline const LagrangianSystem* general_lagrangian(const Problem& problem) {
-  return dynamic_cast<const LagrangianSystem*>(&problem);
+  return problem.as_lagrangian();
 }
 inline bool is_non_separable(const Problem& problem) {
-  return general_lagrangian(problem) != nullptr;
+  return problem.kind() == ProblemKind::kLagrangian;
 }
 
 // Whether Problem::first_order_jacobian is analytic: a Hessian or a first-order rhs_jacobian
@@ -104,7 +98,7 @@ inline bool is_non_separable(const Problem& problem) {
 // second-derivative blocks). The solvers that cannot run without a Jacobian (GSL msbdf/rk4imp,
 // odeint rosenbrock4, CVODE's KLU path) and IDA ask this, not has_first_order_jacobian().
 inline bool has_analytic_first_order_jacobian(const Problem& problem) {
-  return problem.has_first_order_jacobian() || is_non_separable(problem);
+  return problem.has_first_order_jacobian() || problem.kind() == ProblemKind::kLagrangian;
 }
 
 // The problem's own LagrangianSystem when it is non-separable, otherwise the SeparableLagrangian

@@ -120,11 +120,27 @@ std::vector<std::string> capability_names(unsigned capabilities) {
   return out;
 }
 
+const char* kind_name(ProblemKind kind) {
+  switch (kind) {
+    case ProblemKind::kFirstOrder:
+      return "first_order";
+    case ProblemKind::kSeparable:
+      return "separable";
+    case ProblemKind::kLagrangian:
+      return "lagrangian";
+  }
+  return "unknown";
+}
+
+ProblemKind Problem::kind() const {
+  if (has(kFirstOrderOnly)) return ProblemKind::kFirstOrder;
+  if (as_lagrangian() != nullptr) return ProblemKind::kLagrangian;
+  return ProblemKind::kSeparable;
+}
+
 namespace {
 // The LagrangianSystem of a problem that is_non_separable (callers check).
-const LagrangianSystem& general_system(const Problem& problem) {
-  return *general_lagrangian(problem);
-}
+const LagrangianSystem& general_system(const Problem& problem) { return *problem.as_lagrangian(); }
 
 [[noreturn]] void missing(const Problem& problem, const char* what) {
   throw std::logic_error(fmt::format("problem '{}' has no {}", problem.name(), what));
@@ -270,7 +286,7 @@ double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass_.c
 
 double Problem::energy(const Vec& q, const Vec& p) const {
   if (has(kFirstOrderOnly)) return std::numeric_limits<double>::quiet_NaN();
-  if (is_non_separable(*this)) return general_system(*this).hamiltonian(q, p);
+  if (kind() == ProblemKind::kLagrangian) return general_system(*this).hamiltonian(q, p);
   return kinetic(p) + potential(q);
 }
 
@@ -304,7 +320,7 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
   }
   const int n = dof();
   ydot.resize(2 * n);
-  if (is_non_separable(*this)) {
+  if (kind() == ProblemKind::kLagrangian) {
     // Hamilton's equations of the general L: q̇ = v(q, p), ṗ = L_q(q, v) (docs/MECHANICS_GENERAL.md
     // §1; the Euler–Lagrange equation d/dt L_v = L_q with p = L_v, so one Cholesky solve per
     // evaluation, the same as M(q)v̇ = L_q − L_vq v would need).
@@ -335,7 +351,7 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
     return;
   }
   const int n = dof();
-  if (is_non_separable(*this)) {
+  if (kind() == ProblemKind::kLagrangian) {
     DenseMatrix dense;
     general_system(*this).hamiltonian_vector_field_jacobian(y.head(n), y.tail(n), dense);
     // Every entry, zeros included: a sparse solver (CVODE's KLU) keeps one pattern per run.

@@ -51,6 +51,28 @@ enum Capability : unsigned {
 // Capability names for `geomint list` and error messages.
 std::vector<std::string> capability_names(unsigned capabilities);
 
+// The interfaces a problem may offer beyond Problem (problems/lagrangian.hpp,
+// problems/rigid_body.hpp, problems/charged_particle.hpp).
+class LagrangianSystem;
+class FreeRigidBodyStructure;
+class AttitudeProblem;
+class ChargedParticleStructure;
+
+// The kind of system a problem is (docs/DESIGN.md §2): which interface defines its motion, and so
+// which methods can run it (MethodInfo's kinds, integrators/integrator.hpp).
+enum class ProblemKind : unsigned {
+  // y' = f(t, y) and nothing more (van der Pol, Robertson): rhs()/rhs_jacobian(); y is State::q,
+  // State::p is empty, and V, ∇V, M and H mean nothing (has(kFirstOrderOnly)).
+  kFirstOrder = 1u << 0,
+  // L = ½vᵀMv − V(q) with a constant diagonal M: mass(), potential(), gradient() and the fast
+  // paths built on them (fixed_gradient()).
+  kSeparable = 1u << 1,
+  // The general L(q, v) = ½vᵀM(q)v + a(q)ᵀv − V(q) with its Hamiltonian view: as_lagrangian().
+  kLagrangian = 1u << 2,
+};
+// Name of a kind for messages ("first_order", "separable", "lagrangian").
+const char* kind_name(ProblemKind kind);
+
 class Problem {
  public:
   virtual ~Problem() = default;
@@ -61,6 +83,22 @@ class Problem {
   const std::string& name() const { return name_; }
   unsigned capabilities() const { return capabilities_; }
   bool has(Capability c) const { return (capabilities_ & c) != 0; }
+
+  // ---- The kind and the structures the problem offers, each by one query (nullptr: absent) ----
+  // A class that offers one derives from its interface as well and returns `this`; the queries
+  // replace dynamic_casts and are checked against them for every registered problem
+  // (problems/problems_test.cpp, ProblemKinds).
+  ProblemKind kind() const;
+  // The general Lagrangian interface (problems/lagrangian.hpp) of a kLagrangian problem. Such a
+  // problem's mass() is a placeholder of ones that only sets dof(), p = M(q)v + a(q), energy() is
+  // H(q, p) and first_order_rhs() Hamilton's equations.
+  virtual const LagrangianSystem* as_lagrangian() const { return nullptr; }
+  // The free rigid body's Lie–Poisson structure (rigid_body, rigid_body_euler).
+  virtual const FreeRigidBodyStructure* as_free_rigid_body() const { return nullptr; }
+  // The attitude problem Q ∈ SO(3) as 9 constrained coordinates (rigid_body, heavy_top).
+  virtual const AttitudeProblem* as_attitude() const { return nullptr; }
+  // A charged particle's mass, charge, fields and vector potential (charged_particle).
+  virtual const ChargedParticleStructure* as_charged_particle() const { return nullptr; }
 
   int dof() const { return static_cast<int>(mass_.size()); }
   virtual State initial_state() const = 0;

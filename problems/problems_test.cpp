@@ -21,8 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "problems/charged_particle.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
+#include "problems/rigid_body.hpp"
 #include "tests/test_util.hpp"
 
 namespace geomint {
@@ -105,10 +107,10 @@ Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
   }
   const int n = problem.dof();
   Vec rhs(2 * n);
-  if (is_non_separable(problem)) {
+  if (problem.kind() == ProblemKind::kLagrangian) {
     // (q̇, ṗ) = (v, L_q(q, v)) with M(q)v = p − a(q), from the LagrangianSystem's pieces (the
     // derivatives themselves are checked in problems/lagrangian_test.cpp).
-    const LagrangianSystem& system = *general_lagrangian(problem);
+    const LagrangianSystem& system = *problem.as_lagrangian();
     const Vec v = system.velocity(q, p);
     Vec L_q;
     system.lagrangian_q(q, v, L_q);
@@ -160,9 +162,9 @@ TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
   if (problem.has(kFirstOrderOnly)) GTEST_SKIP() << "first-order only (problems/first_order_test)";
   const State start = problem.initial_state();
   ASSERT_GT(problem.dof(), 0);
-  if (is_non_separable(problem)) {
+  if (problem.kind() == ProblemKind::kLagrangian) {
     // mass() is a placeholder; the energy is H = ½vᵀM(q)v + V with v solved from p = M v + a.
-    const LagrangianSystem& system = *general_lagrangian(problem);
+    const LagrangianSystem& system = *problem.as_lagrangian();
     EXPECT_EQ(start.p.size(), problem.dof());
     DenseMatrix M;
     system.mass_matrix(start.q, M);
@@ -357,9 +359,10 @@ TEST_P(ProblemTest, InvariantsAreConstantAlongExact) {
   // Relative to the sizes of the two energy terms, which cancel for bound orbits (Kepler).
   // kinetic(p) reads the constant mass, a placeholder on a non-separable problem (whose p = m v +
   // qA of an electron is 1e-24): there the kinetic energy is H − V.
-  const double kinetic0 = !mechanical                 ? 0.0
-                          : is_non_separable(problem) ? energy0 - problem.potential(start.q)
-                                                      : problem.kinetic(start.p);
+  const double kinetic0 = !mechanical ? 0.0
+                          : problem.kind() == ProblemKind::kLagrangian
+                              ? energy0 - problem.potential(start.q)
+                              : problem.kinetic(start.p);
   const double energy_scale =
       mechanical ? std::max(kinetic0 + std::abs(problem.potential(start.q)), DBL_MIN) : 1.0;
   const double momentum_scale =
@@ -473,6 +476,21 @@ TEST_P(ProblemTest, RejectsUnknownKeysAndMalformedValues) {
   for (const auto& [key, value] : Spec::parse(problem_->spec()).values) {
     EXPECT_TRUE(test::input_error_names(make_problem, name + ":" + key + "=not_a_number", key));
   }
+}
+
+// The kind and structure queries of Problem (problems/problem.hpp) replace dynamic_casts: a class
+// that derives from an interface but forgets to return `this` from its query would silently lose
+// every method that needs it. Each registered problem's answers are checked against the casts.
+TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
+  const Problem& problem = *problem_;
+  EXPECT_EQ(problem.as_lagrangian(), dynamic_cast<const LagrangianSystem*>(&problem));
+  EXPECT_EQ(problem.as_free_rigid_body(), dynamic_cast<const FreeRigidBodyStructure*>(&problem));
+  EXPECT_EQ(problem.as_attitude(), dynamic_cast<const AttitudeProblem*>(&problem));
+  EXPECT_EQ(problem.as_charged_particle(), dynamic_cast<const ChargedParticleStructure*>(&problem));
+  const ProblemKind expected = problem.has(kFirstOrderOnly) ? ProblemKind::kFirstOrder
+                               : problem.as_lagrangian()    ? ProblemKind::kLagrangian
+                                                            : ProblemKind::kSeparable;
+  EXPECT_EQ(problem.kind(), expected) << kind_name(problem.kind());
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, ProblemTest, ::testing::ValuesIn(problem_test_specs()),

@@ -36,6 +36,7 @@ Eigen::Vector3d column(const Vec& x, int k) { return x.segment<3>(3 * k); }
 // The free body: V = 0, and the Lie–Poisson structure (FreeRigidBodyStructure) through Q and Π.
 class RigidBody final : public AttitudeProblem, public FreeRigidBodyStructure {
  public:
+  const FreeRigidBodyStructure* as_free_rigid_body() const override { return this; }
   RigidBody(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude)
       : AttitudeProblem(parameters, attitude,
                         kHessian | kAngularMomentum | kConstraints | kCasimir),
@@ -194,12 +195,10 @@ void AttitudeProblem::series_values(const Vec& q, const Vec& p, std::vector<doub
 }
 
 const FreeRigidBodyStructure* free_rigid_body(const Problem& problem) {
-  return dynamic_cast<const FreeRigidBodyStructure*>(&problem);
+  return problem.as_free_rigid_body();
 }
 
-const AttitudeProblem* attitude_problem(const Problem& problem) {
-  return dynamic_cast<const AttitudeProblem*>(&problem);
-}
+const AttitudeProblem* attitude_problem(const Problem& problem) { return problem.as_attitude(); }
 
 Eigen::Matrix3d read_initial_attitude(Params& params, const std::string& problem) {
   Eigen::Vector3d axis;

@@ -57,6 +57,7 @@ class AttitudeProblem : public Problem {
   AttitudeProblem(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude,
                   unsigned capabilities);
   State initial_state() const override;
+  const AttitudeProblem* as_attitude() const override { return this; }
   // Q from its columns.
   Eigen::Matrix3d attitude(const Vec& q) const;
   // Σ_k c_k × p_k = Q J Ω, the spatial angular momentum.
@@ -95,6 +96,7 @@ class FreeRigidBodyStructure {
                           Vec& q, Vec& p) const = 0;
 };
 
+// (Compatibility shims for Problem::as_free_rigid_body() and as_attitude().)
 // The structure a problem offers, or nullptr (every other problem, and a rigid body started from
 // an `initial=` file, whose given state drops the problem's own pieces).
 const FreeRigidBodyStructure* free_rigid_body(const Problem& problem);

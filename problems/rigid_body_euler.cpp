@@ -12,6 +12,7 @@ namespace {
 
 class RigidBodyEuler final : public FirstOrderProblem, public FreeRigidBodyStructure {
  public:
+  const FreeRigidBodyStructure* as_free_rigid_body() const override { return this; }
   RigidBodyEuler(const RigidBodyParameters& parameters, const Eigen::Vector3d& pi0,
                  const FreeBodyMotion& motion)
       : FirstOrderProblem(Vec(pi0), Capabilities(motion)),

@@ -66,6 +66,7 @@ class RodChain final : public rods::RodProblem {
 // C_ij = μ_ij l_i l_j, and V = −g Σ_i μ_ii l_i cos θ_i (μ_ii: the mass at and below node i).
 class RodChainJoint final : public Problem, public LagrangianSystem {
  public:
+  const LagrangianSystem* as_lagrangian() const override { return this; }
   RodChainJoint(const Vec& node_mass, const Vec& length, double gravity, Vec theta, Vec omega)
       : theta_(std::move(theta)), omega_(std::move(omega)) {
     const int n = static_cast<int>(node_mass.size());

@@ -90,6 +90,7 @@ class SphericalPendulum final : public rods::RodProblem {
 // vertical angular momentum x p_y − y p_x of the Cartesian variant) is kept.
 class SphericalPendulumAngles final : public Problem, public LagrangianSystem {
  public:
+  const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit SphericalPendulumAngles(const SphericalParameters& parameters)
       : parameters_(parameters), inertia_(parameters.mass * parameters.length * parameters.length) {
     set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is mL² diag(1, sin²θ)

@@ -20,6 +20,7 @@ struct SpringPendulumParameters {
 
 class SpringPendulum final : public Problem, public LagrangianSystem {
  public:
+  const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit SpringPendulum(const SpringPendulumParameters& parameters) : P_(parameters) {
     set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is m diag(1, r²)
     set_capabilities(kOmegaMax);

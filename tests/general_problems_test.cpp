@@ -53,7 +53,7 @@ TEST(RodChainJoint, StartsInTheCartesianChainsStateWithItsEnergy) {
   for (const char* parameters : kChains) {
     const auto joint = make_problem(std::string("rod_chain:coordinates=joint,") + parameters);
     const auto cartesian = make_problem(std::string("rod_chain:") + parameters);
-    ASSERT_TRUE(is_non_separable(*joint));
+    ASSERT_TRUE(joint->kind() == ProblemKind::kLagrangian);
     const State a = joint->initial_state();
     const State c = cartesian->initial_state();
     const auto spec = joint->spec();
@@ -217,7 +217,7 @@ TEST(GeneralRows, RerunningARowsMethodSpecReproducesIt) {
   int rows = 0, resolved = 0;
   for (const auto& problem_spec : problem_test_specs()) {
     const auto problem = make_problem(problem_spec);
-    if (!is_non_separable(*problem)) continue;
+    if (problem->kind() != ProblemKind::kLagrangian) continue;
     const Spec canonical = Spec::parse(problem->spec());
     const auto coordinates = canonical.values.find("coordinates");
     const std::string kind =
@@ -292,6 +292,42 @@ TEST(GeneralRows, InitialStateFileUsesThePositionDependentMass) {
     EXPECT_TRUE(from_file.final_state.p == direct.final_state.p) << method;
     EXPECT_EQ(from_file.record.metrics.at("energy_err_max"),
               direct.record.metrics.at("energy_err_max"))
+        << method;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A charged particle started from a file keeps its mass, charge and fields
+// (Problem::as_charged_particle() forwarded by the initial= wrapper): Boris runs, and it and the
+// magnetic-moment metric give the direct run's bits from the same start.
+TEST(GeneralRows, ChargedParticleFromAFileKeepsItsFields) {
+  const std::filesystem::path dir =
+      std::filesystem::path(testing::TempDir()) / "geomint_charged_initial";
+  std::filesystem::create_directories(dir);
+  const std::string base =
+      "charged_particle:field=bottle,mass=1.3,charge=0.8,B=2,length=1.5,vx=1,vz=0.5,z0=0.1,xc=0.05";
+  const State own_start = make_problem(base)->initial_state();
+  const std::string momenta = (dir / "qp.csv").string();
+  {
+    std::ofstream file(momenta);
+    file << "q,p\n";
+    for (int i = 0; i < 3; ++i) {
+      file << fmt::format("{:.17g},{:.17g}\n", own_start.q[i], own_start.p[i]);
+    }
+  }
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 0.3;
+  config.timing_repeats = 0;
+  for (const char* method : {"boris", "del"}) {
+    const RunResult direct = run_one(base, method, config);
+    const RunResult from_file = run_one(base + ",initial=" + momenta, method, config);
+    ASSERT_TRUE(direct.ok && from_file.ok) << method << ": " << from_file.record.status;
+    EXPECT_TRUE(from_file.final_state.q == direct.final_state.q) << method;
+    EXPECT_TRUE(from_file.final_state.p == direct.final_state.p) << method;
+    ASSERT_EQ(from_file.record.metrics.count("magnetic_moment_err_max"), 1u) << method;
+    EXPECT_EQ(from_file.record.metrics.at("magnetic_moment_err_max"),
+              direct.record.metrics.at("magnetic_moment_err_max"))
         << method;
   }
   std::filesystem::remove_all(dir);
