@@ -25,6 +25,8 @@ std::string spec(const coefficients::RknTable& table) {
 // (verify::declared_order starts orders >= 8 at 16·dt0 and drops two levels for orders >= 6).
 // Order 8 is pre-asymptotic at ωh >= 0.4 (7.67 on h = 0.8 … 0.2): it starts ×4 smaller with two
 // more levels.
+// dprkn8 is not a registry variant: the suite's pendulum order test (tests/methods_test.cpp)
+// measures 9.5 on its h = 0.8 … 0.2, pre-asymptotic; this ladder is where it is asymptotic.
 class RknTable : public testing::TestWithParam<coefficients::RknTable> {};
 
 TEST_P(RknTable, HasItsDeclaredOrder) {
