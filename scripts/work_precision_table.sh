@@ -21,14 +21,15 @@ rm -rf wp
 mkdir -p wp
 # split_csv comes from scripts/csv.awk; the program is read from the here-document.
 awk -v out=wp -f "$(dirname "$0")/csv.awk" -f /dev/stdin "$summary" > time_to_error.md <<'AWK'
-# Curve name: the method spec without its tolerances, file-name safe, library defaults dropped.
+# Curve name: the method name and its scheme, s, table or pair (tolerances and library defaults
+# dropped), file-name safe.
 function curve_name(spec,    name, rest, parts, n, i, kept) {
   name = spec; rest = ""
   if (index(spec, ":") > 0) { name = substr(spec, 1, index(spec, ":") - 1); rest = substr(spec, index(spec, ":") + 1) }
   kept = name
   n = split(rest, parts, ",")
   for (i = 1; i <= n; i++) {
-    if (parts[i] ~ /^(scheme|s)=/) { sub(/^scheme=/, "", parts[i]); sub(/=/, "", parts[i]); kept = kept "_" parts[i] }
+    if (parts[i] ~ /^(scheme|s|table|pair)=/) { sub(/^(scheme|table|pair)=/, "", parts[i]); sub(/=/, "", parts[i]); kept = kept "_" parts[i] }
   }
   return kept
 }

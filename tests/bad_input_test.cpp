@@ -114,6 +114,14 @@ const std::vector<Case>& cases() {
       {"SprkWithAForce", "run --problem damped_oscillator --method sprk --dt 0.1 --t-end 1", 2,
        "integrates conservative systems only (its step follows a Hamiltonian H(q, p) and has no "
        "term for a force); problem 'damped_oscillator'"},
+      // --- the RKN families: a table or pair from their lists, conservative problems only ---
+      {"RknUnknownTable", "run --problem kepler --method rkn:table=dprkn7 --dt 0.1 --t-end 1", 2,
+       "table='dprkn7' is not allowed (allowed: nystrom4"},
+      {"RknAdaptivePairWithoutEmbedding",
+       "run --problem kepler --method rkn_adaptive:pair=nystrom4 --t-end 1", 2,
+       "pair='nystrom4' is not allowed (allowed: dprkn4"},
+      {"RknWithAForce", "run --problem damped_oscillator --method rkn --dt 0.1 --t-end 1", 2,
+       "integrates conservative systems only"},
       {"QuaternionOnHeavyTop", "run --problem heavy_top --method quaternion --dt 0.1 --t-end 1", 2,
        "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
       {"QuaternionUnknownBase",

@@ -65,8 +65,12 @@ TEST(MapDefect, DeclaredFlagAgreesWithTheComputedMapForEveryFixedStepMethod) {
         !map_defect_not_applicable(*method, *problem, 0.05).empty()) {
       continue;
     }
-    const MapDefect value =
-        symplecticity_defect_map(spec, *problem, problem->initial_state(), 0.05);
+    // A non-symplectic map of order p >= 6 differs from a symplectic one by O(h^7): at h = 0.05
+    // rkn:table=dprkn6 measures 9.6e-10 against a floor of 1.9e-9, so it is measured at h = 0.2.
+    const bool high_order_explicit =
+        !(method->info().flags & kSymplectic) && method->info().order >= 6;
+    const MapDefect value = symplecticity_defect_map(spec, *problem, problem->initial_state(),
+                                                     high_order_explicit ? 0.2 : 0.05);
     if (method->info().flags & kSymplectic) {
       EXPECT_LE(value.defect, value.fd_error) << spec;
       ++symplectic;
