@@ -167,7 +167,10 @@ struct [[nodiscard]] LoopOutcome {
   StepStatus status;
   long steps = 0;
   double t_reached = 0;  // time of the last step point that passed the checks
+  double seconds = 0;    // wall time of the loop (a timeout row's wall_s)
 };
+
+using Clock = std::chrono::steady_clock;
 
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
 // Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
@@ -175,6 +178,11 @@ struct [[nodiscard]] LoopOutcome {
 // `admit(state)` (the observers' divergence rule, add_energy_observers) before it is visited;
 // `checked` = false (timing pass) skips both, and `visit` for fixed-step methods: the metric
 // pass has already established that the run succeeds.
+// config.wall_budget_s > 0: a step point reached after the budget ends the run as `timeout`
+// (checked runs at every step point; unchecked adaptive runs too, since an adaptive step costs
+// far more than reading the clock). The unchecked fixed-step loop has no visitor, so that
+// explicit methods keep their state in registers; it replays a grid the checked pass (slower,
+// with observers) finished inside the budget, and time_run reports a repeat that overruns.
 template <typename Admit, typename Visit>
 LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& state,
                       const RunConfig& config, bool adaptive, bool checked, Admit&& admit,
@@ -182,10 +190,27 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   LoopOutcome outcome;
   const double t0 = state.t;
   outcome.t_reached = t0;
+  const auto start = Clock::now();
+  const auto seconds_since_start = [&] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  // Sets outcome.status and returns false when the run has spent its wall-clock budget.
+  auto within_budget = [&](const State& s) {
+    if (config.wall_budget_s <= 0) return true;
+    const double spent = seconds_since_start();
+    if (spent <= config.wall_budget_s) return true;
+    outcome.status = StepStatus::failure(
+        kTimeoutStatus,
+        fmt::format("wall-clock budget spent: {:.3g} s > wall_budget_s = {:g} s at t={:.6g} "
+                    "(raise it with --wall-budget S, scene key wall_budget_s)",
+                    spent, config.wall_budget_s, s.t));
+    return false;
+  };
   // Sets outcome.status and returns false when the state fails the checks; a passing step
   // builds no failure message.
   auto check = [&](const State& s) {
     if (!checked) return true;
+    if (!within_budget(s)) return false;
     if (!finite(s)) {
       outcome.status = StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
       return false;
@@ -203,11 +228,15 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
         outcome.status = std::move(status);
         return outcome;
       }
-      if (!check(state)) return outcome;
+      if (!check(state) || (!checked && !within_budget(state))) {
+        outcome.seconds = seconds_since_start();
+        return outcome;
+      }
       ++outcome.steps;
       outcome.t_reached = state.t;
       visit(state, state.t >= t_end);
     }
+    outcome.seconds = seconds_since_start();
     return outcome;
   }
   const StepGrid grid{t0, config.dt, config.t_end,
@@ -238,6 +267,7 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
     }
     outcome.status = std::move(advanced.status);
   }
+  outcome.seconds = seconds_since_start();
   return outcome;
 }
 
@@ -271,6 +301,11 @@ std::vector<std::string> run_config_errors(const RunConfig& config, bool adaptiv
     errors.push_back(
         fmt::format("--diverge-factor must be >= 0 (0 or inf: no divergence rule; got {})",
                     config.diverge_factor));
+  }
+  if (!(config.wall_budget_s >= 0 && config.wall_budget_s <= kMaxWallBudgetSeconds)) {
+    errors.push_back(
+        fmt::format("--wall-budget must be in [0, {:g}] seconds (0: no budget; got {})",
+                    kMaxWallBudgetSeconds, config.wall_budget_s));
   }
   return errors;
 }
@@ -316,6 +351,7 @@ TimingStats timing_stats(std::vector<double> seconds) {
   };
   TimingStats stats;
   stats.min = seconds.front();
+  stats.max = seconds.back();
   stats.median = quantile(0.5);
   stats.iqr = quantile(0.75) - quantile(0.25);
   stats.count = static_cast<int>(seconds.size());
@@ -332,7 +368,6 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
   const RunConfig& config = spec.config;
   const bool adaptive = spec.method.adaptive();
   const int wanted = std::max(1, repeats);
-  using Clock = std::chrono::steady_clock;
   const auto pass_start = Clock::now();
   // One run from a fresh integrator; its wall time, or nullopt with the failed status.
   StepStatus failed = StepStatus::success();
@@ -350,21 +385,48 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
     }
     return std::chrono::duration<double>(Clock::now() - start).count();
   };
+  // A run over the per-run budget ends the pass: the row is a timeout at that run's time.
+  const auto over_budget = [&](double seconds) {
+    return config.wall_budget_s > 0 && seconds > config.wall_budget_s;
+  };
+  const auto timed_out = [&](std::vector<double> seconds) {
+    TimingOutcome result;
+    result.status = StepStatus::success();
+    result.timed_out = true;
+    result.stats = timing_stats(std::move(seconds));
+    result.seconds = result.stats.max;
+    result.budget_note = fmt::format(
+        "timing pass: a run took {:.3g} s > wall_budget_s = {:g} s (raise it with --wall-budget "
+        "S, scene key wall_budget_s)",
+        result.stats.max, config.wall_budget_s);
+    return result;
+  };
   const auto elapsed = [&] {
     return std::chrono::duration<double>(Clock::now() - pass_start).count();
   };
   TimingOutcome outcome;
   const std::optional<double> warm_up = one_run();
-  if (!warm_up) return {std::move(failed), {}, 0, {}};
+  if (!warm_up) {
+    // An adaptive run that hit the budget inside its loop.
+    if (failed.reason == kTimeoutStatus) return timed_out({elapsed()});
+    return {std::move(failed), {}, 0, {}};
+  }
+  if (over_budget(*warm_up)) return timed_out({*warm_up});
   std::vector<double> seconds;
   // A repeat starts only when one more run of the longest duration seen so far still ends
   // inside the budget. A warm-up that alone leaves no room is the pass's only sample.
   double longest = *warm_up;
   while (static_cast<int>(seconds.size()) < wanted) {
     if (elapsed() + longest > config.timing_budget_s) break;
+    const auto run_start = Clock::now();
     const std::optional<double> run = one_run();
+    if (!run && failed.reason == kTimeoutStatus) {
+      seconds.push_back(std::chrono::duration<double>(Clock::now() - run_start).count());
+      return timed_out(seconds);
+    }
     if (!run) return {std::move(failed), {}, 0, {}};
     seconds.push_back(*run);
+    if (over_budget(*run)) return timed_out(seconds);
     longest = std::max(longest, *run);
   }
   if (static_cast<int>(seconds.size()) < wanted) {
@@ -384,6 +446,14 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
 void record_timing(const TimingOutcome& timing, RunRecord& record) {
   if (!timing.status.ok) {
     record.message = timing.failure_message();
+    return;
+  }
+  if (timing.timed_out) {
+    record.status = kTimeoutStatus;
+    record.wall_s = timing.seconds;
+    record.wall_s_min = timing.stats.min;
+    record.wall_s_repeats = timing.stats.count;
+    record.message = timing.budget_note;
     return;
   }
   record.wall_s = timing.stats.median;
@@ -468,12 +538,15 @@ RunResult run_one(const RunSpec& spec) {
     record.message = outcome.status.message;
     record.t_reached = outcome.t_reached;
   }
+  // A timeout is a point of the work-precision diagram at the budget: the seconds spent.
+  if (outcome.status.reason == kTimeoutStatus) record.wall_s = outcome.seconds;
   record.steps = outcome.steps;
   record.counters = integrator->counters();
   if (series) series->commit();
 
   if (result.ok && config.timing_repeats > 0) {
     record_timing(time_run(spec, config.timing_repeats), record);
+    result.ok = record.status != kTimeoutStatus;
   }
   return result;
 }

@@ -20,6 +20,8 @@ struct RunSpec;  // harness/run_spec.hpp
 // `--diverge-factor` / scene key `diverge_factor`. 0 or +inf turns the rule off (non-finite
 // states still end the run with status `nan`).
 constexpr double kDefaultDivergeFactor = 1e8;
+// The failure reason of a run that exceeded RunConfig::wall_budget_s.
+inline constexpr const char* kTimeoutStatus = "timeout";
 // Caps on counts that would otherwise let one option request unbounded work.
 constexpr int kMaxTimingRepeats = 100;
 // Wall-clock budget of one timing pass (warm-up + repeats), scene key `timing_budget_s`: a pass
@@ -27,6 +29,11 @@ constexpr int kMaxTimingRepeats = 100;
 // run gets fewer repeats — a point with its count in wall_s_repeats and a message, not a hole.
 constexpr double kDefaultTimingBudgetSeconds = 600;
 constexpr double kMaxTimingBudgetSeconds = 86400;
+// Wall-clock budget of one run (`--wall-budget`, scene key `wall_budget_s`; 0 = none): a metric
+// pass still running after it ends at the next step point as the row status `timeout` (t_reached,
+// wall_s = the seconds spent), and a timing pass whose run takes longer marks the row `timeout`
+// too, so that a work-precision diagram draws the run as a point at the budget, not as a hole.
+constexpr double kMaxWallBudgetSeconds = 86400;
 constexpr double kMaxFixedSteps = 1e10;  // t_end/dt of one fixed-step run
 // The step budget of a fixed-step run (`--max-steps`, scene key `max_steps`), as the library
 // wrappers have theirs: a run whose grid has more steps ends at once as the failure row
@@ -47,6 +54,7 @@ struct RunConfig {
   int timing_repeats = 3;  // separate timed runs without observers (0..kMaxTimingRepeats)
   double timing_budget_s = kDefaultTimingBudgetSeconds;  // see kDefaultTimingBudgetSeconds
   double diverge_factor = kDefaultDivergeFactor;         // see kDefaultDivergeFactor; 0/inf = off
+  double wall_budget_s = 0;                              // see kMaxWallBudgetSeconds; 0 = no budget
   long max_steps = kDefaultMaxSteps;  // fixed-step runs: grid steps allowed (1..kMaxFixedSteps)
   std::string command_line;           // for the series provenance
   // Problems without an exact solution: error_final/error_max against the reference file
@@ -88,7 +96,7 @@ RunResult run_one(const std::string& problem_spec, const std::string& method_spe
 // range Q3 − Q1, with quartiles interpolated linearly between order statistics (Hyndman–Fan
 // type 7, R's and NumPy's default): Q(p) = x₍ⱼ₎ + f·(x₍ⱼ₊₁₎ − x₍ⱼ₎), j + f = p·(n − 1), 0-based.
 struct TimingStats {
-  double min = 0, median = 0, iqr = 0;
+  double min = 0, median = 0, iqr = 0, max = 0;
   int count = 0;  // repeats the statistics are taken over
 };
 // Throws std::invalid_argument on an empty sample (a timing pass always times one run).
@@ -103,6 +111,9 @@ struct [[nodiscard]] TimingOutcome {
   double seconds = 0;  // stats.median
   // Why fewer than `repeats` runs were timed (the budget), empty otherwise.
   std::string budget_note;
+  // A timed run took longer than config.wall_budget_s: the row becomes status `timeout` with
+  // wall_s = that run's seconds (stats hold the runs timed up to and including it).
+  bool timed_out = false;
   // "timing pass failed: reason: message", the row's message when the status failed.
   std::string failure_message() const;
 };
@@ -111,12 +122,14 @@ TimingOutcome time_run(const RunSpec& spec, int repeats);
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats);
 // Writes a successful outcome's statistics into the record (wall_s = median, wall_s_min,
-// wall_s_iqr, wall_s_repeats) and a budget note as its message; a failed one's message.
+// wall_s_iqr, wall_s_repeats) and a budget note as its message; a failed one's message; a
+// timed-out one also sets status `timeout`.
 void record_timing(const TimingOutcome& timing, RunRecord& record);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,
-// --timing-repeats, --diverge-factor and --max-steps: one message per offending option, naming
-// it and what is allowed. A grid longer than max_steps is no input error but a failure row.
+// --timing-repeats, --diverge-factor, --max-steps and --wall-budget: one message per offending
+// option, naming it and what is allowed. A grid longer than max_steps is no input error but a
+// failure row.
 std::vector<std::string> run_config_errors(const RunConfig& config, bool adaptive);
 // The same as one InputError listing every message.
 void validate_run_config(const RunConfig& config, bool adaptive);

@@ -161,6 +161,7 @@ Scene load_scene(const std::string& path, bool quick) {
     block.diverge_factor = reader.number("diverge_factor", false, kDefaultDivergeFactor);
     block.max_steps =
         reader.integer("max_steps", false, kDefaultMaxSteps, 1, static_cast<long>(kMaxFixedSteps));
+    block.wall_budget_s = reader.number("wall_budget_s", false, 0);
     const auto quick_dts = reader.numbers("quick_dt", false);
     double quick_t_end = 0;
     const bool has_quick_t_end = quick_number(reader, "quick_t_end", where, &quick_t_end);
@@ -170,6 +171,11 @@ Scene load_scene(const std::string& path, bool quick) {
     if (!(block.timing_budget_s > 0 && block.timing_budget_s <= kMaxTimingBudgetSeconds)) {
       throw InputError(fmt::format("{}: 'timing_budget_s' must be in (0, {:g}] seconds (got {})",
                                    where, kMaxTimingBudgetSeconds, block.timing_budget_s));
+    }
+    if (!(block.wall_budget_s >= 0 && block.wall_budget_s <= kMaxWallBudgetSeconds)) {
+      throw InputError(
+          fmt::format("{}: 'wall_budget_s' must be in [0, {:g}] seconds (0: no budget; got {})",
+                      where, kMaxWallBudgetSeconds, block.wall_budget_s));
     }
     for (double dt : quick_dts) check_positive(dt, where, "quick_dt");
     // Both the full and the quick configuration are checked, whichever runs now.

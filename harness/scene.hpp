@@ -23,6 +23,7 @@ struct RunBlock {
   double timing_budget_s = kDefaultTimingBudgetSeconds;  // RunConfig::timing_budget_s
   double diverge_factor = kDefaultDivergeFactor;  // RunConfig::diverge_factor; 0 or inf = off
   long max_steps = kDefaultMaxSteps;              // RunConfig::max_steps
+  double wall_budget_s = 0;                       // RunConfig::wall_budget_s; 0 = none
 };
 
 struct OrderBlock {

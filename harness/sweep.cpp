@@ -276,6 +276,7 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
           job.config.timing_budget_s = block.timing_budget_s;
           job.config.diverge_factor = block.diverge_factor;
           job.config.max_steps = block.max_steps;
+          job.config.wall_budget_s = block.wall_budget_s;
           job.config.extra_metrics = requested_metrics;
           job.config.command_line = options.command_line;
           if (block.series_every > 0) {
@@ -588,6 +589,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (job.ok) {
       try {
         record_timing(time_run(*job.spec, job.timing_repeats), job.record);
+        job.ok = job.record.status != kTimeoutStatus;  // a timeout is a failure row
       } catch (const std::exception& error) {
         job.record.message = fmt::format("timing pass failed: {}", error.what());
       }
@@ -718,7 +720,9 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
         timing.message = fmt::format("timing pass failed: {}", error.what());
       }
       for (const auto& [column, cell] : to_row(timing)) {
-        if (column != "problem" && column != "method" && column != "status") {
+        // The status changes only when the timing pass ran out of wall-clock budget.
+        if (column != "problem" && column != "method" &&
+            (column != "status" || cell == kTimeoutStatus)) {
           row[column] = cell;
           present.insert(column);
         }

@@ -1,9 +1,12 @@
-# Work-precision (issues 5, 29): error_final and energy_err_max against wall time, and error_final
-# against force evaluations and steps, one figure set per problem and horizon, every method curve
+# Work-precision (issues 5, 29): error_final, error_max, energy_err_max and |phase_err| against
+# wall time, and error_final against force evaluations and steps, one figure set per problem and horizon, every method curve
 # on the same log-log axes (fixed-step methods over dt, adaptive ones over tolerance). A point is
 # the median of the timed repeats; its horizontal bar runs from the fastest repeat to median + IQR
 # (which bounds the third quartile). Thick translucent lines: the best-of-family fronts (the runs
-# of a family that no cheaper run of that family beats). Run inside results/work_precision (or
+# of a family that no cheaper run of that family beats). Black crosses: runs that ended at their
+# wall-clock budget (status timeout), at the seconds spent and the top of the diagram's data.
+# Every wall-time diagram of a group spans the same time range, the final and the maximum error
+# diagrams the same error range (wp/<group>.scale). Run inside results/work_precision (or
 # work_precision_full); the data files under wp/ and time_to_error.md are written first by
 # scripts/work_precision_table.sh from summary.csv.
 load scripts."/common.gp"
@@ -34,25 +37,50 @@ do for [format in "png pdf svg"] {
     curves = system("cat wp/".group.".curves")
     families = system("cat wp/".group.".families")
     file(c) = "wp/".group."/".c.".dat"
+    scale = system("cat wp/".group.".scale 2>/dev/null")
+    timeout_file = "wp/".group."/timeouts.dat"
+    has_timeouts = system("test -s ".timeout_file." && echo 1 || echo 0") + 0
+    # The timeout markers (column y of timeouts.dat) as the tail of a plot command run by eval;
+    # empty when the group has none, so that no plot opens a missing file.
+    marker(y) = has_timeouts ? sprintf(", '%s' using 1:%d with points pt 2 ps 2 lw 2 lc rgb 'black' title 'timeout (wall_budget_s spent: reached no error)' noenhanced", timeout_file, y) : ""
+    if (words(scale) == 4) { set xrange [word(scale,1)+0:word(scale,2)+0] } else { set autoscale x }
     front(f, x) = "wp/".group."/front_".f."_".x.".dat"
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     @key_above
     set xlabel "wall time [s] (median of the timed repeats; bar: fastest repeat to median + IQR)"
 
+    if (words(scale) == 4) { set yrange [word(scale,3)+0:word(scale,4)+0] } else { set autoscale y }
     set output "wp_".group."_error.".format
     set title "Final global error against wall time: ".group_title(group) noenhanced
     set ylabel "||(q,p) - exact or reference|| at t_end (problem units)" noenhanced
-    plot for [i=1:words(families)] front(word(families,i), "wall") using 1:2 with lines ls fs(word(families,i)) \
+    eval('plot for [i=1:words(families)] front(word(families,i), "wall") using 1:2 with lines ls fs(word(families,i)) \
            title "front: ".word(families,i), \
          for [i=1:words(curves)] file(word(curves,i)) using 1:2:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
-         for [i=1:words(curves)] file(word(curves,i)) using 1:2 with lines ls ms(word(curves,i)) title word(curves,i)
+         for [i=1:words(curves)] file(word(curves,i)) using 1:2 with lines ls ms(word(curves,i)) title word(curves,i)'.marker(2))
+
+    set output "wp_".group."_error_max.".format
+    set title "Maximum global error over the step points against wall time: ".group_title(group) noenhanced
+    set ylabel "max_k ||(q,p)_k - exact or reference|| (problem units)" noenhanced
+    eval('plot for [i=1:words(curves)] file(word(curves,i)) using 1:10:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
+         for [i=1:words(curves)] file(word(curves,i)) using 1:10 with lines ls ms(word(curves,i)) title word(curves,i)'.marker(3))
+    set autoscale y
 
     set output "wp_".group."_energy.".format
     set title "Largest relative energy error against wall time: ".group_title(group) noenhanced
     set ylabel "max |H - H0| / |H0| (dimensionless)"
-    plot for [i=1:words(curves)] file(word(curves,i)) using 1:3:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
-         for [i=1:words(curves)] file(word(curves,i)) using 1:3 with lines ls ms(word(curves,i)) title word(curves,i)
+    eval('plot for [i=1:words(curves)] file(word(curves,i)) using 1:3:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
+         for [i=1:words(curves)] file(word(curves,i)) using 1:3 with lines ls ms(word(curves,i)) title word(curves,i)'.marker(4))
 
+    # Problems with an exact periodic solution only (phase_err: harness/observers.cpp PhaseObserver).
+    if (system("awk '$11 != \"nan\" { n++ } END { print n + 0 }' wp/".group."/*.dat") + 0 > 0) {
+      set output "wp_".group."_phase.".format
+      set title "Phase error at t_end against wall time: ".group_title(group) noenhanced
+      set ylabel "|phase_err| = 2 pi |tau| / T (radians)" noenhanced
+      eval('plot for [i=1:words(curves)] file(word(curves,i)) using 1:11:5:6 with xerrorbars ls ms(word(curves,i)) notitle, \
+           for [i=1:words(curves)] file(word(curves,i)) using 1:11 with lines ls ms(word(curves,i)) title word(curves,i)'.marker(5))
+    }
+
+    set autoscale x
     set output "wp_".group."_work.".format
     set multiplot layout 1,2 title "Final global error against work (no timing noise): ".group_title(group) noenhanced
     set key outside top center horizontal maxrows 4 samplen 2 width 0 spacing 1.0 font ",7"

@@ -6,13 +6,24 @@
 #                           1 wall_s (median of the timed repeats)  2 error_final  3 energy_err_max
 #                           4 dt or rtol  5 wall_s_min  6 wall_s + wall_s_iqr (>= the third
 #                           quartile, since Q1 <= median)  7 force_evals  8 steps  9 wall_s_iqr
+#                           10 error_max  11 |phase_err| (radians; nan when the problem has none)
+#   wp/<group>/timeouts.dat one line per run that ended as status timeout (its wall_budget_s
+#                           spent, in the metric or the timing pass): 1 wall_s (the seconds spent)
+#                           2-5 the group's largest error_final, error_max, energy_err_max and
+#                           |phase_err| over its ok runs (the marker sits at the top of each
+#                           diagram: the run reached no error level)  6 the curve
 #   wp/<group>/front_<family>_<x>.dat  the best-of-family front against x = wall, evals, steps:
 #                           the runs of one family (summary.csv's `family` column) that no faster
 #                           (cheaper) run of the family beats in error_final; same columns.
 #   wp/<group>.curves, wp/<group>.families, wp/groups  the names the figure script iterates.
+#   wp/<group>.scale        the group's common scale: wall-time range of every point, bar and
+#                           timeout, and the error range over error_final and error_max.
 #   time_to_error.md        per group and curve, the least median wall time of an ok run with
 #                           error_final <= 1e-2, 1e-4, 1e-6, 1e-8, 1e-10 with that run's IQR;
-#                           the fastest curve per level; and the goal of issue 29 item 5 (best
+#                           a curve with timed-out runs that
+#                           reaches a level in no run shows "timeout" there (did not reach,
+#                           explicitly); each group lists its timed-out runs; the fastest curve
+#                           per level; and the goal of issue 29 item 5 (best
 #                           geomint method against best library solver at 1e-8 on Kepler 10^2).
 # A group is a label without its last _<part> (kepler_1e2_explicit -> kepler_1e2).
 set -euo pipefail
@@ -35,9 +46,23 @@ function curve_name(spec,    name, rest, parts, n, i, kept) {
 }
 # The library wrappers, as integrators/integrator.cpp library_method() names them.
 function library(spec) { return spec ~ /^(cvode_|ida|arkode_|gsl_|odeint_)/ }
+# A column's cell, nan when the column is absent or empty (a problem without that metric).
+function cell(name) { return (name in col) && f[col[name]] != "" ? f[col[name]] : "nan" }
+# The largest value of diagram y axis a over a group's ok runs: where its timeout markers sit.
+function top(group, a, v) {
+  if (v == "nan" || v + 0 <= 0) return
+  if (!((group, a) in ymax) || v + 0 > ymax[group, a]) ymax[group, a] = v + 0
+  if (!((group, a) in ymin) || v + 0 < ymin[group, a]) ymin[group, a] = v + 0
+}
+# The wall-time extent of a group over every point and bar drawn (timeouts included).
+function span(group, lo, hi) {
+  if (!(group in xmin) || lo < xmin[group]) xmin[group] = lo
+  if (!(group in xmax) || hi > xmax[group]) xmax[group] = hi
+}
+function top_or_one(group, a) { return ((group, a) in ymax) ? sprintf("%.6g", ymax[group, a]) : 1 }
 function fmt_time(t) { return t == "" ? "-" : sprintf("%.3g s", t) }
 function fmt_cell(key, l) {
-  if (!((key, l) in best)) return "-"
+  if (!((key, l) in best)) return (key in timeouts) ? "timeout" : "-"
   return sprintf("%.3g s (IQR %.2g)", best[key, l], best_iqr[key, l])
 }
 # The least median wall time to error <= X over the runs of one curve, with its spread.
@@ -57,14 +82,26 @@ header == 0 {
   if (!(group in seen_group)) { seen_group[group] = 1; groups[++ngroups] = group }
   key = group SUBSEP curve
   if (!(key in seen_curve)) { seen_curve[key] = 1; curves[group] = curves[group] " " curve; problem[group] = f[col["problem"]]; is_library[key] = library(f[col["method"]]) }
-  if (f[col["status"]] != "ok" || f[col["wall_s"]] == "" || f[col["error_final"]] == "") next
   step = f[col["dt"]]
   if (step == "") { step = f[col["method"]]; sub(/.*rtol=/, "rtol=", step); sub(/,.*/, "", step) }
+  # A run that spent its wall-clock budget: a point at the seconds spent, not a hole.
+  if (f[col["status"]] == "timeout" && f[col["wall_s"]] != "") {
+    timeouts[key] = timeouts[key] + 1
+    span(group, f[col["wall_s"]] + 0, f[col["wall_s"]] + 0)
+    timeout_lines[group] = timeout_lines[group] sprintf("%s %s\n", f[col["wall_s"]], curve)
+    timeout_list[group] = timeout_list[group] sprintf("%s at %s: %s s; ", curve, step, f[col["wall_s"]])
+    next
+  }
+  if (f[col["status"]] != "ok" || f[col["wall_s"]] == "" || f[col["error_final"]] == "") next
   system("mkdir -p " out "/" group)
   wall = f[col["wall_s"]] + 0; iqr = f[col["wall_s_iqr"]] + 0; lo = f[col["wall_s_min"]] + 0
   err = f[col["error_final"]] + 0
-  line = sprintf("%s %s %s %s %s %.17g %s %s %s", f[col["wall_s"]], f[col["error_final"]], f[col["energy_err_max"]], step,
-                 f[col["wall_s_min"]], wall + iqr, f[col["force_evals"]] == "" ? "nan" : f[col["force_evals"]], f[col["steps"]], f[col["wall_s_iqr"]])
+  emax = cell("error_max"); phase = cell("phase_err"); if (phase != "nan" && phase + 0 < 0) phase = substr(phase, 2)
+  line = sprintf("%s %s %s %s %s %.17g %s %s %s %s %s", f[col["wall_s"]], f[col["error_final"]], f[col["energy_err_max"]], step,
+                 f[col["wall_s_min"]], wall + iqr, f[col["force_evals"]] == "" ? "nan" : f[col["force_evals"]], f[col["steps"]], f[col["wall_s_iqr"]],
+                 emax, phase)
+  span(group, lo, wall + iqr)
+  top(group, 1, err); top(group, 2, emax); top(group, 3, cell("energy_err_max")); top(group, 4, phase)
   print line >> (out "/" group "/" curve ".dat")
   family = f[col["family"]]
   if (!((group, family) in seen_family)) { seen_family[group, family] = 1; print family >> (out "/" group ".families") }
@@ -77,7 +114,8 @@ END {
   print "# Time to reach error X (least median wall time of an ok run with error_final <= X)\n"
   print "Per group (problem and horizon) and method curve: the median wall time of the timed repeats"
   print "of the cheapest run that reaches X, with that run's interquartile range (IQR, seconds);"
-  print "- = not reached by any run in the sweep.\n"
+  print "- = not reached by any run in the sweep; timeout = not reached, and some of the curve's runs"
+  print "ended at their wall-clock budget (scene key wall_budget_s) before t_end.\n"
   for (g = 1; g <= ngroups; g++) {
     group = groups[g]
     if (group in group_has_data) print group > (out "/groups")
@@ -101,6 +139,23 @@ END {
           side_min[group, l, side] = best_min[key, l]; side_name[group, l, side] = names[c]
         }
       }
+    }
+    if (group in timeout_list) {
+      printf "\nTimed out (wall_budget_s spent before t_end: reached no level): %s\n", substr(timeout_list[group], 1, length(timeout_list[group]) - 2)
+      system("mkdir -p " out "/" group)
+      n = split(timeout_lines[group], tl, "\n")
+      for (i = 1; i < n; i++) {
+        split(tl[i], parts, " ")
+        printf "%s %s %s %s %s %s\n", parts[1], top_or_one(group, 1), top_or_one(group, 2), top_or_one(group, 3), top_or_one(group, 4), parts[2] > (out "/" group "/timeouts.dat")
+      }
+    }
+    # One scale per group: every wall-time diagram spans the same x range, and the final and the
+    # maximum error diagrams the same y range (a factor 2 of margin), so curves compare across them.
+    if (group in xmin && ((group, 1) in ymin)) {
+      elo = ymin[group, 1]; ehi = ymax[group, 1]
+      if (((group, 2) in ymin) && ymin[group, 2] < elo) elo = ymin[group, 2]
+      if (((group, 2) in ymax) && ymax[group, 2] > ehi) ehi = ymax[group, 2]
+      printf "%.6g %.6g %.6g %.6g\n", xmin[group] / 2, xmax[group] * 2, elo / 2, ehi * 2 > (out "/" group ".scale")
     }
     printf "\nFastest: "
     for (l = 1; l <= nlevels; l++) {

@@ -14,6 +14,7 @@
 #include "harness/run.hpp"
 #include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/problem.hpp"
 
 namespace geomint {
 namespace {
@@ -48,6 +49,58 @@ TEST(StepBudget, EveryAdaptiveMethodStopsAtMaxSteps) {
     EXPECT_TRUE(run_one("kepler", entry.name + ":max_steps=100000", quiet(0, 1)).ok) << entry.name;
   }
   EXPECT_GE(adaptive, 9);
+}
+
+// The wall-clock budget (RunConfig::wall_budget_s) ends every kind of run as a row with status
+// `timeout` and the seconds spent as wall_s, never as a hole: fixed-step, adaptive and library
+// methods alike (a budget of 1 ns is spent by the first step). Each run stops after one step.
+TEST(WallBudget, EveryMethodEndsAsATimeoutRowWithItsSeconds) {
+  const auto kepler = make_problem("kepler:e=0.3");
+  RunConfig config = quiet(0.01, 50.0);
+  config.wall_budget_s = 1e-9;
+  int methods = 0;
+  for (const auto& entry : integrator_registry()) {
+    if (!applicable(*make_integrator(entry.name), *kepler).ok) continue;
+    ++methods;
+    const RunResult result = run_one("kepler:e=0.3", entry.name, config);
+    EXPECT_FALSE(result.ok) << entry.name;
+    EXPECT_EQ(result.record.status, kTimeoutStatus) << entry.name;
+    EXPECT_NE(result.record.message.value_or("").find("wall_budget_s"), std::string::npos)
+        << entry.name << ": " << result.record.message.value_or("");
+    ASSERT_TRUE(result.record.wall_s.has_value()) << entry.name;
+    EXPECT_GT(*result.record.wall_s, config.wall_budget_s) << entry.name;
+    ASSERT_TRUE(result.record.t_reached.has_value()) << entry.name;
+    EXPECT_LT(*result.record.t_reached, 50.0) << entry.name;
+  }
+  EXPECT_GE(methods, 30);
+  // A generous budget changes nothing.
+  config.wall_budget_s = 600;
+  EXPECT_TRUE(run_one("kepler:e=0.3", "stormer_verlet", config).ok);
+  EXPECT_TRUE(run_one("kepler:e=0.3", "gsl_rk8pd", config).ok);
+}
+
+// The timing pass honours the budget too: a timed run that overruns it turns the row into a
+// timeout at that run's time (fixed-step: after the run, whose loop has no visitor; adaptive:
+// inside the loop), with the repeats timed so far.
+TEST(WallBudget, TimingPassOverrunMakesTheRowATimeout) {
+  RunConfig config = quiet(0.01, 20.0);
+  config.wall_budget_s = 1e-9;
+  for (const char* method : {"stormer_verlet", "gsl_rk8pd", "cvode_adams"}) {
+    const TimingOutcome timing = time_run("kepler:e=0.3", method, config, 5);
+    ASSERT_TRUE(timing.status.ok) << method << ": " << timing.failure_message();
+    EXPECT_TRUE(timing.timed_out) << method;
+    EXPECT_EQ(timing.stats.count, 1) << method;
+    RunRecord record;
+    record_timing(timing, record);
+    EXPECT_EQ(record.status, kTimeoutStatus) << method;
+    ASSERT_TRUE(record.wall_s.has_value()) << method;
+    EXPECT_GT(*record.wall_s, config.wall_budget_s) << method;
+    EXPECT_NE(record.message.value_or("").find("wall_budget_s"), std::string::npos) << method;
+  }
+  config.wall_budget_s = 600;
+  const TimingOutcome ample = time_run("kepler:e=0.3", "stormer_verlet", config, 2);
+  EXPECT_FALSE(ample.timed_out);
+  EXPECT_EQ(ample.stats.count, 2);
 }
 
 // Below round-off the library controllers accepted steps near the smallest representable size

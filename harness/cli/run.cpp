@@ -25,6 +25,7 @@ struct RunOptions {
   double diverge_factor = kDefaultDivergeFactor;
   bool series_state = false;
   long max_steps = kDefaultMaxSteps;
+  double wall_budget_s = 0;
   std::vector<std::string> extra_metrics;
 };
 
@@ -48,6 +49,7 @@ int run_run(RunOptions options, const Context& context) {
   config.timing_repeats = static_cast<int>(options.timing_repeats);
   config.diverge_factor = options.diverge_factor;
   config.max_steps = options.max_steps;
+  config.wall_budget_s = options.wall_budget_s;
   config.extra_metrics = options.extra_metrics;
   config.command_line = context.command_line;
   // Outputs are checked before anything is computed.
@@ -105,6 +107,10 @@ Verb add_run(CLI::App& app) {
                       fmt::format("step budget of a fixed-step run: more grid steps end the run "
                                   "as the failure row max_steps (default {:g}, at most {:g})",
                                   static_cast<double>(kDefaultMaxSteps), kMaxFixedSteps));
+  command->add_option("--wall-budget", options->wall_budget_s,
+                      fmt::format("wall-clock budget of the run in seconds: a longer run ends as "
+                                  "the row status timeout (0 = none, the default; at most {:g})",
+                                  kMaxWallBudgetSeconds));
   command->add_option("--metric", options->extra_metrics,
                       "also compute an optional metric (repeatable): symplecticity_defect, "
                       "period_measured (with period_err_rel), energy_growth_exponent, "
