@@ -66,6 +66,9 @@ struct Case {
   std::string method;
   std::string problem;
 };
+// Printed into the ctest name ("  # GetParam() = ..."): without it GoogleTest prints the struct's
+// bytes, pointers included, so the name changed from build to build.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.method << " on " << c.problem; }
 
 class AdvanceMatchesStep : public ::testing::TestWithParam<Case> {};
 

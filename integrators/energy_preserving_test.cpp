@@ -48,6 +48,11 @@ struct EnergyCase {
   std::string method, problem;
   double h;
 };
+// Printed into the test's name; without it GoogleTest prints the struct's bytes, pointers
+// included, so the ctest name changed from build to build.
+void PrintTo(const EnergyCase& c, std::ostream* os) {
+  *os << c.method << " on " << c.problem << " at h = " << c.h;
+}
 
 class EnergyPreserving : public testing::TestWithParam<EnergyCase> {};
 
