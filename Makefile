@@ -10,7 +10,7 @@ LONG_SCENES ?= work_precision_full
 FIGURE_SCENES = $(filter-out $(LONG_SCENES),$(SCENES))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-all reproduce-quick gates gate-quick bench \
-        format clean mutation mutation-check sanitize-build test-sanitize fuzz readme-tables \
+        format clean mutation mutation-check sanitize-build fuzz-build test-sanitize fuzz readme-tables \
         report report-quick \
         test-cluster test-external perf
 
@@ -63,8 +63,17 @@ SAN_ENV = ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initializatio
 sanitize-build: deps
 	@mkdir -p $(SAN_DIR) && cmake -S . -B $(SAN_DIR) -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
-	  > $(SAN_DIR)/configure.log 2>&1 || (cat $(SAN_DIR)/configure.log; exit 1)
+	  -DGEOMINT_FUZZ_COVERAGE=OFF > $(SAN_DIR)/configure.log 2>&1 || (cat $(SAN_DIR)/configure.log; exit 1)
 	@$(SAN_ENV) cmake --build $(SAN_DIR) -j $(JOBS)
+
+# The fuzzing build: the same, with libFuzzer's coverage instrumentation on the fuzzed libraries
+# (problems, harness), which `make fuzz` needs and the sanitizer suite does not.
+FUZZ_DIR ?= build-fuzz
+fuzz-build: deps
+	@mkdir -p $(FUZZ_DIR) && cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
+	  -DGEOMINT_FUZZ_COVERAGE=ON > $(FUZZ_DIR)/configure.log 2>&1 || (cat $(FUZZ_DIR)/configure.log; exit 1)
+	@$(SAN_ENV) cmake --build $(FUZZ_DIR) -j $(JOBS) --target spec_fuzzer scene_fuzzer gates_fuzzer
 
 # The fast suite under ASan + UBSan (what `.ci/run` runs after `make test`): any report fails.
 # Left out: the tests labelled `slow` (as in `make test`) and `nosan`: long-horizon repetitions
@@ -80,8 +89,8 @@ test-sanitize: sanitize-build
 
 # Each fuzzer for FUZZ_SECONDS on its committed corpus (fuzz/corpus/<target>/); fails on a finding.
 FUZZ_SECONDS ?= 60
-fuzz: sanitize-build
-	@$(SAN_ENV) bash scripts/fuzz.sh $(SAN_DIR) $(FUZZ_SECONDS)
+fuzz: fuzz-build
+	@$(SAN_ENV) bash scripts/fuzz.sh $(FUZZ_DIR) $(FUZZ_SECONDS)
 
 # Regenerates every committed scene but LONG_SCENES: tables (CSV + Markdown) and gnuplot figures; then the
 # scaling figure from the benchmarks' reduced sizes (results/scaling/, scripts/scaling.sh).

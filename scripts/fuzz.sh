@@ -15,7 +15,7 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 for target in "${targets[@]}"; do
   binary="$build/fuzz/${target}_fuzzer"
-  [ -x "$binary" ] || { echo "fuzz: $binary not built (make sanitize-build)" >&2; exit 2; }
+  [ -x "$binary" ] || { echo "fuzz: $binary not built (make fuzz-build)" >&2; exit 2; }
   work="$build/fuzz/corpus/$target"
   artifacts="$build/fuzz/artifacts/$target"
   log="$build/fuzz/$target.log"
