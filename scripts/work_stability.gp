@@ -14,8 +14,8 @@ methods_bar = "stormer_verlet rk4 composition_yoshida4 implicit_euler implicit_m
 style(m) = (m eq "sprk_blanes_moan4" ? 15 : ms(m))
 words_stiff_spring = "stiff_spring (wall - k_soft - m - k_stiff - m): stiffness = k_stiff/k_soft"
 words_fpu_stiff = "fpu_stiff (m = 3): stiffness = omega^2 (stiff springs omega^2/2)"
-words_elastic_bar_young = "elastic_bar 8x2x2 cells (192 tets), bent, no gravity: stiffness = Young's modulus E"
-words_elastic_bar_mesh = "elastic_bar E = 1e4, refined n = 2..5 (nx,ny,nz = 4n,n,n): stiffness = omega_max^2"
+words_elastic_bar_young = "elastic_bar, 192 tets, bent, no gravity: stiffness = E"
+words_elastic_bar_mesh = "elastic_bar, E = 1e4, 4n x n x n cells, n = 1, 2, 3: omega_max^2"
 xlabel_of(panel) = (panel eq "elastic_bar_young" ? "Young's modulus E (Pa)" : \
   (panel eq "elastic_bar_mesh" ? "omega_max^2 at the initial state (1/s^2)" : "stiffness (dimensionless)"))
 title_of(panel) = (panel eq "stiff_spring" ? words_stiff_spring : (panel eq "fpu_stiff" ? words_fpu_stiff : \
@@ -32,7 +32,7 @@ do for [format in "png pdf svg"] {
   do for [measure in "cpu eval"] {
     set output (measure eq "cpu" ? "work_stability." : "work_stability_evals.").format
     set multiplot layout 2,2 title (measure eq "cpu" ? \
-      "Simulated time per CPU-second at the largest stable step (capped at h = 0.3, bar 0.1); fastest of 5 timed repeats, bars down by the IQR" : \
+      "Simulated time per CPU-second at the largest stable step (cap h = 0.3, bar 0.1); fastest of 5 (bar: 3) timed repeats, bars down by the IQR" : \
       "Simulated time per force + Hessian evaluation at the largest stable step (capped at h = 0.3, bar 0.1)")
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     set ylabel (measure eq "cpu" ? "simulated time / CPU second" : "simulated time / evaluation")
