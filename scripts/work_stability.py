@@ -168,9 +168,9 @@ def main(folder):
         })
     records.sort(key=lambda r: (r["problem"], r["axis"], r["kind"], r["method"], r["stiffness"]))
 
-    columns = ["problem", "axis", "stiffness", "method", "kind", "family", "stability_status", "h_stable",
-               "h_used", "limited_by", "wall_per_step", "wall_per_step_iqr", "evals_per_step",
-               "newton_per_step", "sim_per_cpu_s", "sim_per_eval"]
+    columns = ["problem", "axis", "stiffness", "method", "kind", "family", "stability_status",
+               "h_stable", "h_used", "limited_by", "wall_per_step", "wall_per_step_iqr",
+               "evals_per_step", "newton_per_step", "sim_per_cpu_s", "sim_per_eval"]
     with open(os.path.join(folder, "work_stability.csv"), "w", newline="") as handle:
         handle.write("\n".join(header) + "\n")
         writer = csv.writer(handle, lineterminator="\n")
