@@ -5,6 +5,11 @@ of summary.csv) into work_stability.csv, fits log-log slopes against the stiffne
 the best implicit method overtakes the best explicit one (work_stability_fit.csv), and writes one
 curve file per problem and method under curves/ for scripts/work_stability.gp.
 
+Each point lies on one stiffness axis: stiff_spring's ratio, fpu_stiff's omega^2, and the elastic
+bar's Young's modulus (a fixed mesh) or its refinement (omega_max^2 of the mesh). The axis of a bar
+point comes from its [[stability]] block's label ("bar_young_..." or "bar_mesh_..."), since the
+canonical problem spec lists every parameter and cannot tell the two apart.
+
 Usage: work_stability.py FOLDER   (results/work_stability or results/work_stability/quick)
 """
 import csv
@@ -12,18 +17,40 @@ import math
 import os
 import sys
 
-# Every method's step is capped at H_CAP: about 30 steps per period of the slow mode (stiff_spring's
-# slow frequency is ~0.71, fpu_stiff's soft springs oscillate at O(1)), so the implicit methods,
-# stable for every h, are charged for resolving the slow motion the way an animator would.
-H_CAP = 0.3
+# Every method's step is capped per axis: about 30 steps per period of the slow mode. stiff_spring's
+# slow frequency is ~0.71 and fpu_stiff's soft springs oscillate at O(1), hence 0.3; the bar's first
+# bending mode has a period of ~3.1 s at E = 1e5 (beam theory: omega_1 = 1.875^2 sqrt(E I/(rho A
+# L^4)) = 2.03 rad/s), hence 0.1. The implicit methods, stable for every h, are charged for
+# resolving the slow motion the way an animator would. On the Young's-modulus axis the cap stays
+# 0.1 at every E (a fixed frame step), although the bending period scales as E^(-1/2) there.
+H_CAP = {"ratio": 0.3, "omega2": 0.3, "young": 0.1, "mesh": 0.1}
 
-# Stiffness on the x axis: the spring-constant ratio k_stiff/k_soft of stiff_spring, and omega^2
-# for fpu_stiff (its stiff springs have constant omega^2/2, the soft ones are O(1)), so that both
-# problems' explicit limits fall as stiffness^(-1/2).
-PROBLEMS = {
-    "stiff_spring": lambda params: float(params["ratio"]),
-    "fpu_stiff": lambda params: float(params["omega"]) ** 2,
+
+def axis_of(label, name):
+    """The stiffness axis of a stability row: 'ratio' (stiff_spring), 'omega2' (fpu_stiff),
+    'young' or 'mesh' (elastic_bar, from the block label); None for a problem not on any axis."""
+    if name == "elastic_bar":
+        return "young" if label.startswith("bar_young") else (
+            "mesh" if label.startswith("bar_mesh") else None)
+    return {"stiff_spring": "ratio", "fpu_stiff": "omega2"}.get(name)
+
+
+# Stiffness on the x axis, from the problem's parameters and omega_max at its initial state: the
+# spring-constant ratio k_stiff/k_soft of stiff_spring; omega^2 for fpu_stiff (its stiff springs
+# have constant omega^2/2, the soft ones are O(1)); Young's modulus E for the bar on a fixed mesh;
+# omega_max^2 for the bar under refinement (omega_max grows as 1/cell size). On every axis an
+# explicit method's limit falls as stiffness^(-1/2).
+STIFFNESS = {
+    "ratio": lambda params, omega: float(params["ratio"]),
+    "omega2": lambda params, omega: float(params["omega"]) ** 2,
+    "young": lambda params, omega: float(params["young"]),
+    "mesh": lambda params, omega: omega ** 2,
 }
+
+
+def panel_of(problem, axis):
+    """Name of the figure panel and curve files: the problem, or elastic_bar_<axis>."""
+    return f"{problem}_{axis}" if problem == "elastic_bar" else problem
 
 
 def read_table(path):
@@ -110,20 +137,23 @@ def main(folder):
     records = []
     for row in stability:
         name, params = split_problem(row["problem"])
-        if name not in PROBLEMS or (row["problem"], row["method"]) not in cost:
+        axis = axis_of(row["label"], name)
+        if axis is None or (row["problem"], row["method"]) not in cost:
             continue
         omega = float(row["omega"])
         if row["status"] == "unstable_at_min":
             continue  # no stable step in the searched range: no point on the diagram
         h_stable = float(row["homega_max_measured"]) / omega
-        limited = row["status"] == "bracketed" and h_stable < H_CAP
-        h_used = min(h_stable, H_CAP)
+        h_cap = H_CAP[axis]
+        limited = row["status"] == "bracketed" and h_stable < h_cap
+        h_used = min(h_stable, h_cap)
         wall, wall_iqr, evals, newton, family = cost[(row["problem"], row["method"])]
         records.append({
             "problem": name,
-            "stiffness": PROBLEMS[name](params),
+            "axis": axis,
+            "stiffness": STIFFNESS[axis](params, omega),
             "method": short_method(row["method"]),
-            "kind": "implicit" if row["label"].startswith("implicit") else "explicit",
+            "kind": "implicit" if "implicit" in row["label"] else "explicit",
             "family": family,
             "stability_status": row["status"],
             "h_stable": h_stable if row["status"] == "bracketed" else math.inf,
@@ -136,11 +166,11 @@ def main(folder):
             "sim_per_cpu_s": h_used / wall,
             "sim_per_eval": h_used / evals,
         })
-    records.sort(key=lambda r: (r["problem"], r["kind"], r["method"], r["stiffness"]))
+    records.sort(key=lambda r: (r["problem"], r["axis"], r["kind"], r["method"], r["stiffness"]))
 
-    columns = ["problem", "stiffness", "method", "kind", "family", "stability_status", "h_stable",
-               "h_used", "limited_by", "wall_per_step", "wall_per_step_iqr", "evals_per_step",
-               "newton_per_step", "sim_per_cpu_s", "sim_per_eval"]
+    columns = ["problem", "axis", "stiffness", "method", "kind", "family", "stability_status",
+               "h_stable", "h_used", "limited_by", "wall_per_step", "wall_per_step_iqr",
+               "evals_per_step", "newton_per_step", "sim_per_cpu_s", "sim_per_eval"]
     with open(os.path.join(folder, "work_stability.csv"), "w", newline="") as handle:
         handle.write("\n".join(header) + "\n")
         writer = csv.writer(handle, lineterminator="\n")
@@ -153,20 +183,20 @@ def main(folder):
     fit_rows = []
     groups = {}
     for r in records:
-        groups.setdefault((r["problem"], r["method"], r["kind"]), []).append(r)
-    for (problem, method, kind), rows in sorted(groups.items()):
+        groups.setdefault((r["problem"], r["axis"], r["method"], r["kind"]), []).append(r)
+    for (problem, axis, method, kind), rows in sorted(groups.items()):
         used = [r for r in rows if kind == "implicit" or r["limited_by"] == "stability"]
-        fit_rows.append([problem, method, kind, len(used),
+        fit_rows.append([problem, axis, method, kind, len(used),
                          fmt(fit_slope([(r["stiffness"], r["sim_per_cpu_s"]) for r in used])),
                          fmt(fit_slope([(r["stiffness"], r["sim_per_eval"]) for r in used])), "",
                          "", "", ""])
-    for problem in sorted({r["problem"] for r in records}):
+    for problem, axis in sorted({(r["problem"], r["axis"]) for r in records}):
         best = {}
         for measure in ("sim_per_cpu_s", "sim_per_eval"):
             for kind in ("explicit", "implicit"):
                 table, winner = {}, {}
                 for r in records:
-                    if r["problem"] == problem and r["kind"] == kind:
+                    if r["problem"] == problem and r["axis"] == axis and r["kind"] == kind:
                         if r[measure] > table.get(r["stiffness"], 0):
                             table[r["stiffness"]], winner[r["stiffness"]] = r[measure], r["method"]
                 best[(measure, kind)] = (table, winner)
@@ -175,14 +205,14 @@ def main(folder):
         cross_work = crossover(best[("sim_per_eval", "explicit")][0],
                                best[("sim_per_eval", "implicit")][0])
         top = max(best[("sim_per_eval", "explicit")][0])
-        fit_rows.append([problem, "best_implicit_vs_best_explicit", "crossover",
+        fit_rows.append([problem, axis, "best_implicit_vs_best_explicit", "crossover",
                          len(best[("sim_per_eval", "explicit")][0]), "", "", fmt(cross_wall),
                          fmt(cross_work), best[("sim_per_eval", "explicit")][1][top],
                          best[("sim_per_eval", "implicit")][1][top]])
     with open(os.path.join(folder, "work_stability_fit.csv"), "w", newline="") as handle:
         handle.write("\n".join(header) + "\n")
         writer = csv.writer(handle, lineterminator="\n")
-        writer.writerow(["problem", "method", "kind", "points", "slope_sim_per_cpu_s",
+        writer.writerow(["problem", "axis", "method", "kind", "points", "slope_sim_per_cpu_s",
                          "slope_sim_per_eval", "crossover_stiffness_wall",
                          "crossover_stiffness_work", "best_explicit_at_max",
                          "best_implicit_at_max"])
@@ -194,8 +224,8 @@ def main(folder):
     os.makedirs(curves, exist_ok=True)
     for old in os.listdir(curves):
         os.remove(os.path.join(curves, old))
-    for (problem, method, kind), rows in groups.items():
-        with open(os.path.join(curves, f"{problem}__{method}.dat"), "w") as handle:
+    for (problem, axis, method, kind), rows in groups.items():
+        with open(os.path.join(curves, f"{panel_of(problem, axis)}__{method}.dat"), "w") as handle:
             handle.write("# stiffness sim_per_cpu_s sim_per_cpu_s_lo sim_per_cpu_s_hi sim_per_eval\n")
             for r in rows:
                 # Bars from the fastest repeat down to fastest + IQR: the spread of the timing.
@@ -207,40 +237,55 @@ def main(folder):
 
 def selftest():
     """Runs main() on a made-up folder whose answers are known in closed form: explicit limits
-    h = 2/sqrt(k) at one evaluation a step, implicit ones stable to the cap at 3 evaluations a
-    step. Checks the slopes (-1/2 and 0), that a capped explicit point is left out of the fit, that
-    an explicit search stuck at its minimum gives no point, and the crossover 2/sqrt(k) = 0.3/3,
-    k = 400. Exit 1 naming the first wrong number (ctest WorkStability.selftest)."""
+    h = 2/omega at one evaluation a step, implicit ones stable to the cap at 3 evaluations a step.
+    stiff_spring (omega = sqrt(k), cap 0.3): slopes -1/2 and 0, a capped explicit point left out of
+    the fit, no point for an explicit search stuck at its minimum, crossover 2/sqrt(k) = 0.3/3 at
+    k = 400. The bar (cap 0.1): on the Young axis (omega = sqrt(E)/10, stiffness E) the crossover
+    20/sqrt(E) = 0.1/3 is at E = 3.6e5; on the mesh axis (stiffness omega^2) 2/omega = 0.1/3 at
+    omega^2 = 3600. Exit 1 naming the first wrong number (ctest WorkStability.selftest)."""
     import tempfile
     folder = tempfile.mkdtemp(prefix="work_stability_selftest_")
     provenance = "# geomint: selftest\n# scene: work_stability\n# variant: quick\n"
-    stiffnesses = [10.0, 1e2, 1e4, 1e6]  # at k = 10 the explicit limit 0.63 is above the cap 0.3
+    # (labels' prefix, problem spec, omega) per point. At k = 10 the explicit limit 0.63 is above
+    # the cap 0.3; at E = 1e4 (h = 0.2) and omega^2 = 100 (h = 0.2) above the bar's cap 0.1.
+    points = [("", f'"stiff_spring:ratio={k:g}"', math.sqrt(k)) for k in (10.0, 1e2, 1e4, 1e6)]
+    points += [("bar_young_", f'"elastic_bar:nx=2,young={e:g}"', math.sqrt(e) / 10)
+               for e in (1e4, 1e5, 1e6, 1e7)]
+    points += [("bar_mesh_", f'"elastic_bar:nx={n},young=1000"', math.sqrt(k))
+               for n, k in ((2, 1e2), (3, 1e3), (4, 1e4), (5, 1e5))]
     with open(os.path.join(folder, "summary.csv"), "w") as summary, \
          open(os.path.join(folder, "stability.csv"), "w") as stability:
         summary.write(provenance + "label,problem,method,family,status,steps,force_evals,"
                       "hessian_evals,newton_iters,wall_s,wall_s_min,wall_s_iqr\n")
         stability.write(provenance + "label,problem,method,omega,homega_max_measured,status\n")
-        for k in stiffnesses:
-            problem = f'"stiff_spring:ratio={k:g}"'
-            omega = math.sqrt(k)
+        for prefix, problem, omega in points:
+            cap = 0.3 if prefix == "" else 0.1
             for label, method, evals, status, homega in (
                     ("explicit_limit", "stormer_verlet", 1, "bracketed", 2.0),
                     ("explicit_limit", "rk4", 4, "unstable_at_min", 0.5),
-                    ("implicit_limit", "implicit_euler", 3, "stable_to_max", 0.3 * omega)):
+                    ("implicit_limit", "implicit_euler", 3, "stable_to_max", cap * omega)):
                 summary.write(f"t,{problem},{method},f,ok,100,{100 * evals},0,0,{2e-6 * evals},{1e-6 * evals},0\n")
-                stability.write(f"{label},{problem},{method},{omega!r},{homega!r},{status}\n")
+                stability.write(f"{prefix}{label},{problem},{method},{omega!r},{homega!r},{status}\n")
     main(folder)
-    fits = {(r["method"], r["kind"]): r for r in read_table(
+    fits = {(r["axis"], r["method"], r["kind"]): r for r in read_table(
         os.path.join(folder, "work_stability_fit.csv"))[0]}
-    points = read_table(os.path.join(folder, "work_stability.csv"))[0]
+    rows = read_table(os.path.join(folder, "work_stability.csv"))[0]
+    cross = "best_implicit_vs_best_explicit", "crossover"
     checks = [
-        ("explicit slope per evaluation", fits[("stormer_verlet", "explicit")]["slope_sim_per_eval"], -0.5),
-        ("explicit slope per CPU-second", fits[("stormer_verlet", "explicit")]["slope_sim_per_cpu_s"], -0.5),
-        ("explicit points fitted (the capped one left out)", fits[("stormer_verlet", "explicit")]["points"], 3),
-        ("implicit slope per evaluation", fits[("implicit_euler", "implicit")]["slope_sim_per_eval"], 0.0),
-        ("crossover per evaluation", fits[("best_implicit_vs_best_explicit", "crossover")]["crossover_stiffness_work"], 400.0),
-        ("crossover per CPU-second", fits[("best_implicit_vs_best_explicit", "crossover")]["crossover_stiffness_wall"], 400.0),
-        ("points (none for a search stuck at its minimum)", len(points), 8),
+        ("explicit slope per evaluation", fits[("ratio", "stormer_verlet", "explicit")]["slope_sim_per_eval"], -0.5),
+        ("explicit slope per CPU-second", fits[("ratio", "stormer_verlet", "explicit")]["slope_sim_per_cpu_s"], -0.5),
+        ("explicit points fitted (the capped one left out)", fits[("ratio", "stormer_verlet", "explicit")]["points"], 3),
+        ("implicit slope per evaluation", fits[("ratio", "implicit_euler", "implicit")]["slope_sim_per_eval"], 0.0),
+        ("crossover per evaluation", fits[("ratio",) + cross]["crossover_stiffness_work"], 400.0),
+        ("crossover per CPU-second", fits[("ratio",) + cross]["crossover_stiffness_wall"], 400.0),
+        ("bar, Young axis: explicit slope per evaluation", fits[("young", "stormer_verlet", "explicit")]["slope_sim_per_eval"], -0.5),
+        ("bar, Young axis: explicit points fitted (cap 0.1)", fits[("young", "stormer_verlet", "explicit")]["points"], 3),
+        ("bar, Young axis: crossover per evaluation", fits[("young",) + cross]["crossover_stiffness_work"], 3.6e5),
+        ("bar, mesh axis: explicit slope per evaluation", fits[("mesh", "stormer_verlet", "explicit")]["slope_sim_per_eval"], -0.5),
+        ("bar, mesh axis: implicit slope per evaluation", fits[("mesh", "implicit_euler", "implicit")]["slope_sim_per_eval"], 0.0),
+        ("bar, mesh axis: crossover per evaluation", fits[("mesh",) + cross]["crossover_stiffness_work"], 3600.0),
+        ("bar, mesh axis: implicit h_used (the cap)", [r for r in rows if r["axis"] == "mesh" and r["kind"] == "implicit"][0]["h_used"], 0.1),
+        ("points (none for a search stuck at its minimum)", len(rows), 24),
     ]
     for what, got, expected in checks:
         if not math.isclose(float(got), expected, rel_tol=1e-9, abs_tol=1e-12):
