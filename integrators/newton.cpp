@@ -13,6 +13,8 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "integrators/boomer_amg.hpp"
+#include "integrators/newton_profile.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -60,6 +63,37 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
     rz = rz_next;
   }
   return CgOutcome::kNoConvergence;
+}
+
+// Wall-clock seconds of a phase of the solve, added to a NewtonProfile total when it ends.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(std::atomic<long>& nanoseconds)
+      : total_(nanoseconds), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() {
+    total_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::steady_clock::now() - start_)
+                         .count(),
+                     std::memory_order_relaxed);
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  std::atomic<long>& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+struct ProfileTotals {
+  std::atomic<long> solves{0}, iterations{0}, cg_iterations{0}, jacobians{0}, residuals{0},
+      objectives{0}, linear_solves{0};
+  std::atomic<long> total_ns{0}, jacobian_ns{0}, residual_ns{0}, objective_ns{0}, setup_ns{0},
+      linear_ns{0};
+};
+
+ProfileTotals& profile_totals() {
+  static ProfileTotals totals;
+  return totals;
 }
 
 }  // namespace
@@ -198,6 +232,7 @@ struct NewtonSolver::Factorisation {
   // positive definite — which the caller then handles (SPD shift, or an LDLT fallback).
   bool factorise(const SparseMatrix& matrix, bool symmetric, bool reuse_symbolic, int& analyses,
                  int& factorizations) {
+    const PhaseTimer timer(profile_totals().setup_ns);
     has_factor = false;
     direct_fallback = false;
     const bool analyse = !reuse_symbolic || !same_pattern(matrix, symmetric);
@@ -307,6 +342,8 @@ struct NewtonSolver::Factorisation {
   // Solves with the held factorisation; false when CG met negative curvature or did not reach
   // cg_target (then `out` is not a usable direction).
   bool solve(bool symmetric, const Vec& rhs, Vec& out, bool& negative_curvature) {
+    const PhaseTimer timer(profile_totals().linear_ns);
+    profile_totals().linear_solves.fetch_add(1, std::memory_order_relaxed);
     negative_curvature = false;
     if (!symmetric) {
       out = lu.solve(rhs);
@@ -459,8 +496,59 @@ std::string describe(const NewtonResult& result) {
                      result.iterations, result.residual_norm, result.threshold, result.reason);
 }
 
+namespace {
+
+// Adds a finished solve's totals to the NewtonProfile (declared after the result it reads, so it
+// runs before the result is gone on every return path).
+class SolveProfile {
+ public:
+  explicit SolveProfile(const NewtonResult& result)
+      : result_(result), timer_(profile_totals().total_ns) {}
+  ~SolveProfile() {
+    ProfileTotals& totals = profile_totals();
+    totals.solves.fetch_add(1, std::memory_order_relaxed);
+    totals.iterations.fetch_add(result_.iterations, std::memory_order_relaxed);
+    totals.cg_iterations.fetch_add(result_.cg_iterations, std::memory_order_relaxed);
+    totals.residuals.fetch_add(result_.residual_evals, std::memory_order_relaxed);
+  }
+  SolveProfile(const SolveProfile&) = delete;
+  SolveProfile& operator=(const SolveProfile&) = delete;
+
+ private:
+  const NewtonResult& result_;
+  PhaseTimer timer_;
+};
+
+}  // namespace
+
+NewtonProfile newton_profile() {
+  const ProfileTotals& totals = profile_totals();
+  const auto count = [](const std::atomic<long>& value) {
+    return value.load(std::memory_order_relaxed);
+  };
+  const auto seconds = [](const std::atomic<long>& nanoseconds) {
+    return 1e-9 * static_cast<double>(nanoseconds.load(std::memory_order_relaxed));
+  };
+  NewtonProfile profile;
+  profile.solves = count(totals.solves);
+  profile.iterations = count(totals.iterations);
+  profile.cg_iterations = count(totals.cg_iterations);
+  profile.residuals = count(totals.residuals);
+  profile.objectives = count(totals.objectives);
+  profile.jacobians = count(totals.jacobians);
+  profile.linear_solves = count(totals.linear_solves);
+  profile.total_s = seconds(totals.total_ns);
+  profile.residual_s = seconds(totals.residual_ns);
+  profile.objective_s = seconds(totals.objective_ns);
+  profile.jacobian_s = seconds(totals.jacobian_ns);
+  profile.setup_s = seconds(totals.setup_ns);
+  profile.linear_s = seconds(totals.linear_ns);
+  return profile;
+}
+
 NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
   NewtonResult result;
+  const SolveProfile profile(result);
   const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
   result.threshold = std::max(relative_tolerance * residual_scale, kSubnormalResidual);
   double scale = residual_scale;
@@ -473,6 +561,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   Vec residual;
   auto evaluate = [&](const Vec& at, Vec& r) {
     ++result.residual_evals;
+    const PhaseTimer timer(profile_totals().residual_ns);
     system.residual(at, r);
     if (r.size() != at.size()) {
       throw std::logic_error(
@@ -485,7 +574,10 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   // other, and scaling by 2ᵏ keeps every comparison bit for bit.
   double merit_unit = 1.0;
   auto merit_of = [&](const Vec& at, const Vec& r) {
-    return system.objective ? system.objective(at) : 0.5 * (merit_unit * r).squaredNorm();
+    if (!system.objective) return 0.5 * (merit_unit * r).squaredNorm();
+    profile_totals().objectives.fetch_add(1, std::memory_order_relaxed);
+    const PhaseTimer timer(profile_totals().objective_ns);
+    return system.objective(at);
   };
   auto fail = [&](const char* reason) {
     result.reason = reason;
@@ -612,7 +704,11 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       reuse_factor = stale;
     }
     if (!stale) {
-      system.jacobian(x, f.jacobian);
+      {
+        profile_totals().jacobians.fetch_add(1, std::memory_order_relaxed);
+        const PhaseTimer timer(profile_totals().jacobian_ns);
+        system.jacobian(x, f.jacobian);
+      }
       if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
         throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
                                            f.jacobian.rows(), f.jacobian.cols(), x.size()));
