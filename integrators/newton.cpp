@@ -23,6 +23,7 @@
 
 #include "integrators/boomer_amg.hpp"
 #include "integrators/newton_profile.hpp"
+#include "problems/parallel.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -31,32 +32,43 @@ namespace {
 
 using MetisLdlt = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>>;
 
-// Preconditioned conjugate gradients on the lower triangle of A (as the Cholesky solvers read
-// it), from x = 0, until ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient
-// for the curvature test: pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD
-// safeguard needs to know (Nocedal & Wright §5.1 and §7.1, truncated CG).
+// Preconditioned conjugate gradients on A (stored in full, both triangles), from x = 0, until
+// ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient for the curvature test:
+// pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD safeguard needs to know
+// (Nocedal & Wright §5.1 and §7.1, truncated CG). The product A p is the threaded
+// geomint::symmetric_product (problems/parallel.hpp), the same bits at any thread count.
 enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
+
+// ‖r‖₂ as robust_norm gives it, from one pass over r where the sum of squares is far from under-
+// and overflow (a CG residual is tested every iteration; robust_norm takes two passes and a
+// temporary). Squares that underflow below 1e-200 change no bit of a sum above it.
+double residual_norm(const Vec& r) {
+  const double squares = r.squaredNorm();
+  return squares > 1e-200 && squares < 1e300 ? std::sqrt(squares) : robust_norm(r);
+}
 
 template <class Preconditioner>
 CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& preconditioner,
                             const Vec& b, double target, int max_iterations, Vec& x,
-                            int& iterations) {
+                            int& iterations, double& final_residual) {
   iterations = 0;
   x = Vec::Zero(b.size());
   Vec r = b;
-  if (robust_norm(r) <= target) return CgOutcome::kConverged;
+  final_residual = residual_norm(r);
+  if (final_residual <= target) return CgOutcome::kConverged;
   Vec z = preconditioner.solve(r);
   Vec p = z, Ap;
   double rz = r.dot(z);
   for (int k = 0; k < max_iterations; ++k) {
     ++iterations;
-    Ap.noalias() = A.selfadjointView<Eigen::Lower>() * p;
+    symmetric_product(A, p, Ap);
     const double curvature = p.dot(Ap);
     if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
     const double alpha = rz / curvature;
     x += alpha * p;
     r -= alpha * Ap;
-    if (robust_norm(r) <= target) return CgOutcome::kConverged;
+    final_residual = residual_norm(r);
+    if (final_residual <= target) return CgOutcome::kConverged;
     z = preconditioner.solve(r);
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
@@ -163,9 +175,11 @@ struct NewtonSolver::Factorisation {
   Eigen::IncompleteCholesky<double, Eigen::Lower> ichol;
   Eigen::SparseLU<SparseMatrix> lu;
   BoomerAmg amg;
-  // CG iterations of the first solve after the last AMG set-up (−1: none yet), and whether the
-  // next factorise() must rebuild it (LinearSolverOptions::amg_refresh_growth).
-  int amg_baseline_iterations = -1;
+  // CG iterations per decade of residual reduction in the first solve after the last AMG set-up
+  // (−1: none yet), and whether the next factorise() must rebuild it
+  // (LinearSolverOptions::amg_refresh_growth). Per decade, because the forcing terms ask the
+  // solves of one Newton iteration for a few decades and of another for many.
+  double amg_baseline_iterations = -1;
   bool amg_refresh = false;
   double amg_refresh_growth = 2.0;
   // Counters of the solve in progress (set by NewtonSolver::solve).
@@ -174,15 +188,23 @@ struct NewtonSolver::Factorisation {
   int* cg_iterations_counter = nullptr;
   SparseMatrix jacobian;
   LinearSolverKind kind = LinearSolverKind::kLdlt;  // resolved for the current system
-  // The factorisation held is of this matrix (CG: the matrix itself, kept for the iteration).
-  SparseMatrix factored;
+  // The factorisation held is of this matrix, which factorise() was given (`jacobian`: it is
+  // not changed before the next factorise()), so CG iterates on it without a copy.
+  const SparseMatrix* factored = nullptr;
+  // CG multiplies by the matrix in full (both triangles): `factored` itself when it stores them
+  // (every Newton matrix of geomint does), else its lower triangle mirrored into full_matrix.
+  const SparseMatrix* cg_matrix = nullptr;
+  SparseMatrix full_matrix;
+  bool pattern_in_full = true;   // the remembered pattern has both triangles
   bool has_factor = false;       // a usable factorisation of the current system's size is held
   bool direct_fallback = false;  // CG/CHOLMOD found J indefinite: this factor is an LDLT of it
   // Modified Newton: the last solve ended contracting fast, so its factorisation may start the
   // next one.
   bool keep_factor = false;
-  // Set by the caller before solve(): the residual the CG iteration must reach.
+  // Set by the caller before solve(): the residual the CG iteration must reach; set by solve():
+  // the residual ‖rhs − A·out‖ it reached (CG only).
   double cg_target = 0.0;
+  double cg_residual = 0.0;
   // Pattern of the matrix last passed to analyzePattern, and which factorisation it was for.
   bool has_pattern = false;
   bool pattern_symmetric = false;
@@ -218,6 +240,14 @@ struct NewtonSolver::Factorisation {
     rows = J.rows();
     outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
     inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
+    long above = 0, below = 0;
+    for (int k = 0; k < J.outerSize(); ++k) {
+      for (SparseMatrix::InnerIterator it(J, k); it; ++it) {
+        above += it.row() < it.col();
+        below += it.row() > it.col();
+      }
+    }
+    pattern_in_full = above == below;
   }
 
   template <class Solver>
@@ -236,6 +266,10 @@ struct NewtonSolver::Factorisation {
     has_factor = false;
     direct_fallback = false;
     const bool analyse = !reuse_symbolic || !same_pattern(matrix, symmetric);
+    if (analyse) {
+      ++analyses;
+      remember_pattern(matrix, symmetric);
+    }
     // A reused AMG set-up is no new preconditioner: setup_amg() counts the set-ups.
     if (!symmetric || kind != LinearSolverKind::kCgAmg) ++factorizations;
     bool ok = false;
@@ -267,11 +301,12 @@ struct NewtonSolver::Factorisation {
         case LinearSolverKind::kAuto:
           break;  // resolved before
       }
-      factored = matrix;
-    }
-    if (analyse) {
-      ++analyses;
-      remember_pattern(matrix, symmetric);
+      factored = &matrix;
+      cg_matrix = &matrix;
+      if (is_cg() && !pattern_in_full) {
+        full_matrix = matrix.selfadjointView<Eigen::Lower>();
+        cg_matrix = &full_matrix;
+      }
     }
     has_factor = ok;
     return ok;
@@ -281,7 +316,7 @@ struct NewtonSolver::Factorisation {
   // not, and the system has no SPD safeguard: the plain Newton step, as before the choice existed.
   bool factorise_indefinite(int& factorizations) {
     ++factorizations;
-    ldlt.compute(factored);
+    ldlt.compute(*factored);
     has_factor = ldlt.info() == Eigen::Success;
     direct_fallback = has_factor;
     return has_factor;
@@ -303,21 +338,27 @@ struct NewtonSolver::Factorisation {
 
   // CG preconditioned by the held AMG set-up; an old set-up that fails (a matrix that moved too
   // far from it) is rebuilt from the current matrix and the solve repeated once. Tracks the
-  // refresh rule of LinearSolverOptions::amg_refresh_growth.
+  // refresh rule of LinearSolverOptions::amg_refresh_growth, in CG iterations per decade of
+  // residual reduction (at least one decade counted per solve).
   CgOutcome amg_cg(const Vec& rhs, int max_cg, Vec& out) {
     int iterations = 0;
     const bool fresh = amg_baseline_iterations < 0;
-    CgOutcome outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+    CgOutcome outcome =
+        preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
     *cg_iterations_counter += iterations;
     if (outcome == CgOutcome::kNoConvergence && !fresh) {
-      if (!setup_amg(factored)) return outcome;
-      outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+      if (!setup_amg(*factored)) return outcome;
+      outcome =
+          preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
       *cg_iterations_counter += iterations;
     }
     if (outcome != CgOutcome::kConverged) return outcome;
+    const double decades =
+        cg_residual > 0.0 ? std::max(1.0, std::log10(residual_norm(rhs) / cg_residual)) : 1.0;
     if (amg_baseline_iterations < 0) {
-      amg_baseline_iterations = iterations;
-    } else if (iterations > amg_refresh_growth * amg_baseline_iterations + kAmgRefreshSlack) {
+      amg_baseline_iterations = iterations / decades;
+    } else if (iterations >
+               amg_refresh_growth * amg_baseline_iterations * decades + kAmgRefreshSlack) {
       amg_refresh = true;
     }
     return outcome;
@@ -367,11 +408,13 @@ struct NewtonSolver::Factorisation {
         out = cholmod.solve(rhs);
         break;
       case LinearSolverKind::kCg:
-        outcome = preconditioned_cg(factored, diagonal, rhs, cg_target, max_cg, out, iterations);
+        outcome = preconditioned_cg(*cg_matrix, diagonal, rhs, cg_target, max_cg, out, iterations,
+                                    cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgIchol:
-        outcome = preconditioned_cg(factored, ichol, rhs, cg_target, max_cg, out, iterations);
+        outcome = preconditioned_cg(*cg_matrix, ichol, rhs, cg_target, max_cg, out, iterations,
+                                    cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgAmg:
