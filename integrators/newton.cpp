@@ -123,16 +123,14 @@ constexpr double kFirstForcing = 1e-3;
 constexpr double kMaxForcing = 0.1;
 constexpr double kForcingSafeguardExponent = 1.618033988749895;
 
-// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md "Implicit step", CPU s of
-// a steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
-// unknowns cg 0.535 against cg_amg 0.697; at 544 320 unknowns cg 11.4 against cg_amg 9.9. The
-// threshold sits near the geometric middle of the two sizes; sizes between were not measured.
-constexpr long kAutoAmgFrom = 200000;
-
+// `auto` is kCg at every size from kAutoIterativeFrom on. kCgAmg was picked from 200 000 unknowns
+// on the strength of loaded CPU times (11.4 s cg against 9.92 s cg_amg per step at 544 320
+// unknowns); on the quiet machine (load 1.3, docs/PERF.md "Implicit step") cg took 5.06 s and
+// cg_amg 5.31 s per step at that size, 463 against 482 ms at 56 355 unknowns: no size measured
+// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
-  if (unknowns < kAutoIterativeFrom) return LinearSolverKind::kLdlt;
-  return unknowns < kAutoAmgFrom ? LinearSolverKind::kCg : LinearSolverKind::kCgAmg;
+  return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
 }
 
 const char* linear_solver_name(LinearSolverKind kind) {
@@ -166,8 +164,8 @@ LinearSolverOptions read_linear_solver_option(Params& params) {
   const std::string name = params.choice(
       "linear_solver", "auto", names,
       fmt::format("solver of the symmetric Newton systems (auto: ldlt below {} unknowns, "
-                  "cg below {}, else cg_amg)",
-                  kAutoIterativeFrom, kAutoAmgFrom));
+                  "else cg)",
+                  kAutoIterativeFrom));
   for (LinearSolverKind kind : kinds) {
     if (name == linear_solver_name(kind)) options.kind = kind;
   }
