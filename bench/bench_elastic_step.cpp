@@ -9,6 +9,8 @@
 #include <string>
 
 #include "integrators/integrator.hpp"
+#include "integrators/newton_profile.hpp"
+#include "problems/parallel.hpp"
 #include "problems/problem.hpp"
 
 namespace {
@@ -41,6 +43,7 @@ void BM_Step(benchmark::State& state, const std::string& method) {
   integrator->reset(*problem, s, h);
   geomint::StepStatus status = integrator->step(*problem, s, h);  // warm-up
   const geomint::Counters before = integrator->counters();
+  const geomint::NewtonProfile profile_before = geomint::newton_profile();
   for (auto _ : state) {
     status = integrator->step(*problem, s, h);
     if (!status.ok) {
@@ -59,6 +62,28 @@ void BM_Step(benchmark::State& state, const std::string& method) {
   state.counters["factorizations"] = per_step(&geomint::Counters::factorizations);
   state.counters["hessian_evals"] = per_step(&geomint::Counters::hessian_evals);
   state.counters["peak_rss_mb"] = peak_rss_mb();
+  // Where a step's time goes (integrators/newton.hpp NewtonProfile): CG iterations per step
+  // (deterministic) and wall seconds per step of each phase of the Newton solves, which under
+  // load are as unreliable as the step's wall time but show the shares.
+  const geomint::NewtonProfile profile = geomint::newton_profile();
+  const auto per_step_count = [&](long geomint::NewtonProfile::*field) {
+    return benchmark::Counter(static_cast<double>(profile.*field - profile_before.*field),
+                              benchmark::Counter::kAvgIterations);
+  };
+  const auto per_step_seconds = [&](double geomint::NewtonProfile::*field) {
+    return benchmark::Counter(profile.*field - profile_before.*field,
+                              benchmark::Counter::kAvgIterations);
+  };
+  state.counters["cg_iters"] = per_step_count(&geomint::NewtonProfile::cg_iterations);
+  state.counters["residual_evals"] = per_step_count(&geomint::NewtonProfile::residuals);
+  state.counters["energy_evals"] = per_step_count(&geomint::NewtonProfile::objectives);
+  state.counters["s_newton"] = per_step_seconds(&geomint::NewtonProfile::total_s);
+  state.counters["s_jacobian"] = per_step_seconds(&geomint::NewtonProfile::jacobian_s);
+  state.counters["s_residual"] = per_step_seconds(&geomint::NewtonProfile::residual_s);
+  state.counters["s_energy"] = per_step_seconds(&geomint::NewtonProfile::objective_s);
+  state.counters["s_setup"] = per_step_seconds(&geomint::NewtonProfile::setup_s);
+  state.counters["s_linear"] = per_step_seconds(&geomint::NewtonProfile::linear_s);
+  state.counters["threads"] = geomint::thread_count();
 }
 
 // One benchmark per (method, sizes first..last); three timed steps, one at 10⁶ tetrahedra.

@@ -4,7 +4,9 @@
 // §3.2).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,9 +17,43 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/parallel.hpp"
 
 namespace geomint {
 namespace {
+
+// J = diag(m) + c·H with the bits of Eigen's `J = M; J += c * H` for the sparse diagonal M (an
+// entry m_i + c·H_ii on the diagonal and 0 + c·H_ij elsewhere: Eigen's sum adds 0 where an operand
+// has no entry), but in one threaded pass over H's values into J's storage (reused from the last
+// call) instead of a serial merge into a newly allocated matrix: at 10⁵ tetrahedra that merge was
+// a quarter of a Newton iteration's Jacobian time (docs/PERF.md "Implicit step"). Needs H square,
+// compressed and with every diagonal entry in its pattern (the assembled Hessians of the mesh and
+// spring problems); false otherwise, and the caller sums as before.
+bool diagonal_plus_scaled(const Vec& m, double c, const SparseMatrix& H, SparseMatrix& J) {
+  const Eigen::Index n = H.outerSize();
+  if (!H.isCompressed() || H.rows() != n || m.size() != n) return false;
+  const int* outer = H.outerIndexPtr();
+  const int* inner = H.innerIndexPtr();
+  std::vector<int> diagonal(static_cast<std::size_t>(n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const int* at = std::lower_bound(inner + outer[j], inner + outer[j + 1], static_cast<int>(j));
+    if (at == inner + outer[j + 1] || *at != j) return false;
+    diagonal[static_cast<std::size_t>(j)] = static_cast<int>(at - inner);
+  }
+  J = H;
+  const double* from = H.valuePtr();
+  double* to = J.valuePtr();
+  const auto entries = static_cast<std::size_t>(H.nonZeros());
+  for_each_chunk(chunk_count(entries, std::size_t{1} << 16), entries,
+                 [&](int, std::size_t begin, std::size_t end) {
+                   for (std::size_t k = begin; k < end; ++k) to[k] = 0.0 + c * from[k];
+                 });
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const auto k = static_cast<std::size_t>(diagonal[static_cast<std::size_t>(j)]);
+    to[k] = m[j] + c * from[k];
+  }
+  return true;
+}
 
 // Update from (q_k, p_k), with q^α = q_k + αhv and the impulses F_d∓ of the force_slot/force_at
 // options (integrators/forcing.hpp; discrete_lagrangian.cpp's α-rule is the same map):
@@ -241,12 +277,17 @@ class HamiltonPontryagin final : public Integrator,
       residual = mass.cwiseProduct(x) - b_ + implicit_term_;
     };
     system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
-      jacobian = mass_matrix_;
       if (coupled) {
         const Vec q_alpha = q0_ + (alpha_ * h_) * x;
         eval_hessian(problem, q_alpha, hessian_);
         inner_scale = std::abs((1 - alpha_) * h_) * gradient_term_scale(hessian_, q_alpha);
-        jacobian += (alpha_ * (1 - alpha_) * h_ * h_) * hessian_;
+        const double weight = alpha_ * (1 - alpha_) * h_ * h_;
+        if (!diagonal_plus_scaled(mass, weight, hessian_, jacobian)) {
+          jacobian = mass_matrix_;
+          jacobian += weight * hessian_;
+        }
+      } else {
+        jacobian = mass_matrix_;
       }
       if (minus_ > 0.0) add_impulse_jacobian(problem, x, jacobian);
     };

@@ -13,6 +13,8 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -20,6 +22,8 @@
 #include <vector>
 
 #include "integrators/boomer_amg.hpp"
+#include "integrators/newton_profile.hpp"
+#include "problems/parallel.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -28,32 +32,43 @@ namespace {
 
 using MetisLdlt = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>>;
 
-// Preconditioned conjugate gradients on the lower triangle of A (as the Cholesky solvers read
-// it), from x = 0, until ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient
-// for the curvature test: pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD
-// safeguard needs to know (Nocedal & Wright §5.1 and §7.1, truncated CG).
+// Preconditioned conjugate gradients on A (stored in full, both triangles), from x = 0, until
+// ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient for the curvature test:
+// pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD safeguard needs to know
+// (Nocedal & Wright §5.1 and §7.1, truncated CG). The product A p is the threaded
+// geomint::symmetric_product (problems/parallel.hpp), the same bits at any thread count.
 enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
+
+// ‖r‖₂ as robust_norm gives it, from one pass over r where the sum of squares is far from under-
+// and overflow (a CG residual is tested every iteration; robust_norm takes two passes and a
+// temporary). Squares that underflow below 1e-200 change no bit of a sum above it.
+double residual_norm(const Vec& r) {
+  const double squares = r.squaredNorm();
+  return squares > 1e-200 && squares < 1e300 ? std::sqrt(squares) : robust_norm(r);
+}
 
 template <class Preconditioner>
 CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& preconditioner,
                             const Vec& b, double target, int max_iterations, Vec& x,
-                            int& iterations) {
+                            int& iterations, double& final_residual) {
   iterations = 0;
   x = Vec::Zero(b.size());
   Vec r = b;
-  if (robust_norm(r) <= target) return CgOutcome::kConverged;
+  final_residual = residual_norm(r);
+  if (final_residual <= target) return CgOutcome::kConverged;
   Vec z = preconditioner.solve(r);
   Vec p = z, Ap;
   double rz = r.dot(z);
   for (int k = 0; k < max_iterations; ++k) {
     ++iterations;
-    Ap.noalias() = A.selfadjointView<Eigen::Lower>() * p;
+    symmetric_product(A, p, Ap);
     const double curvature = p.dot(Ap);
     if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
     const double alpha = rz / curvature;
     x += alpha * p;
     r -= alpha * Ap;
-    if (robust_norm(r) <= target) return CgOutcome::kConverged;
+    final_residual = residual_norm(r);
+    if (final_residual <= target) return CgOutcome::kConverged;
     z = preconditioner.solve(r);
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
@@ -62,18 +77,60 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
   return CgOutcome::kNoConvergence;
 }
 
+// Wall-clock seconds of a phase of the solve, added to a NewtonProfile total when it ends.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(std::atomic<long>& nanoseconds)
+      : total_(nanoseconds), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() {
+    total_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::steady_clock::now() - start_)
+                         .count(),
+                     std::memory_order_relaxed);
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  std::atomic<long>& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+struct ProfileTotals {
+  std::atomic<long> solves{0}, iterations{0}, cg_iterations{0}, jacobians{0}, residuals{0},
+      objectives{0}, linear_solves{0};
+  std::atomic<long> total_ns{0}, jacobian_ns{0}, residual_ns{0}, objective_ns{0}, setup_ns{0},
+      linear_ns{0};
+};
+
+ProfileTotals& profile_totals() {
+  static ProfileTotals totals;
+  return totals;
+}
+
 }  // namespace
 
-// `auto` picks kCgAmg from this many unknowns on. Measured (docs/PERF.md "Implicit step", CPU s of
-// a steady-state hp:alpha=0.5 step of the elastic bar, bench/bench_elastic_step.cpp): at 56 355
-// unknowns cg 0.535 against cg_amg 0.697; at 544 320 unknowns cg 11.4 against cg_amg 9.9. The
-// threshold sits near the geometric middle of the two sizes; sizes between were not measured.
-constexpr long kAutoAmgFrom = 200000;
+// Forcing terms of the inexact Newton iteration with CG (Eisenstat & Walker, "Choosing the
+// forcing terms in an inexact Newton method", SIAM J. Sci. Comput. 17(1), 1996, choice 1):
+// iteration k's CG stops at ‖J d + R_k‖ ≤ max(0.1·threshold, η_k‖R_k‖). η₀ = kFirstForcing (the
+// constant forcing used before, measured on the elastic bar: docs/PERF.md "Implicit step"); then
+// η_k = |‖R_k‖ − ‖R_{k−1} + J_{k−1}s_{k−1}‖| / ‖R_{k−1}‖, the miss of the last step's linear model,
+// at least η_{k−1}^((1+√5)/2) when that exceeds 0.1 (their safeguard against a sudden tightening),
+// at most kMaxForcing. A nearly linear step (small miss) gets a tight solve and ends in fewer
+// Newton iterations; a strongly nonlinear one (large miss) a loose one, saving CG iterations that
+// Newton would discard. The Newton stopping test is unchanged.
+constexpr double kFirstForcing = 1e-3;
+constexpr double kMaxForcing = 0.1;
+constexpr double kForcingSafeguardExponent = 1.618033988749895;
 
+// `auto` is kCg at every size from kAutoIterativeFrom on. kCgAmg was picked from 200 000 unknowns
+// on the strength of loaded CPU times (11.4 s cg against 9.92 s cg_amg per step at 544 320
+// unknowns); on the quiet machine (load 1.3, docs/PERF.md "Implicit step") cg took 5.06 s and
+// cg_amg 5.31 s per step at that size, 463 against 482 ms at 56 355 unknowns: no size measured
+// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
-  if (unknowns < kAutoIterativeFrom) return LinearSolverKind::kLdlt;
-  return unknowns < kAutoAmgFrom ? LinearSolverKind::kCg : LinearSolverKind::kCgAmg;
+  return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
 }
 
 const char* linear_solver_name(LinearSolverKind kind) {
@@ -107,8 +164,8 @@ LinearSolverOptions read_linear_solver_option(Params& params) {
   const std::string name = params.choice(
       "linear_solver", "auto", names,
       fmt::format("solver of the symmetric Newton systems (auto: ldlt below {} unknowns, "
-                  "cg below {}, else cg_amg)",
-                  kAutoIterativeFrom, kAutoAmgFrom));
+                  "else cg)",
+                  kAutoIterativeFrom));
   for (LinearSolverKind kind : kinds) {
     if (name == linear_solver_name(kind)) options.kind = kind;
   }
@@ -129,9 +186,11 @@ struct NewtonSolver::Factorisation {
   Eigen::IncompleteCholesky<double, Eigen::Lower> ichol;
   Eigen::SparseLU<SparseMatrix> lu;
   BoomerAmg amg;
-  // CG iterations of the first solve after the last AMG set-up (−1: none yet), and whether the
-  // next factorise() must rebuild it (LinearSolverOptions::amg_refresh_growth).
-  int amg_baseline_iterations = -1;
+  // CG iterations per decade of residual reduction in the first solve after the last AMG set-up
+  // (−1: none yet), and whether the next factorise() must rebuild it
+  // (LinearSolverOptions::amg_refresh_growth). Per decade, because the forcing terms ask the
+  // solves of one Newton iteration for a few decades and of another for many.
+  double amg_baseline_iterations = -1;
   bool amg_refresh = false;
   double amg_refresh_growth = 2.0;
   // Counters of the solve in progress (set by NewtonSolver::solve).
@@ -140,15 +199,23 @@ struct NewtonSolver::Factorisation {
   int* cg_iterations_counter = nullptr;
   SparseMatrix jacobian;
   LinearSolverKind kind = LinearSolverKind::kLdlt;  // resolved for the current system
-  // The factorisation held is of this matrix (CG: the matrix itself, kept for the iteration).
-  SparseMatrix factored;
+  // The factorisation held is of this matrix, which factorise() was given (`jacobian`: it is
+  // not changed before the next factorise()), so CG iterates on it without a copy.
+  const SparseMatrix* factored = nullptr;
+  // CG multiplies by the matrix in full (both triangles): `factored` itself when it stores them
+  // (every Newton matrix of geomint does), else its lower triangle mirrored into full_matrix.
+  const SparseMatrix* cg_matrix = nullptr;
+  SparseMatrix full_matrix;
+  bool pattern_in_full = true;   // the remembered pattern has both triangles
   bool has_factor = false;       // a usable factorisation of the current system's size is held
   bool direct_fallback = false;  // CG/CHOLMOD found J indefinite: this factor is an LDLT of it
   // Modified Newton: the last solve ended contracting fast, so its factorisation may start the
   // next one.
   bool keep_factor = false;
-  // Set by the caller before solve(): the residual the CG iteration must reach.
+  // Set by the caller before solve(): the residual the CG iteration must reach; set by solve():
+  // the residual ‖rhs − A·out‖ it reached (CG only).
   double cg_target = 0.0;
+  double cg_residual = 0.0;
   // Pattern of the matrix last passed to analyzePattern, and which factorisation it was for.
   bool has_pattern = false;
   bool pattern_symmetric = false;
@@ -184,6 +251,14 @@ struct NewtonSolver::Factorisation {
     rows = J.rows();
     outer.assign(J.outerIndexPtr(), J.outerIndexPtr() + J.outerSize() + 1);
     inner.assign(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros());
+    long above = 0, below = 0;
+    for (int k = 0; k < J.outerSize(); ++k) {
+      for (SparseMatrix::InnerIterator it(J, k); it; ++it) {
+        above += it.row() < it.col();
+        below += it.row() > it.col();
+      }
+    }
+    pattern_in_full = above == below;
   }
 
   template <class Solver>
@@ -198,9 +273,14 @@ struct NewtonSolver::Factorisation {
   // positive definite — which the caller then handles (SPD shift, or an LDLT fallback).
   bool factorise(const SparseMatrix& matrix, bool symmetric, bool reuse_symbolic, int& analyses,
                  int& factorizations) {
+    const PhaseTimer timer(profile_totals().setup_ns);
     has_factor = false;
     direct_fallback = false;
     const bool analyse = !reuse_symbolic || !same_pattern(matrix, symmetric);
+    if (analyse) {
+      ++analyses;
+      remember_pattern(matrix, symmetric);
+    }
     // A reused AMG set-up is no new preconditioner: setup_amg() counts the set-ups.
     if (!symmetric || kind != LinearSolverKind::kCgAmg) ++factorizations;
     bool ok = false;
@@ -232,11 +312,12 @@ struct NewtonSolver::Factorisation {
         case LinearSolverKind::kAuto:
           break;  // resolved before
       }
-      factored = matrix;
-    }
-    if (analyse) {
-      ++analyses;
-      remember_pattern(matrix, symmetric);
+      factored = &matrix;
+      cg_matrix = &matrix;
+      if (is_cg() && !pattern_in_full) {
+        full_matrix = matrix.selfadjointView<Eigen::Lower>();
+        cg_matrix = &full_matrix;
+      }
     }
     has_factor = ok;
     return ok;
@@ -246,7 +327,7 @@ struct NewtonSolver::Factorisation {
   // not, and the system has no SPD safeguard: the plain Newton step, as before the choice existed.
   bool factorise_indefinite(int& factorizations) {
     ++factorizations;
-    ldlt.compute(factored);
+    ldlt.compute(*factored);
     has_factor = ldlt.info() == Eigen::Success;
     direct_fallback = has_factor;
     return has_factor;
@@ -268,21 +349,27 @@ struct NewtonSolver::Factorisation {
 
   // CG preconditioned by the held AMG set-up; an old set-up that fails (a matrix that moved too
   // far from it) is rebuilt from the current matrix and the solve repeated once. Tracks the
-  // refresh rule of LinearSolverOptions::amg_refresh_growth.
+  // refresh rule of LinearSolverOptions::amg_refresh_growth, in CG iterations per decade of
+  // residual reduction (at least one decade counted per solve).
   CgOutcome amg_cg(const Vec& rhs, int max_cg, Vec& out) {
     int iterations = 0;
     const bool fresh = amg_baseline_iterations < 0;
-    CgOutcome outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+    CgOutcome outcome =
+        preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
     *cg_iterations_counter += iterations;
     if (outcome == CgOutcome::kNoConvergence && !fresh) {
-      if (!setup_amg(factored)) return outcome;
-      outcome = preconditioned_cg(factored, amg, rhs, cg_target, max_cg, out, iterations);
+      if (!setup_amg(*factored)) return outcome;
+      outcome =
+          preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
       *cg_iterations_counter += iterations;
     }
     if (outcome != CgOutcome::kConverged) return outcome;
+    const double decades =
+        cg_residual > 0.0 ? std::max(1.0, std::log10(residual_norm(rhs) / cg_residual)) : 1.0;
     if (amg_baseline_iterations < 0) {
-      amg_baseline_iterations = iterations;
-    } else if (iterations > amg_refresh_growth * amg_baseline_iterations + kAmgRefreshSlack) {
+      amg_baseline_iterations = iterations / decades;
+    } else if (iterations >
+               amg_refresh_growth * amg_baseline_iterations * decades + kAmgRefreshSlack) {
       amg_refresh = true;
     }
     return outcome;
@@ -307,6 +394,8 @@ struct NewtonSolver::Factorisation {
   // Solves with the held factorisation; false when CG met negative curvature or did not reach
   // cg_target (then `out` is not a usable direction).
   bool solve(bool symmetric, const Vec& rhs, Vec& out, bool& negative_curvature) {
+    const PhaseTimer timer(profile_totals().linear_ns);
+    profile_totals().linear_solves.fetch_add(1, std::memory_order_relaxed);
     negative_curvature = false;
     if (!symmetric) {
       out = lu.solve(rhs);
@@ -330,11 +419,13 @@ struct NewtonSolver::Factorisation {
         out = cholmod.solve(rhs);
         break;
       case LinearSolverKind::kCg:
-        outcome = preconditioned_cg(factored, diagonal, rhs, cg_target, max_cg, out, iterations);
+        outcome = preconditioned_cg(*cg_matrix, diagonal, rhs, cg_target, max_cg, out, iterations,
+                                    cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgIchol:
-        outcome = preconditioned_cg(factored, ichol, rhs, cg_target, max_cg, out, iterations);
+        outcome = preconditioned_cg(*cg_matrix, ichol, rhs, cg_target, max_cg, out, iterations,
+                                    cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgAmg:
@@ -459,8 +550,59 @@ std::string describe(const NewtonResult& result) {
                      result.iterations, result.residual_norm, result.threshold, result.reason);
 }
 
+namespace {
+
+// Adds a finished solve's totals to the NewtonProfile (declared after the result it reads, so it
+// runs before the result is gone on every return path).
+class SolveProfile {
+ public:
+  explicit SolveProfile(const NewtonResult& result)
+      : result_(result), timer_(profile_totals().total_ns) {}
+  ~SolveProfile() {
+    ProfileTotals& totals = profile_totals();
+    totals.solves.fetch_add(1, std::memory_order_relaxed);
+    totals.iterations.fetch_add(result_.iterations, std::memory_order_relaxed);
+    totals.cg_iterations.fetch_add(result_.cg_iterations, std::memory_order_relaxed);
+    totals.residuals.fetch_add(result_.residual_evals, std::memory_order_relaxed);
+  }
+  SolveProfile(const SolveProfile&) = delete;
+  SolveProfile& operator=(const SolveProfile&) = delete;
+
+ private:
+  const NewtonResult& result_;
+  PhaseTimer timer_;
+};
+
+}  // namespace
+
+NewtonProfile newton_profile() {
+  const ProfileTotals& totals = profile_totals();
+  const auto count = [](const std::atomic<long>& value) {
+    return value.load(std::memory_order_relaxed);
+  };
+  const auto seconds = [](const std::atomic<long>& nanoseconds) {
+    return 1e-9 * static_cast<double>(nanoseconds.load(std::memory_order_relaxed));
+  };
+  NewtonProfile profile;
+  profile.solves = count(totals.solves);
+  profile.iterations = count(totals.iterations);
+  profile.cg_iterations = count(totals.cg_iterations);
+  profile.residuals = count(totals.residuals);
+  profile.objectives = count(totals.objectives);
+  profile.jacobians = count(totals.jacobians);
+  profile.linear_solves = count(totals.linear_solves);
+  profile.total_s = seconds(totals.total_ns);
+  profile.residual_s = seconds(totals.residual_ns);
+  profile.objective_s = seconds(totals.objective_ns);
+  profile.jacobian_s = seconds(totals.jacobian_ns);
+  profile.setup_s = seconds(totals.setup_ns);
+  profile.linear_s = seconds(totals.linear_ns);
+  return profile;
+}
+
 NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
   NewtonResult result;
+  const SolveProfile profile(result);
   const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
   result.threshold = std::max(relative_tolerance * residual_scale, kSubnormalResidual);
   double scale = residual_scale;
@@ -473,6 +615,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   Vec residual;
   auto evaluate = [&](const Vec& at, Vec& r) {
     ++result.residual_evals;
+    const PhaseTimer timer(profile_totals().residual_ns);
     system.residual(at, r);
     if (r.size() != at.size()) {
       throw std::logic_error(
@@ -485,7 +628,10 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   // other, and scaling by 2ᵏ keeps every comparison bit for bit.
   double merit_unit = 1.0;
   auto merit_of = [&](const Vec& at, const Vec& r) {
-    return system.objective ? system.objective(at) : 0.5 * (merit_unit * r).squaredNorm();
+    if (!system.objective) return 0.5 * (merit_unit * r).squaredNorm();
+    profile_totals().objectives.fetch_add(1, std::memory_order_relaxed);
+    const PhaseTimer timer(profile_totals().objective_ns);
+    return system.objective(at);
   };
   auto fail = [&](const char* reason) {
     result.reason = reason;
@@ -517,11 +663,13 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   Vec direction, trial, trial_residual;
   f.kind = resolve_linear_solver(options_.linear.kind, x.size());
   const bool modified = options_.linear.modified_newton && !f.is_cg();
-  // The CG iteration stops at a residual tied to Newton's: far below ‖R‖ (fast outer
-  // convergence) and below the threshold (the last correction does not leave an error the
-  // stopping test would see). The stopping test on R itself is unchanged.
+  // Inexact Newton: the CG iteration stops at forcing·‖R‖ (forcing terms: kFirstForcing, then
+  // Eisenstat–Walker's, updated after every accepted step below) and below the threshold (the
+  // last correction does not leave an error the stopping test would see). The stopping test on R
+  // itself is unchanged, so it alone decides convergence. Direct solvers ignore the target.
+  double forcing = kFirstForcing;
   auto set_cg_target = [&] {
-    f.cg_target = std::max(0.1 * result.threshold, 1e-3 * result.residual_norm);
+    f.cg_target = std::max(0.1 * result.threshold, forcing * result.residual_norm);
   };
   // Solves J d = −R with the held factorisation (or CG on the held matrix).
   auto solve_held = [&](const Vec& rhs, Vec& out) {
@@ -612,7 +760,11 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       reuse_factor = stale;
     }
     if (!stale) {
-      system.jacobian(x, f.jacobian);
+      {
+        profile_totals().jacobians.fetch_add(1, std::memory_order_relaxed);
+        const PhaseTimer timer(profile_totals().jacobian_ns);
+        system.jacobian(x, f.jacobian);
+      }
       if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
         throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
                                            f.jacobian.rows(), f.jacobian.cols(), x.size()));
@@ -723,6 +875,15 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
     merit = trial_merit;
     const double previous_norm = result.residual_norm;
     result.residual_norm = robust_norm(residual);
+    if (f.is_cg() && previous_norm > 0.0) {
+      // Eisenstat–Walker choice 1: how far the linear model R + J·s of the step taken missed the
+      // new residual. For a damped step s = αd, ‖R + αJd‖ ≤ (1 − α)‖R‖ + α‖R + Jd‖.
+      const double model = (1.0 - step) * previous_norm + step * f.cg_residual;
+      double next = std::abs(result.residual_norm - model) / previous_norm;
+      const double safeguard = std::pow(forcing, kForcingSafeguardExponent);
+      if (safeguard > 0.1) next = std::max(next, safeguard);
+      forcing = std::min(next, kMaxForcing);
+    }
     reuse_factor = modified && f.has_factor && step == 1.0 &&
                    result.residual_norm <= kModifiedNewtonContraction * previous_norm;
     if (options_.record_history) result.residual_history.push_back(result.residual_norm);

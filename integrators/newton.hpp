@@ -45,10 +45,10 @@ struct LinearSolverOptions {
   // is factorised as soon as it does not). Direct solvers only; CG always uses the current matrix.
   bool modified_newton = false;
   // cg_amg keeps its multigrid set-up (built from an earlier matrix: a preconditioner need not be
-  // of the current one) until a CG solve takes more than amg_refresh_growth × (the iterations of
-  // the first solve after that set-up) + kAmgRefreshSlack iterations, and rebuilds it on the next
-  // Jacobian; a CG failure with an old set-up rebuilds it at once and solves again. 0 rebuilds
-  // for every Jacobian.
+  // of the current one) until a CG solve takes more than amg_refresh_growth × (the iterations per
+  // decade of the first solve after that set-up) × its decades + kAmgRefreshSlack iterations, and
+  // rebuilds it on the next Jacobian; a CG failure with an old set-up rebuilds it at once and
+  // solves again. 0 rebuilds for every Jacobian.
   double amg_refresh_growth = 2.0;
 };
 

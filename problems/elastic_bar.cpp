@@ -482,6 +482,8 @@ class ElasticBar final : public Problem {
   // node layers shared by neighbouring chunks, a few per cent at 10⁴ elements.
   // Below this many elements per chunk a thread costs more than it saves (docs/PERF.md).
   static constexpr std::size_t kMinElementsPerChunk = 2048;
+  // Below this many matrix entries per chunk a thread costs more than zeroing them saves.
+  static constexpr std::size_t kMinEntriesPerChunk = std::size_t{1} << 16;
 
   // Whether chunk `chunk` starting at element `begin` must queue its additions to the node pair's
   // entries (or, with b = a, to node a's vector entries).
@@ -527,7 +529,7 @@ class ElasticBar final : public Problem {
   // contributions in the same order, so the symmetry of K_e carries over to the last bit.
   template <class ElementFn>
   void assemble(const Vec& q, const ElementFn& element, SparseMatrix& out) const {
-    out = pattern_;
+    reset_to_pattern(out);
     double* values = out.valuePtr();
     const int* outer = out.outerIndexPtr();
     const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
@@ -561,6 +563,31 @@ class ElasticBar final : public Problem {
     for (const auto& later : queued) {
       for (const auto& [index, value] : later) values[index] += value;
     }
+  }
+
+  // Makes `out` K's pattern with zero values. A matrix that already has the pattern (the caller's
+  // from the last assembly) keeps its storage and only has its values zeroed, both on the threads
+  // (half the memory traffic of copying pattern_, and no allocation); anything else gets a copy.
+  void reset_to_pattern(SparseMatrix& out) const {
+    const auto entries = static_cast<std::size_t>(pattern_.nonZeros());
+    if (out.rows() != pattern_.rows() || out.cols() != pattern_.cols() || !out.isCompressed() ||
+        static_cast<std::size_t>(out.nonZeros()) != entries ||
+        !std::equal(pattern_.outerIndexPtr(), pattern_.outerIndexPtr() + pattern_.outerSize() + 1,
+                    out.outerIndexPtr())) {
+      out = pattern_;
+      return;
+    }
+    const int chunks = chunk_count(entries, kMinEntriesPerChunk);
+    std::vector<char> same(static_cast<std::size_t>(chunks), 0);
+    const int* expected = pattern_.innerIndexPtr();
+    const int* held = out.innerIndexPtr();
+    double* values = out.valuePtr();
+    for_each_chunk(chunks, entries, [&](int chunk, std::size_t begin, std::size_t end) {
+      same[static_cast<std::size_t>(chunk)] =
+          std::equal(expected + begin, expected + end, held + begin);
+      std::fill(values + begin, values + end, 0.0);
+    });
+    if (std::find(same.begin(), same.end(), 0) != same.end()) out = pattern_;
   }
 
   // Sparsity pattern of K: 3×3 blocks for all node pairs that share an element, built from sorted
