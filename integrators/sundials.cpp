@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -451,7 +452,7 @@ class Cvode final : public SundialsIntegrator {
 class Ida final : public SundialsIntegrator {
  public:
   Ida(const AdaptiveSettings& settings, int max_order, int index, int max_nonlin_iters,
-      double nonlin_conv_coef, double multiplier_atol)
+      double nonlin_conv_coef, std::optional<double> multiplier_atol)
       : SundialsIntegrator(settings, "ida"),
         max_order_(max_order),
         index_(index),
@@ -509,7 +510,12 @@ class Ida final : public SundialsIntegrator {
       return;
     }
     if (index_ != 0 && !exclude_from_error_test(ida)) return;
-    if (index_ != 0 && multiplier_atol_ != settings_.atol && !loosen_multipliers(ida)) return;
+    if (index_ != 0 && multiplier_atol_ && !loosen_multipliers(ida)) return;
+    if (index_ == 2 && !multiplier_atol_ &&
+        !check_setup(IDAWFtolerances(ida, &step_scaled_weights), "IDAWFtolerances")) {
+      return;
+    }
+    first_step_ = 0;
     matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
     if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
     if (!matrix_ || !linear_solver_) {
@@ -535,6 +541,10 @@ class Ida final : public SundialsIntegrator {
     if (!status.ok) return status;
     void* ida = memory_.get();
     int flag = IDASetStopTime(ida, t_stop);
+    if (flag >= 0 && index_ == 2 && !multiplier_atol_ && first_step_ == 0) {
+      first_step_ = initial_step(t_stop);
+      flag = IDASetInitStep(ida, first_step_);
+    }
     double t_returned = t_;
     if (flag >= 0) flag = IDASolve(ida, t_stop, &t_returned, y_.get(), yp_.get(), IDA_ONE_STEP);
     update_counters();
@@ -565,8 +575,74 @@ class Ida final : public SundialsIntegrator {
     if (!tolerances) return setup_failed(-1, "N_VNew_Serial failed");
     auto atol = view_mutable(tolerances.get());
     atol.setConstant(settings_.atol);
-    atol.tail(n_ - 2 * dof_).setConstant(multiplier_atol_);
+    atol.tail(n_ - 2 * dof_).setConstant(*multiplier_atol_);
     return check_setup(IDASVtolerances(ida, settings_.rtol, tolerances.get()), "IDASVtolerances");
+  }
+
+  // Index 2: the error weights of λ and μ scale with the step. Their Newton increments carry the
+  // round-off of the constraint rows amplified by c_j = α/h (δμ ≈ c_j (G M⁻¹Gᵀ)⁻¹ r_g, r_g ≈ ε|q|;
+  // likewise δλ from G M⁻¹p), so a fixed weight 1/(rtol|μ| + atol) fails IDA's convergence test
+  // at the tiny first steps (from p(0) = 0 and a tight atol) once g(q) rounds to a nonzero
+  // value: IDA_CONV_FAIL at t ≈ 0, depending on the problem's units. What the step needs is the
+  // multipliers' effect on the differential variables over it, h Gᵀδλ on p and h M⁻¹Gᵀδμ on q,
+  // in those variables' own weights: w(λ_i) = h ‖G_i ∘ w(p)‖₂, w(μ_i) = h ‖G_i M⁻¹ ∘ w(q)‖₂
+  // (the h-scaling of index-2 variables of Hairer & Wanner II §VII.3 and Brenan, Campbell &
+  // Petzold 1996 §5.4; λ, μ are outside the error test, so only the Newton test sees these).
+  // IDA calls this at every step start with h the step about to be tried; before the first
+  // step with the first step set by initial_step().
+  int evaluate_step_scaled_weights(N_Vector y_vector, N_Vector weights_vector) noexcept {
+    try {
+      const auto y = view(y_vector);
+      auto w = view_mutable(weights_vector);
+      const int n = dof_, m = constraint_count_;
+      w.head(2 * n) =
+          (settings_.rtol * y.head(2 * n).array().abs() + settings_.atol).inverse().matrix();
+      long steps = 0;
+      double h = first_step_, t = t_;
+      IDAGetNumSteps(memory_.get(), &steps);
+      if (steps > 0) {
+        IDAGetCurrentStep(memory_.get(), &h);
+        IDAGetCurrentTime(memory_.get(), &t);
+      }
+      h = std::abs(h);
+      q_ = y.head(n);
+      problem_->constraint_jacobian_at(t, q_, G_);
+      const Vec& inverse_mass = problem_->inverse_mass();
+      Vec on_p = Vec::Zero(m), on_q = Vec::Zero(m);
+      for (int col = 0; col < G_.outerSize(); ++col) {
+        for (SparseMatrix::InnerIterator it(G_, col); it; ++it) {
+          on_p[it.row()] += std::pow(it.value() * w[n + col], 2);
+          on_q[it.row()] += std::pow(it.value() * inverse_mass[col] * w[col], 2);
+        }
+      }
+      w.segment(2 * n, m) = h * on_p.cwiseSqrt();
+      w.tail(m) = h * on_q.cwiseSqrt();
+      // A zero weight (a constraint row without entries, h = 0) would make IDA's difference
+      // quotient increment 1/w infinite.
+      return w.allFinite() && w.minCoeff() > 0 ? 0 : -1;
+    } catch (const std::exception& error) {
+      callback_error_ = error.what();
+      return -1;
+    }
+  }
+  static int step_scaled_weights(N_Vector y, N_Vector weights, void* self) {
+    return static_cast<Ida*>(self)->evaluate_step_scaled_weights(y, weights);
+  }
+
+  // IDA's own first step (IDA user guide v6.4.1 §2.1, IDASolve): 0.001 |t_stop − t0|, cut to
+  // 0.5 / ‖y'(t0)‖ (weighted RMS over the differential components), here because the step-scaled
+  // weights need it before IDA computes it.
+  double initial_step(double t_stop) const {
+    const auto y = view(y_.get());
+    const auto yp = view(yp_.get());
+    const int differential = 2 * dof_;
+    const Vec weights =
+        (settings_.rtol * y.head(differential).array().abs() + settings_.atol).inverse().matrix();
+    const double yp_norm =
+        std::sqrt(yp.head(differential).cwiseProduct(weights).squaredNorm() / n_);
+    double h = 0.001 * std::abs(t_stop - t_);
+    if (yp_norm * h > 0.5) h = 0.5 / yp_norm;
+    return h;
   }
 
   // id = 1 for the components in the error test, 0 for the rest (suppressed).
@@ -670,7 +746,10 @@ class Ida final : public SundialsIntegrator {
   int index_;  // 0: the ODE residual; 2 or 3: the constrained DAE of that index
   int max_nonlin_iters_;
   double nonlin_conv_coef_;
-  double multiplier_atol_;  // absolute tolerance of λ (and μ) in the Newton convergence test
+  // Absolute tolerance of λ (and μ) in the Newton convergence test when given; otherwise index 2
+  // weighs them by the step (evaluate_step_scaled_weights), index 3 by atol.
+  std::optional<double> multiplier_atol_;
+  double first_step_ = 0;  // index 2 with step-scaled weights: the step IDA starts with
   int constraint_count_ = 0;
   bool analytic_jacobian_ = false;
   Vec q_, p_, force_, applied_, rate_, g_, g_time_, a_time_;
@@ -903,15 +982,20 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
       "Newton convergence test coefficient relative to the local error test (IDA default 0.33)",
       [](double v) { return v > 0 && v <= 1; }, "in (0, 1]");
   params.omit_default_from_canonical("nonlin_conv_coef");
+  const bool multiplier_atol_given = params.given("multiplier_atol");
   const double multiplier_atol = params.real(
       "multiplier_atol", settings.atol,
       "absolute tolerance of the multipliers (index 2 or 3), which only IDA's Newton "
-      "convergence test weighs (default: atol)",
+      "convergence test weighs (default: at index 2 weights that scale with the step, at "
+      "index 3 atol)",
       [](double v) { return v >= 0; }, ">= 0");
-  params.omit_default_from_canonical("multiplier_atol");
-  return std::make_unique<Ida>(settings, max_order, index == "ode" ? 0 : std::stoi(index),
-                               static_cast<int>(max_nonlin_iters), nonlin_conv_coef,
-                               multiplier_atol);
+  // Given, it stays in the canonical spec even at the value of atol: at index 2 it then differs
+  // from the default.
+  if (!multiplier_atol_given) params.omit_default_from_canonical("multiplier_atol");
+  return std::make_unique<Ida>(
+      settings, max_order, index == "ode" ? 0 : std::stoi(index),
+      static_cast<int>(max_nonlin_iters), nonlin_conv_coef,
+      multiplier_atol_given ? std::optional<double>(multiplier_atol) : std::nullopt);
 }
 
 std::unique_ptr<Integrator> make_arkode_erk(Params& params) {
