@@ -590,13 +590,13 @@ class Ida final : public SundialsIntegrator {
   // other than 1, on the rigid bodies, or car_axis at rtol 1e-10. So each multiplier's weight is
   // the fixed one, capped at kRoundoffMargin⁻¹ × the weight under which its round-off noise would
   // count 1: the multipliers' effect over the step in the differential variables' weights,
-  // h ‖G_i ∘ w(p)‖₂ for λ_i and h ‖G_i M⁻¹ ∘ w(q)‖₂ for μ_i (the h-scaling of index-2 variables in
-  // RADAU5, Hairer & Wanner II §VII.8), over the round-off of p resp. q in those weights,
-  // ε max_j |p_j| w(p)_j resp. ε max_j |q_j| w(q)_j. At ordinary steps the cap is far above the
-  // fixed weight, which then holds (the h-scaled weights alone let λ settle only to tol/h and cost
-  // accuracy and steps: 6059 steps and error 8.9e-9 against 2707 and 6.9e-10 on
-  // cartesian_pendulum:theta0=1.2 to t = 20 at rtol 1e-10). IDA calls this at every step start,
-  // with h the step about to be tried; before the first step h is the first step set by
+  // h ‖G_i ∘ w(p)‖₂ for λ_i and h ‖G_i M⁻¹ ∘ w(q)‖₂ for μ_i (the h-scaling of index-2 variables,
+  // as RADAU5's NIND2 scaling of Hairer & Wanner), over the round-off of p resp. q in those
+  // weights, ε max_j |p_j| w(p)_j resp. ε max_j |q_j| w(q)_j. At ordinary steps and tolerances the
+  // cap is above the fixed weight, which then holds: the h-scaled weights alone (commit e35f6b9)
+  // let λ settle only to tol/h and cost accuracy, error 8.9e-9 against 3.6e-9 capped on
+  // IdaDae.Index2AndIndex3SolveTheCartesianPendulum (rtol 1e-10). IDA calls this at every step
+  // start, with h the step about to be tried; before the first step h is the first step set by
   // initial_step().
   static constexpr double kRoundoffMargin = 100;
   int evaluate_step_scaled_weights(N_Vector y_vector, N_Vector weights_vector) noexcept {
@@ -765,8 +765,8 @@ class Ida final : public SundialsIntegrator {
   int index_;  // 0: the ODE residual; 2 or 3: the constrained DAE of that index
   int max_nonlin_iters_;
   double nonlin_conv_coef_;
-  // Absolute tolerance of λ (and μ) in the Newton convergence test when given; otherwise index 2
-  // weighs them by the step (evaluate_step_scaled_weights), index 3 by atol.
+  // Absolute tolerance of λ (and μ) in the Newton convergence test when given; otherwise atol,
+  // at index 2 with the cap of evaluate_step_scaled_weights.
   std::optional<double> multiplier_atol_;
   double first_step_ = 0;  // index 2 with step-scaled weights: the step IDA starts with
   int constraint_count_ = 0;
@@ -1005,8 +1005,8 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
   const double multiplier_atol = params.real(
       "multiplier_atol", settings.atol,
       "absolute tolerance of the multipliers (index 2 or 3), which only IDA's Newton "
-      "convergence test weighs (default: at index 2 weights that scale with the step, at "
-      "index 3 atol)",
+      "convergence test weighs (default: atol, at index 2 capped where the multipliers' "
+      "round-off, amplified by 1/h, would fail that test)",
       [](double v) { return v >= 0; }, ">= 0");
   // Given, it stays in the canonical spec even at the value of atol: at index 2 it then differs
   // from the default.
