@@ -13,9 +13,12 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -451,7 +454,7 @@ class Cvode final : public SundialsIntegrator {
 class Ida final : public SundialsIntegrator {
  public:
   Ida(const AdaptiveSettings& settings, int max_order, int index, int max_nonlin_iters,
-      double nonlin_conv_coef, double multiplier_atol)
+      double nonlin_conv_coef, std::optional<double> multiplier_atol)
       : SundialsIntegrator(settings, "ida"),
         max_order_(max_order),
         index_(index),
@@ -509,7 +512,12 @@ class Ida final : public SundialsIntegrator {
       return;
     }
     if (index_ != 0 && !exclude_from_error_test(ida)) return;
-    if (index_ != 0 && multiplier_atol_ != settings_.atol && !loosen_multipliers(ida)) return;
+    if (index_ != 0 && multiplier_atol_ && !loosen_multipliers(ida)) return;
+    if (index_ == 2 && !multiplier_atol_ &&
+        !check_setup(IDAWFtolerances(ida, &step_scaled_weights), "IDAWFtolerances")) {
+      return;
+    }
+    first_step_ = 0;
     matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
     if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
     if (!matrix_ || !linear_solver_) {
@@ -535,6 +543,10 @@ class Ida final : public SundialsIntegrator {
     if (!status.ok) return status;
     void* ida = memory_.get();
     int flag = IDASetStopTime(ida, t_stop);
+    if (flag >= 0 && index_ == 2 && !multiplier_atol_ && first_step_ == 0) {
+      first_step_ = initial_step(t_stop);
+      flag = IDASetInitStep(ida, first_step_);
+    }
     double t_returned = t_;
     if (flag >= 0) flag = IDASolve(ida, t_stop, &t_returned, y_.get(), yp_.get(), IDA_ONE_STEP);
     update_counters();
@@ -565,8 +577,91 @@ class Ida final : public SundialsIntegrator {
     if (!tolerances) return setup_failed(-1, "N_VNew_Serial failed");
     auto atol = view_mutable(tolerances.get());
     atol.setConstant(settings_.atol);
-    atol.tail(n_ - 2 * dof_).setConstant(multiplier_atol_);
+    atol.tail(n_ - 2 * dof_).setConstant(*multiplier_atol_);
     return check_setup(IDASVtolerances(ida, settings_.rtol, tolerances.get()), "IDASVtolerances");
+  }
+
+  // Index 2: the error weights of λ and μ, which only IDA's Newton convergence test uses (they
+  // are outside the error test). Their Newton increments carry the round-off of the constraint
+  // rows amplified by c_j = α/h: δμ ≈ c_j (G M⁻¹Gᵀ)⁻¹ r_g with r_g ≈ ε|q| from g(q), likewise δλ
+  // from the ε|p| of G M⁻¹p. With the fixed weights 1/(rtol|λ| + atol) that noise fails the test
+  // at the tiny first steps (from p(0) = 0 and a tight atol) as soon as g(q) rounds to a nonzero
+  // value, whatever the step: IDA_CONV_FAIL at t ≈ 0 on rod_chain with a mass ratio or length
+  // other than 1, on the rigid bodies, or car_axis at rtol 1e-10. So each multiplier's weight is
+  // the fixed one, capped at kRoundoffMargin⁻¹ × the weight under which its round-off noise would
+  // count 1: the multipliers' effect over the step in the differential variables' weights,
+  // h ‖G_i ∘ w(p)‖₂ for λ_i and h ‖G_i M⁻¹ ∘ w(q)‖₂ for μ_i (the h-scaling of index-2 variables,
+  // as RADAU5's NIND2 scaling of Hairer & Wanner), over the round-off of p resp. q in those
+  // weights, ε max_j |p_j| w(p)_j resp. ε max_j |q_j| w(q)_j. At ordinary steps and tolerances the
+  // cap is above the fixed weight, which then holds: the h-scaled weights alone (commit e35f6b9)
+  // let λ settle only to tol/h and cost accuracy, error 8.9e-9 against 3.6e-9 capped on
+  // IdaDae.Index2AndIndex3SolveTheCartesianPendulum (rtol 1e-10). IDA calls this at every step
+  // start, with h the step about to be tried; before the first step h is the first step set by
+  // initial_step().
+  static constexpr double kRoundoffMargin = 100;
+  int evaluate_step_scaled_weights(N_Vector y_vector, N_Vector weights_vector) noexcept {
+    try {
+      const auto y = view(y_vector);
+      auto w = view_mutable(weights_vector);
+      const int n = dof_, m = constraint_count_;
+      // What IDASStolerances would set, for every component.
+      w = (settings_.rtol * y.array().abs() + settings_.atol).inverse().matrix();
+      long steps = 0;
+      double h = first_step_, t = t_;
+      IDAGetNumSteps(memory_.get(), &steps);
+      if (steps > 0) {
+        IDAGetCurrentStep(memory_.get(), &h);
+        IDAGetCurrentTime(memory_.get(), &t);
+      }
+      h = std::abs(h);
+      q_ = y.head(n);
+      problem_->constraint_jacobian_at(t, q_, G_);
+      const Vec& inverse_mass = problem_->inverse_mass();
+      Vec on_p = Vec::Zero(m), on_q = Vec::Zero(m);
+      for (int col = 0; col < G_.outerSize(); ++col) {
+        for (SparseMatrix::InnerIterator it(G_, col); it; ++it) {
+          on_p[it.row()] += std::pow(it.value() * w[n + col], 2);
+          on_q[it.row()] += std::pow(it.value() * inverse_mass[col] * w[col], 2);
+        }
+      }
+      const double unit_roundoff = std::numeric_limits<double>::epsilon();
+      const double p_noise = kRoundoffMargin * unit_roundoff *
+                             y.segment(n, n).cwiseAbs().cwiseProduct(w.segment(n, n)).maxCoeff();
+      const double q_noise =
+          kRoundoffMargin * unit_roundoff * y.head(n).cwiseAbs().cwiseProduct(w.head(n)).maxCoeff();
+      for (int i = 0; i < m; ++i) {
+        // p = 0 (a start at rest) or q = 0 carries no round-off to amplify: the fixed weight.
+        if (p_noise > 0) w[2 * n + i] = std::min(w[2 * n + i], h * std::sqrt(on_p[i]) / p_noise);
+        if (q_noise > 0) {
+          w[2 * n + m + i] = std::min(w[2 * n + m + i], h * std::sqrt(on_q[i]) / q_noise);
+        }
+      }
+      // A zero weight (a constraint row without entries, h = 0) would make IDA's difference
+      // quotient increment 1/w infinite.
+      return w.allFinite() && w.minCoeff() > 0 ? 0 : -1;
+    } catch (const std::exception& error) {
+      callback_error_ = error.what();
+      return -1;
+    }
+  }
+  static int step_scaled_weights(N_Vector y, N_Vector weights, void* self) {
+    return static_cast<Ida*>(self)->evaluate_step_scaled_weights(y, weights);
+  }
+
+  // IDA's own first step (IDA user guide v6.4.1 §2.1, IDASolve): 0.001 |t_stop − t0|, cut to
+  // 0.5 / ‖y'(t0)‖ (weighted RMS over the differential components), here because the step-scaled
+  // weights need it before IDA computes it.
+  double initial_step(double t_stop) const {
+    const auto y = view(y_.get());
+    const auto yp = view(yp_.get());
+    const int differential = 2 * dof_;
+    const Vec weights =
+        (settings_.rtol * y.head(differential).array().abs() + settings_.atol).inverse().matrix();
+    const double yp_norm =
+        std::sqrt(yp.head(differential).cwiseProduct(weights).squaredNorm() / n_);
+    double h = 0.001 * std::abs(t_stop - t_);
+    if (yp_norm * h > 0.5) h = 0.5 / yp_norm;
+    return h;
   }
 
   // id = 1 for the components in the error test, 0 for the rest (suppressed).
@@ -670,7 +765,10 @@ class Ida final : public SundialsIntegrator {
   int index_;  // 0: the ODE residual; 2 or 3: the constrained DAE of that index
   int max_nonlin_iters_;
   double nonlin_conv_coef_;
-  double multiplier_atol_;  // absolute tolerance of λ (and μ) in the Newton convergence test
+  // Absolute tolerance of λ (and μ) in the Newton convergence test when given; otherwise atol,
+  // at index 2 with the cap of evaluate_step_scaled_weights.
+  std::optional<double> multiplier_atol_;
+  double first_step_ = 0;  // index 2 with step-scaled weights: the step IDA starts with
   int constraint_count_ = 0;
   bool analytic_jacobian_ = false;
   Vec q_, p_, force_, applied_, rate_, g_, g_time_, a_time_;
@@ -903,15 +1001,20 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
       "Newton convergence test coefficient relative to the local error test (IDA default 0.33)",
       [](double v) { return v > 0 && v <= 1; }, "in (0, 1]");
   params.omit_default_from_canonical("nonlin_conv_coef");
+  const bool multiplier_atol_given = params.given("multiplier_atol");
   const double multiplier_atol = params.real(
       "multiplier_atol", settings.atol,
       "absolute tolerance of the multipliers (index 2 or 3), which only IDA's Newton "
-      "convergence test weighs (default: atol)",
+      "convergence test weighs (default: atol, at index 2 capped where the multipliers' "
+      "round-off, amplified by 1/h, would fail that test)",
       [](double v) { return v >= 0; }, ">= 0");
-  params.omit_default_from_canonical("multiplier_atol");
-  return std::make_unique<Ida>(settings, max_order, index == "ode" ? 0 : std::stoi(index),
-                               static_cast<int>(max_nonlin_iters), nonlin_conv_coef,
-                               multiplier_atol);
+  // Given, it stays in the canonical spec even at the value of atol: at index 2 it then differs
+  // from the default.
+  if (!multiplier_atol_given) params.omit_default_from_canonical("multiplier_atol");
+  return std::make_unique<Ida>(
+      settings, max_order, index == "ode" ? 0 : std::stoi(index),
+      static_cast<int>(max_nonlin_iters), nonlin_conv_coef,
+      multiplier_atol_given ? std::optional<double>(multiplier_atol) : std::nullopt);
 }
 
 std::unique_ptr<Integrator> make_arkode_erk(Params& params) {

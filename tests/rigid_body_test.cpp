@@ -217,19 +217,23 @@ TEST(HeavyTopRuns, SymmetricTopKeepsTheSpinAboutItsAxis) {
             1e-2);
 }
 
-// IDA's Newton convergence test weighs the multipliers λ, μ by their absolute tolerance although
-// they are outside the error test: at the default atol = 1e-10 the corrector fails at t = 0 on
-// the 9-coordinate body (results/rigid_body/README.md, "IDA on the attitude problems"), with
-// multiplier_atol = 1e-3 the index-2 form runs (measured over T = 2: energy 9.6e-8, QᵀQ − I
-// 1.6e-8, g 6.0e-9). A multiplier tolerance that does not reach IDA fails the second half.
-TEST(RigidBodyRuns, IdaRunsWithALooserMultiplierTolerance) {
-  const RunResult strict = run(kBody, "ida:index=2", 0.01, 2);
-  EXPECT_FALSE(strict.ok);
-  EXPECT_EQ(strict.record.status, "ida_flag_-4");
-  const RunResult loose = run(kBody, "ida:index=2,multiplier_atol=1e-3", 0.01, 2);
-  ASSERT_TRUE(loose.ok) << loose.record.message.value_or("");
-  EXPECT_LT(loose.record.metrics.at("energy_err_max"), 1e-5);
-  EXPECT_LT(loose.record.metrics.at("orthogonality_err_max"), 1e-7);
+// IDA's Newton convergence test weighs the multipliers λ, μ although they are outside the error
+// test. With fixed weights 1/(rtol|λ| + atol) at atol = 1e-10 (`multiplier_atol=1e-10`, the
+// default until integrators/sundials.cpp capped them where their round-off, amplified by 1/h,
+// fails the test) the corrector fails at t = 0 on the 9-coordinate body
+// (results/rigid_body/README.md, "IDA on the attitude problems"); the default (capped weights) and
+// multiplier_atol = 1e-3 run.
+TEST(RigidBodyRuns, IdaIndex2RunsWithStepScaledMultiplierWeights) {
+  const RunResult fixed = run(kBody, "ida:index=2,multiplier_atol=1e-10", 0.01, 2);
+  EXPECT_FALSE(fixed.ok);
+  EXPECT_EQ(fixed.record.status, "ida_flag_-4");
+  for (const char* spec : {"ida:index=2", "ida:index=2,multiplier_atol=1e-3"}) {
+    SCOPED_TRACE(spec);
+    const RunResult result = run(kBody, spec, 0.01, 2);
+    ASSERT_TRUE(result.ok) << result.record.message.value_or("");
+    EXPECT_LT(result.record.metrics.at("energy_err_max"), 1e-5);
+    EXPECT_LT(result.record.metrics.at("orthogonality_err_max"), 1e-7);
+  }
 }
 
 }  // namespace
