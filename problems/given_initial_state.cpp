@@ -55,7 +55,9 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
   const HolonomicConstraints* as_constrained() const override {
     return base_constraints_ != nullptr ? this : nullptr;
   }
-  int constraint_count() const override { return base_constraints_->constraint_count(); }
+  int constraint_count() const override {
+    return base_constraints_ != nullptr ? base_constraints_->constraint_count() : 0;
+  }
   void constraint(const Vec& q, Vec& g) const override { base_constraints_->constraint(q, g); }
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
     base_constraints_->constraint_jacobian(q, G);
