@@ -146,11 +146,12 @@ namespace {
 
 // G(q) at time t, dense (m × n); the time-free call on time-free problems.
 Eigen::MatrixXd dense_constraint_jacobian(const Problem& problem, double t, const Vec& q) {
+  const HolonomicConstraints& constraints = constraints_of(problem);
   SparseMatrix G;
-  if (problem.has(kTimeDependentConstraints)) {
-    problem.constraint_jacobian_at(t, q, G);
+  if (constraints.time_dependent()) {
+    constraints.constraint_jacobian_at(t, q, G);
   } else {
-    problem.constraint_jacobian(q, G);
+    constraints.constraint_jacobian(q, G);
   }
   return Eigen::MatrixXd(G);
 }
@@ -163,15 +164,16 @@ Eigen::MatrixXd dense_constraint_jacobian(const Problem& problem, double t, cons
 // the Newton iteration does not reach round-off.
 bool project_onto_manifold(const Problem& problem, State& state) {
   const Vec& inverse_mass = problem.inverse_mass();
+  const HolonomicConstraints& constraints = constraints_of(problem);
   const Eigen::MatrixXd direction =
       inverse_mass.asDiagonal() * dense_constraint_jacobian(problem, state.t, state.q).transpose();
   Vec residual;
   int polish = 0;
   for (int iteration = 0; iteration < 30 && polish < 3; ++iteration) {
-    if (problem.has(kTimeDependentConstraints)) {
-      problem.constraint_at(state.t, state.q, residual);
+    if (constraints.time_dependent()) {
+      constraints.constraint_at(state.t, state.q, residual);
     } else {
-      problem.constraint(state.q, residual);
+      constraints.constraint(state.q, residual);
     }
     const Eigen::MatrixXd G = dense_constraint_jacobian(problem, state.t, state.q);
     if (!residual.allFinite() || !G.allFinite()) return false;

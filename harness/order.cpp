@@ -31,13 +31,14 @@ double median(std::vector<double> values) {
 // the state's multiplier λ(q_N, p_N) against λ(t_N).
 double multiplier_error(const Problem& problem, const RunResult& run, OrderStudy& study) {
   const State& end = run.final_state;
+  const HolonomicConstraints& constraints = constraints_of(problem);
   if (run.final_impulses) {
     const ConstraintImpulses& impulses = *run.final_impulses;
-    const Vec exact = *problem.exact_multipliers(end.t - impulses.h / 2);
+    const Vec exact = *constraints.exact_multipliers(end.t - impulses.h / 2);
     return (impulses.mean_multiplier() - exact).lpNorm<Eigen::Infinity>();
   }
   study.multiplier_from_state = true;
-  const Vec exact = *problem.exact_multipliers(end.t);
+  const Vec exact = *constraints.exact_multipliers(end.t);
   return (problem.multipliers(end.t, end.q, end.p) - exact).lpNorm<Eigen::Infinity>();
 }
 
@@ -170,8 +171,9 @@ OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const Meth
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> errors_q, errors_p, errors_multiplier;
-  study.multiplier_applies = problem->has(kConstraints) &&
-                             problem->exact_multipliers(problem->initial_state().t).has_value();
+  const HolonomicConstraints* constraints = problem->as_constrained();
+  study.multiplier_applies = constraints != nullptr &&
+                             constraints->exact_multipliers(problem->initial_state().t).has_value();
   // What error_final was measured against: the exact solution, or the reference file the run
   // found (car_axis: the Test Set's values); without either, the finest level
   // (Richardson-style self-convergence).
@@ -203,7 +205,7 @@ OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const Meth
       if (study.multiplier_applies) {
         multiplier_scale =
             std::max(multiplier_scale,
-                     problem->exact_multipliers(run.final_state.t)->lpNorm<Eigen::Infinity>());
+                     constraints->exact_multipliers(run.final_state.t)->lpNorm<Eigen::Infinity>());
       }
       const double q_squared = (run.final_state.q - reference.q).squaredNorm();
       const double p_squared = (run.final_state.p - reference.p).squaredNorm();

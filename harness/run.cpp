@@ -51,10 +51,10 @@ class SeriesWriter {
     }
     for (const auto& name : problem.series_names()) columns.push_back(name);
     // Constrained problems: the residuals and the exact motion's multipliers through the state.
-    if (problem.has(kConstraints)) {
+    if (const HolonomicConstraints* constraints = problem.as_constrained()) {
       columns.push_back("constraint_err");
       columns.push_back("constraint_vel_err");
-      for (const auto& name : problem.multiplier_names()) columns.push_back(name);
+      for (const auto& name : constraints->multiplier_names()) columns.push_back(name);
     }
     if (with_state_) {
       // A first-order-only problem's state is y alone (State::q).

@@ -29,15 +29,15 @@ struct KktPoint {
 // g and G at one time: g(q, t) and G(q, t) for rheonomic constraints, the time-free calls
 // otherwise (so that time-free results stay bit-identical).
 struct ConstraintsAt {
-  ConstraintsAt(const Problem& problem_in, double t_in)
-      : problem(problem_in), t(t_in), rheonomic(problem_in.has(kTimeDependentConstraints)) {}
+  ConstraintsAt(const Problem& problem, double t_in)
+      : constraints(constraints_of(problem)), t(t_in), rheonomic(constraints.time_dependent()) {}
   void value(const Vec& q, Vec& g) const {
-    rheonomic ? problem.constraint_at(t, q, g) : problem.constraint(q, g);
+    rheonomic ? constraints.constraint_at(t, q, g) : constraints.constraint(q, g);
   }
   void jacobian(const Vec& q, SparseMatrix& G) const {
-    rheonomic ? problem.constraint_jacobian_at(t, q, G) : problem.constraint_jacobian(q, G);
+    rheonomic ? constraints.constraint_jacobian_at(t, q, G) : constraints.constraint_jacobian(q, G);
   }
-  const Problem& problem;
+  const HolonomicConstraints& constraints;
   double t;
   bool rheonomic;
 };
@@ -283,7 +283,7 @@ Vec project_momentum_to_tangent_space(const Problem& problem, double t, const Ve
   Vec rate = G_Minv * p;
   if (at.rheonomic) {
     Vec g_t, a_t;
-    problem.constraint_time_terms(t, q, problem.inverse_mass().cwiseProduct(p), g_t, a_t);
+    at.constraints.constraint_time_terms(t, q, problem.inverse_mass().cwiseProduct(p), g_t, a_t);
     rate += g_t;  // G M⁻¹p + ∂g/∂t = 0 at t
   }
   const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);

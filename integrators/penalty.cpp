@@ -18,7 +18,8 @@ namespace {
 // not the constrained one (the harness measures against the real problem anyway).
 class PenalisedProblem final : public Problem {
  public:
-  PenalisedProblem(const Problem& base, double stiffness) : base_(base), stiffness_(stiffness) {
+  PenalisedProblem(const Problem& base, double stiffness)
+      : base_(base), constraints_(constraints_of(base)), stiffness_(stiffness) {
     set_mass(base.mass());
     set_capabilities(base.capabilities() &
                      (kHessian | kForce | kForceJacobian | kLinearMomentum | kAngularMomentum));
@@ -28,23 +29,23 @@ class PenalisedProblem final : public Problem {
   State initial_state() const override { return base_.initial_state(); }
 
   double potential(const Vec& q) const override {
-    base_.constraint(q, g_);
+    constraints_.constraint(q, g_);
     return base_.potential(q) + 0.5 * stiffness_ * g_.squaredNorm();
   }
   // ∇V + k Gᵀg.
   void gradient(const Vec& q, Vec& gradient) const override {
     base_.gradient(q, gradient);
-    base_.constraint(q, g_);
-    base_.constraint_jacobian(q, G_);
+    constraints_.constraint(q, g_);
+    constraints_.constraint_jacobian(q, G_);
     gradient += stiffness_ * (G_.transpose() * g_);
   }
   // ∇²V + k(GᵀG + Σ gᵢ∇²gᵢ); the last sum is the constraint Hessian at λ = k g.
   void hessian(const Vec& q, SparseMatrix& H) const override {
     base_.hessian(q, H);
-    base_.constraint(q, g_);
-    base_.constraint_jacobian(q, G_);
+    constraints_.constraint(q, g_);
+    constraints_.constraint_jacobian(q, G_);
     SparseMatrix curvature;
-    base_.constraint_hessian(q, stiffness_ * g_, curvature);
+    constraints_.constraint_hessian(q, stiffness_ * g_, curvature);
     const SparseMatrix gauss_newton = SparseMatrix(G_.transpose() * G_);
     H = H + stiffness_ * gauss_newton + curvature;
     H.makeCompressed();
@@ -64,6 +65,7 @@ class PenalisedProblem final : public Problem {
 
  private:
   const Problem& base_;
+  const HolonomicConstraints& constraints_;  // the base problem's, left out of this one
   double stiffness_;
   // Scratch (the Problem interface is const).
   mutable Vec g_;

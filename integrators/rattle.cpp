@@ -66,12 +66,13 @@ class Rattle final : public Integrator {
     eval_total_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
     Vec p_half = state.p + (h / 2) * force_;
     const Vec q_start = state.q;
-    const bool rheonomic = problem.has(kTimeDependentConstraints);
+    const HolonomicConstraints& constraints = constraints_of(problem);
+    const bool rheonomic = constraints.time_dependent();
     const double t_next = state.t + h;
     if (rheonomic) {
-      problem.constraint_jacobian_at(state.t, q_start, G_start_);
+      constraints.constraint_jacobian_at(state.t, q_start, G_start_);
     } else {
-      problem.constraint_jacobian(q_start, G_start_);
+      constraints.constraint_jacobian(q_start, G_start_);
     }
     // M⁻¹G(q)ᵀ: the direction in which each position multiplier moves q⁺.
     const Eigen::MatrixXd direction =
@@ -81,11 +82,11 @@ class Rattle final : public Integrator {
     Vec residual;
     for (long iteration = 0;; ++iteration) {
       if (rheonomic) {
-        problem.constraint_at(t_next, q_next, residual);
-        problem.constraint_jacobian_at(t_next, q_next, G_next_);
+        constraints.constraint_at(t_next, q_next, residual);
+        constraints.constraint_jacobian_at(t_next, q_next, G_next_);
       } else {
-        problem.constraint(q_next, residual);
-        problem.constraint_jacobian(q_next, G_next_);
+        constraints.constraint(q_next, residual);
+        constraints.constraint_jacobian(q_next, G_next_);
       }
       if (!residual.allFinite() || !q_next.allFinite()) {
         return StepStatus::failure(
@@ -125,8 +126,8 @@ class Rattle final : public Integrator {
       Vec rate = G_Minv * state.p;
       if (rheonomic) {
         Vec g_t, a_t;
-        problem.constraint_time_terms(state.t, state.q, inverse_mass.cwiseProduct(state.p), g_t,
-                                      a_t);
+        constraints.constraint_time_terms(state.t, state.q, inverse_mass.cwiseProduct(state.p), g_t,
+                                          a_t);
         rate += g_t;  // G M⁻¹p⁺ + ∂g/∂t = 0 at t + h
       }
       const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);

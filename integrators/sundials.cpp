@@ -482,7 +482,8 @@ class Ida final : public SundialsIntegrator {
     matrix_.reset();
     yp_.reset();
     id_.reset();
-    constraint_count_ = index_ == 0 ? 0 : problem.constraint_count();
+    constraints_ = index_ == 0 ? nullptr : &constraints_of(problem);
+    constraint_count_ = index_ == 0 ? 0 : constraints_->constraint_count();
     const int multipliers = index_ == 3 ? constraint_count_ : 2 * constraint_count_;
     if (!begin_reset(problem, state, multipliers)) return;
     yp_.reset(N_VNew_Serial(n_, context_.get()));
@@ -697,7 +698,7 @@ class Ida final : public SundialsIntegrator {
         problem.force(q_, v, t, applied_);
         force_ += applied_;
       }
-      problem.constraint_jacobian_at(t, q_, G_);
+      constraints_->constraint_jacobian_at(t, q_, G_);
       force_ -= G_.transpose() * y.segment(2 * n, m);
       rate_.resize(2 * n);
       rate_.head(n) = v;
@@ -713,12 +714,12 @@ class Ida final : public SundialsIntegrator {
         return 0;
       }
       r.head(2 * n) = view(yp_vector).head(2 * n) - rate_;
-      problem.constraint_at(t, q_, g_);
+      constraints_->constraint_at(t, q_, g_);
       if (index_ == 3) {
         r.tail(m) = g_;
       } else {
         // dg/dt = G v + ∂g/∂t (rheonomic constraints; zero otherwise).
-        problem.constraint_time_terms(t, q_, v, g_time_, a_time_);
+        constraints_->constraint_time_terms(t, q_, v, g_time_, a_time_);
         r.segment(2 * n, m) = G_ * v + g_time_;
         r.tail(m) = g_;
       }
@@ -770,6 +771,7 @@ class Ida final : public SundialsIntegrator {
   std::optional<double> multiplier_atol_;
   double first_step_ = 0;  // index 2 with step-scaled weights: the step IDA starts with
   int constraint_count_ = 0;
+  const HolonomicConstraints* constraints_ = nullptr;  // the problem's, set by reset (index 2, 3)
   bool analytic_jacobian_ = false;
   Vec q_, p_, force_, applied_, rate_, g_, g_time_, a_time_;
   SparseMatrix G_;

@@ -9,7 +9,7 @@
 namespace geomint {
 namespace {
 
-class CartesianPendulum final : public Problem {
+class CartesianPendulum final : public Problem, public HolonomicConstraints {
  public:
   CartesianPendulum(double theta0, double v0, double length, double mass, double gravity)
       : theta0_(theta0),
@@ -19,7 +19,7 @@ class CartesianPendulum final : public Problem {
         gravity_(gravity),
         omega0_(std::sqrt(gravity / length)),
         motion_(theta0, omega0_, v0) {
-    unsigned capabilities = kHessian | kOmegaMax | kConstraints;
+    unsigned capabilities = kHessian | kOmegaMax;
     if (motion_.has_exact()) capabilities |= kExact | kPeriod;
     set_mass(Vec::Constant(2, mass));
     set_capabilities(capabilities);
@@ -42,6 +42,7 @@ class CartesianPendulum final : public Problem {
 
   // Scaled by 1/L so that G = qᵀ/L is the unit rod direction on the manifold and the multiplier
   // λ in M q̈ = −∇V − Gᵀλ is the rod tension itself (force units), not tension/L.
+  const HolonomicConstraints* as_constrained() const override { return this; }
   int constraint_count() const override { return 1; }
   void constraint(const Vec& q, Vec& g) const override {
     // (|q| − L)(|q| + L) instead of |q|² − L² keeps relative accuracy on the manifold.

@@ -46,14 +46,14 @@ TEST(ConstrainedProblems, TimeTermsMatchFiniteDifferences) {
       const Vec v = test::random_vector(n, ++seed);
       const auto g_at = [&](double s) {
         Vec g;
-        problem->constraint_at(t + s, q + s * v, g);
+        constraints_of(*problem).constraint_at(t + s, q + s * v, g);
         return g;
       };
       SparseMatrix G;
-      problem->constraint_jacobian_at(t, q, G);
+      constraints_of(*problem).constraint_jacobian_at(t, q, G);
       Vec c, g_t, a_t;
-      problem->constraint_curvature(q, v, c);
-      problem->constraint_time_terms(t, q, v, g_t, a_t);
+      constraints_of(*problem).constraint_curvature(q, v, c);
+      constraints_of(*problem).constraint_time_terms(t, q, v, g_t, a_t);
       const double h = 1e-4;
       const Vec rate = G * v + g_t;
       const Vec rate_fd = (g_at(h) - g_at(-h)) / (2 * h);
@@ -65,7 +65,7 @@ TEST(ConstrainedProblems, TimeTermsMatchFiniteDifferences) {
       const Vec w = test::random_vector(n, ++seed);
       const auto g_q = [&](const Vec& x) {
         Vec g;
-        problem->constraint_at(t, x, g);
+        constraints_of(*problem).constraint_at(t, x, g);
         return g;
       };
       EXPECT_LE(inf_norm(G * w - directional_difference(g_q, q, w, 1e-5)), 1e-7) << "t = " << t;
@@ -101,7 +101,7 @@ TEST(CartesianPendulum, MultiplierIsRodTension) {
     EXPECT_NEAR(problem->multipliers(t, at.q, at.p)[0], tension, 1e-12 * mass * gravity)
         << "t = " << t;
   }
-  EXPECT_EQ(problem->multiplier_names(), std::vector<std::string>{"tension"});
+  EXPECT_EQ(constraints_of(*problem).multiplier_names(), std::vector<std::string>{"tension"});
 }
 
 // The Cartesian motion is the angle pendulum's: x = L sin θ(t) with θ from `pendulum`.

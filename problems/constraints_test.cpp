@@ -24,13 +24,13 @@ Vec inf_norms_of_rows(const Eigen::MatrixXd& matrix) { return matrix.cwiseAbs().
 
 Eigen::MatrixXd jacobian_at(const Problem& problem, const Vec& q) {
   SparseMatrix G;
-  problem.constraint_jacobian(q, G);
+  constraints_of(problem).constraint_jacobian(q, G);
   return Eigen::MatrixXd(G);
 }
 
 Vec residual_at(const Problem& problem, const Vec& q) {
   Vec g;
-  problem.constraint(q, g);
+  constraints_of(problem).constraint(q, g);
   return g;
 }
 
@@ -60,14 +60,14 @@ class ConstrainedProblem : public testing::TestWithParam<std::string> {
 // rounding ~ε|g|/δ are both ~1e-10 relative, well inside the 1e-7 allowed.
 TEST_P(ConstrainedProblem, JacobianMatchesFiniteDifferences) {
   const Problem& problem = *problem_;
-  const int m = problem.constraint_count();
+  const int m = constraints_of(problem).constraint_count();
   const double delta = 1e-6 * length_scale_;
   for (const auto& [q, v] : points_) {
     const Eigen::MatrixXd G = jacobian_at(problem, q);
     ASSERT_EQ(G.rows(), m);
     ASSERT_EQ(G.cols(), problem.dof());
     ASSERT_EQ(residual_at(problem, q).size(), m);
-    ASSERT_EQ(static_cast<int>(problem.multiplier_names().size()), m);
+    ASSERT_EQ(static_cast<int>(constraints_of(problem).multiplier_names().size()), m);
     const double scale = inf_norms_of_rows(G).maxCoeff();
     for (int j = 0; j < problem.dof(); ++j) {
       Vec plus = q, minus = q;
@@ -87,8 +87,8 @@ TEST_P(ConstrainedProblem, CurvatureMatchesTheDerivativeOfGv) {
   const double delta = 1e-6 * length_scale_;
   for (const auto& [q, v] : points_) {
     Vec c;
-    problem.constraint_curvature(q, v, c);
-    ASSERT_EQ(c.size(), problem.constraint_count());
+    constraints_of(problem).constraint_curvature(q, v, c);
+    ASSERT_EQ(c.size(), constraints_of(problem).constraint_count());
     if (v.isZero(0)) {  // a chain released from rest: c is quadratic in v
       EXPECT_TRUE(c.isZero(0)) << c.transpose();
       continue;
@@ -107,12 +107,12 @@ TEST_P(ConstrainedProblem, CurvatureMatchesTheDerivativeOfGv) {
 // K(q, λ) = ∂(G(q)ᵀλ)/∂q, column by column, and symmetric.
 TEST_P(ConstrainedProblem, HessianMatchesTheDerivativeOfGTransposeLambda) {
   const Problem& problem = *problem_;
-  const int m = problem.constraint_count();
+  const int m = constraints_of(problem).constraint_count();
   const double delta = 1e-6 * length_scale_;
   const Vec lambda = test::random_vector(m, 7) * 2.5;
   for (const auto& [q, v] : points_) {
     SparseMatrix K_sparse;
-    problem.constraint_hessian(q, lambda, K_sparse);
+    constraints_of(problem).constraint_hessian(q, lambda, K_sparse);
     const Eigen::MatrixXd K(K_sparse);
     ASSERT_EQ(K.rows(), problem.dof());
     ASSERT_EQ(K.cols(), problem.dof());
@@ -134,8 +134,10 @@ TEST_P(ConstrainedProblem, InitialStateIsConsistentToRoundOff) {
   const Problem& problem = *problem_;
   const State start = problem.initial_state();
   EXPECT_NO_THROW(problem.check_consistent(start, "initial state", 1e-14));
-  EXPECT_EQ(problem.multiplier_names().size(), static_cast<size_t>(problem.constraint_count()));
-  EXPECT_EQ(problem.multipliers(start.t, start.q, start.p).size(), problem.constraint_count());
+  EXPECT_EQ(constraints_of(problem).multiplier_names().size(),
+            static_cast<size_t>(constraints_of(problem).constraint_count()));
+  EXPECT_EQ(problem.multipliers(start.t, start.q, start.p).size(),
+            constraints_of(problem).constraint_count());
 }
 
 // An inconsistent state (the path a user-given Cartesian state would take) is bad input whose
@@ -170,6 +172,60 @@ TEST(ConstrainedProblems, TheCatalogueHasConstrainedProblems) {
   EXPECT_GE(constrained_specs().size(), 4u);
 }
 
+// A bead on a circle of radius 3.5 with mass 0.25 (non-unit scales), built without the registry:
+// its constraints come from the interface alone. `claim` is passed to set_capabilities (a
+// problem that tries to declare the bits itself), `time_dependent` to the interface.
+class Bead final : public Problem, public HolonomicConstraints {
+ public:
+  Bead(bool constrained, unsigned claim, bool time_dependent)
+      : constrained_(constrained), time_dependent_(time_dependent) {
+    set_mass(Vec::Constant(2, 0.25));
+    set_capabilities(kHessian | claim);
+  }
+  State initial_state() const override { return {0.0, Vec::Unit(2, 0) * 3.5, Vec::Zero(2)}; }
+  double potential(const Vec&) const override { return 0.0; }
+  void gradient(const Vec& q, Vec& g) const override { g = Vec::Zero(q.size()); }
+  const HolonomicConstraints* as_constrained() const override {
+    return constrained_ ? this : nullptr;
+  }
+  bool time_dependent() const override { return time_dependent_; }
+  int constraint_count() const override { return 1; }
+  void constraint(const Vec& q, Vec& g) const override { g = Vec::Constant(1, q.norm() - 3.5); }
+  void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
+    G.resize(1, 2);
+    G.insert(0, 0) = q[0] / q.norm();
+    G.insert(0, 1) = q[1] / q.norm();
+    G.makeCompressed();
+  }
+  void constraint_curvature(const Vec&, const Vec&, Vec& c) const override { c = Vec::Zero(1); }
+  void constraint_hessian(const Vec& q, const Vec&, SparseMatrix& K) const override {
+    K.resize(q.size(), q.size());
+  }
+
+ private:
+  bool constrained_, time_dependent_;
+};
+
+// One source of truth for kConstraints and kTimeDependentConstraints: as_constrained() and
+// time_dependent() set them, and a problem that declares them itself is refused at construction.
+TEST(ConstrainedProblems, CapabilitiesFollowTheQueryAndCannotBeClaimed) {
+  EXPECT_TRUE(Bead(true, 0, false).has(kConstraints));
+  EXPECT_FALSE(Bead(true, 0, false).has(kTimeDependentConstraints));
+  EXPECT_TRUE(Bead(true, 0, true).has(kTimeDependentConstraints));
+  EXPECT_EQ(capability_names(Bead(true, 0, true).capabilities()),
+            (std::vector<std::string>{"hessian", "constraints", "time_dependent_constraints"}));
+  EXPECT_FALSE(Bead(false, 0, true).has(kConstraints));
+  EXPECT_FALSE(Bead(false, 0, true).has(kTimeDependentConstraints));
+  EXPECT_THROW(Bead(false, kConstraints, false), std::logic_error);
+  EXPECT_THROW(Bead(true, kTimeDependentConstraints, true), std::logic_error);
+  // The helpers go through the query: on a problem without constraints they refuse by name.
+  const Bead free_bead(false, 0, false);
+  EXPECT_THROW(free_bead.constraint_residual(free_bead.initial_state().q), std::logic_error);
+  const Bead bead(true, 0, false);
+  EXPECT_EQ(bead.constraint_residual(bead.initial_state().q), 0.0);
+  EXPECT_EQ(&constraints_of(bead), static_cast<const HolonomicConstraints*>(&bead));
+}
+
 // The multipliers are the rods' tensions, in force units, with the sign of a pulling rod: on the
 // conical spherical pendulum T = m g / cos θ (vertical balance), on a hanging chain at rest the
 // tension of rod i carries the weight of the nodes below it.
@@ -187,7 +243,7 @@ TEST(ConstrainedProblems, MultipliersAreTheRodTensions) {
   EXPECT_NEAR(tension[0], (2 + 1 + 0.5) * 2.5, 1e-12);
   EXPECT_NEAR(tension[1], (1 + 0.5) * 2.5, 1e-12);
   EXPECT_NEAR(tension[2], 0.5 * 2.5, 1e-12);
-  EXPECT_EQ(chain->multiplier_names(),
+  EXPECT_EQ(constraints_of(*chain).multiplier_names(),
             (std::vector<std::string>{"tension1", "tension2", "tension3"}));
 }
 

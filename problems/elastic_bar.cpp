@@ -198,7 +198,7 @@ void element_matrix(const Mat9& A, const Mat43& G, double volume, Mat12& K) {
   K = 0.5 * sum;
 }
 
-class ElasticBar final : public Problem {
+class ElasticBar final : public Problem, public HolonomicConstraints {
  public:
   explicit ElasticBar(const BarConfig& config)
       : config_(config),
@@ -214,7 +214,6 @@ class ElasticBar final : public Problem {
     if (config_.clamp == Clamp::kPinConstraint && config_.gravity == 0) {
       capabilities |= kAngularMomentum;
     }
-    if (config_.pinned_by_constraint()) capabilities |= kConstraints;
     set_capabilities(capabilities);
     set_defaults(1e-3, 1.0);
     build_initial_state();
@@ -335,7 +334,10 @@ class ElasticBar final : public Problem {
 
   // Pins q_i − X_i = 0, three rows per pinned node: G is a selection matrix, so the curvature
   // and the constraint Hessian vanish; the multipliers are the reaction forces on the pinned
-  // nodes (with a minus sign: M q̈ = −∇V − Gᵀλ).
+  // nodes (with a minus sign: M q̈ = −∇V − Gᵀλ). Only clamp=constraint|pin has them.
+  const HolonomicConstraints* as_constrained() const override {
+    return config_.pinned_by_constraint() ? this : nullptr;
+  }
   int constraint_count() const override { return 3 * static_cast<int>(pinned_dofs_.size()); }
   void constraint(const Vec& q, Vec& g) const override {
     g.resize(constraint_count());

@@ -15,13 +15,17 @@
 namespace geomint {
 namespace {
 
-class GivenInitialState : public Problem {
+class GivenInitialState : public Problem, public HolonomicConstraints {
  public:
   GivenInitialState(std::unique_ptr<Problem> base, State initial)
-      : base_(std::move(base)), initial_(std::move(initial)) {
+      : base_(std::move(base)),
+        base_constraints_(base_->as_constrained()),
+        initial_(std::move(initial)) {
     set_mass(base_->mass());
-    // The exact solution, period and tabulated end state belong to the problem's own start.
-    set_capabilities(base_->capabilities() & ~(kExact | kPeriod | kEndReference));
+    // The exact solution, period and tabulated end state belong to the problem's own start;
+    // the constraint capabilities follow from as_constrained() below.
+    set_capabilities(base_->capabilities() &
+                     ~(kExact | kPeriod | kEndReference | kDerivedCapabilities));
     set_defaults(base_->default_dt(), base_->default_t_end());
   }
 
@@ -46,27 +50,37 @@ class GivenInitialState : public Problem {
   double period_observable(const Vec& q, const Vec& p) const override {
     return base_->period_observable(q, p);
   }
-  int constraint_count() const override { return base_->constraint_count(); }
-  void constraint(const Vec& q, Vec& g) const override { base_->constraint(q, g); }
+  // The base's constraints, except its exact multipliers (they belong to its own start, like
+  // exact(): the default nullopt), so the wrapper is its own HolonomicConstraints.
+  const HolonomicConstraints* as_constrained() const override {
+    return base_constraints_ != nullptr ? this : nullptr;
+  }
+  int constraint_count() const override {
+    return base_constraints_ != nullptr ? base_constraints_->constraint_count() : 0;
+  }
+  void constraint(const Vec& q, Vec& g) const override { base_constraints_->constraint(q, g); }
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
-    base_->constraint_jacobian(q, G);
+    base_constraints_->constraint_jacobian(q, G);
   }
   void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override {
-    base_->constraint_curvature(q, v, c);
+    base_constraints_->constraint_curvature(q, v, c);
   }
   void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
-    base_->constraint_hessian(q, lambda, K);
+    base_constraints_->constraint_hessian(q, lambda, K);
   }
-  std::vector<std::string> multiplier_names() const override { return base_->multiplier_names(); }
+  std::vector<std::string> multiplier_names() const override {
+    return base_constraints_->multiplier_names();
+  }
+  bool time_dependent() const override { return base_constraints_->time_dependent(); }
   void constraint_at(double t, const Vec& q, Vec& g) const override {
-    base_->constraint_at(t, q, g);
+    base_constraints_->constraint_at(t, q, g);
   }
   void constraint_jacobian_at(double t, const Vec& q, SparseMatrix& G) const override {
-    base_->constraint_jacobian_at(t, q, G);
+    base_constraints_->constraint_jacobian_at(t, q, G);
   }
   void constraint_time_terms(double t, const Vec& q, const Vec& v, Vec& g_t,
                              Vec& a_t) const override {
-    base_->constraint_time_terms(t, q, v, g_t, a_t);
+    base_constraints_->constraint_time_terms(t, q, v, g_t, a_t);
   }
   // A charged particle's mass, charge, fields and vector potential do not depend on its start:
   // the Boris pusher and the magnetic-moment metric keep them.
@@ -83,6 +97,7 @@ class GivenInitialState : public Problem {
 
  private:
   std::unique_ptr<Problem> base_;
+  const HolonomicConstraints* base_constraints_;  // base_->as_constrained(), or nullptr
   State initial_;
 };
 

@@ -14,7 +14,7 @@ class HeavyTop final : public AttitudeProblem {
  public:
   HeavyTop(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude, double weight,
            const Eigen::Vector3d& centre)
-      : AttitudeProblem(parameters, attitude, kHessian | kAngularMomentum | kConstraints),
+      : AttitudeProblem(parameters, attitude, kHessian | kAngularMomentum),
         weight_(weight),
         centre_(centre) {
     // The step also resolves the pendulum frequency √(m g |χ| / I_min) of the swing.

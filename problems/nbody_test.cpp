@@ -128,11 +128,34 @@ TEST(InitialStateFile, WrongLengthNamesTheDofAndConstraintsAreChecked) {
   EXPECT_TRUE(test::input_error_names(
       make_problem, "cartesian_pendulum:length=2.5,initial=" + off_rod, "initial state"));
   const std::string on_rod = write_temp("geomint_initial_on_rod.csv", "0,1\n-2.5,0\n");
-  EXPECT_EQ(make_problem("cartesian_pendulum:length=2.5,initial=" + on_rod)->initial_state().q[1],
-            -2.5);
+  const auto wrapped = make_problem("cartesian_pendulum:length=2.5,initial=" + on_rod);
+  EXPECT_EQ(wrapped->initial_state().q[1], -2.5);
+  // The wrapper passes the constraints through (as_constrained(), hence kConstraints) but not
+  // the exact multipliers, which belong to the problem's own start like exact().
+  ASSERT_NE(wrapped->as_constrained(), nullptr);
+  EXPECT_TRUE(wrapped->has(kConstraints));
+  EXPECT_FALSE(wrapped->has(kTimeDependentConstraints));
+  EXPECT_EQ(wrapped->as_constrained()->multiplier_names(), std::vector<std::string>{"tension"});
+  EXPECT_TRUE(
+      make_problem("cartesian_pendulum:length=2.5")->as_constrained()->exact_multipliers(0.3));
+  EXPECT_FALSE(wrapped->as_constrained()->exact_multipliers(0.3));
+  // A rheonomic problem stays rheonomic: car_axis from its own start, written out in full.
+  const State car_state = make_problem("car_axis")->initial_state();
+  std::string car_rows;
+  for (int i = 0; i < car_state.q.size(); ++i) {
+    char row[64];
+    std::snprintf(row, sizeof row, "%.17g,%.17g\n", car_state.q[i], car_state.p[i]);
+    car_rows += row;
+  }
+  const std::string car_start = write_temp("geomint_initial_car.csv", car_rows);
+  const auto car = make_problem("car_axis:initial=" + car_start);
+  EXPECT_TRUE(car->has(kConstraints));
+  EXPECT_TRUE(car->has(kTimeDependentConstraints));
   const std::string garbage = write_temp("geomint_initial_garbage.csv", "q,p\n1,x\n");
   EXPECT_TRUE(test::input_error_names(make_problem, "harmonic:initial=" + garbage, ":2:"));
-  for (const auto& path : {three, off_rod, on_rod, garbage}) std::filesystem::remove(path);
+  for (const auto& path : {three, off_rod, on_rod, garbage, car_start}) {
+    std::filesystem::remove(path);
+  }
 }
 
 TEST(SpringChainNodeInit, DisplacesOneNodeAndKeepsTheExactSolution) {

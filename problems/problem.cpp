@@ -159,33 +159,28 @@ Vec Problem::angular_momentum(const Vec&, const Vec&) const { missing(*this, "an
 double Problem::period() const { missing(*this, "period"); }
 double Problem::period_observable(const Vec& q, const Vec&) const { return q[0]; }
 double Problem::omega_max(const Vec&) const { missing(*this, "omega_max"); }
-int Problem::constraint_count() const { missing(*this, "constraints"); }
-void Problem::constraint(const Vec&, Vec&) const { missing(*this, "constraints"); }
-void Problem::constraint_jacobian(const Vec&, SparseMatrix&) const {
-  missing(*this, "constraint Jacobian");
-}
-void Problem::constraint_curvature(const Vec&, const Vec&, Vec&) const {
-  missing(*this, "constraint curvature");
-}
-void Problem::constraint_hessian(const Vec&, const Vec&, SparseMatrix&) const {
-  missing(*this, "constraint Hessian");
+unsigned Problem::capabilities() const {
+  unsigned derived = 0;
+  if (const HolonomicConstraints* constraints = as_constrained()) {
+    derived |= kConstraints;
+    if (constraints->time_dependent()) derived |= kTimeDependentConstraints;
+  }
+  return capabilities_ | derived;
 }
 
-std::optional<Vec> Problem::exact_multipliers(double) const { return std::nullopt; }
-
-void Problem::constraint_at(double, const Vec& q, Vec& g) const { constraint(q, g); }
-void Problem::constraint_jacobian_at(double, const Vec& q, SparseMatrix& G) const {
-  constraint_jacobian(q, G);
-}
-void Problem::constraint_time_terms(double, const Vec&, const Vec&, Vec& g_t, Vec& a_t) const {
-  g_t = Vec::Zero(constraint_count());
-  a_t = Vec::Zero(constraint_count());
+void Problem::set_capabilities(unsigned capabilities) {
+  if ((capabilities & kDerivedCapabilities) != 0) {
+    throw std::logic_error(
+        "Problem::set_capabilities: kConstraints and kTimeDependentConstraints are derived from "
+        "as_constrained() (problems/constraints.hpp), not declared");
+  }
+  capabilities_ = capabilities;
 }
 
-std::vector<std::string> Problem::multiplier_names() const {
-  std::vector<std::string> names;
-  for (int i = 1; i <= constraint_count(); ++i) names.push_back(fmt::format("lambda{}", i));
-  return names;
+const HolonomicConstraints& constraints_of(const Problem& problem) {
+  const HolonomicConstraints* constraints = problem.as_constrained();
+  if (constraints == nullptr) missing(problem, "constraints");
+  return *constraints;
 }
 
 Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
@@ -198,11 +193,12 @@ Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
     force(q, v, t, f);
     force_total += f;
   }
+  const HolonomicConstraints& constraints = constraints_of(*this);
   SparseMatrix G;
-  constraint_jacobian_at(t, q, G);
+  constraints.constraint_jacobian_at(t, q, G);
   Vec c, g_t, a_t;
-  constraint_curvature(q, v, c);
-  constraint_time_terms(t, q, v, g_t, a_t);
+  constraints.constraint_curvature(q, v, c);
+  constraints.constraint_time_terms(t, q, v, g_t, a_t);
   c += a_t;
   // m is small for every catalogue problem (rods, pins), so a dense solve of G M⁻¹ Gᵀ is the
   // simplest correct choice; LDLT copes with the semidefinite case of redundant constraints.
@@ -233,23 +229,24 @@ double Problem::constraint_velocity_residual(const Vec& q, const Vec& p) const {
 
 double Problem::constraint_residual(double t, const Vec& q) const {
   Vec g;
-  constraint_at(t, q, g);
+  constraints_of(*this).constraint_at(t, q, g);
   return g.size() > 0 ? g.cwiseAbs().maxCoeff() : 0.0;
 }
 
 double Problem::constraint_velocity_residual(double t, const Vec& q, const Vec& p) const {
+  const HolonomicConstraints& constraints = constraints_of(*this);
   SparseMatrix G;
-  constraint_jacobian_at(t, q, G);
+  constraints.constraint_jacobian_at(t, q, G);
   const Vec v = inverse_mass_.cwiseProduct(p);
   Vec g_t, a_t;
-  constraint_time_terms(t, q, v, g_t, a_t);
+  constraints.constraint_time_terms(t, q, v, g_t, a_t);
   const Vec rate = G * v + g_t;
   return rate.size() > 0 ? rate.cwiseAbs().maxCoeff() : 0.0;
 }
 
 void Problem::check_consistent(const State& state, const std::string& what, double tol) const {
   SparseMatrix G;
-  constraint_jacobian_at(state.t, state.q, G);
+  constraints_of(*this).constraint_jacobian_at(state.t, state.q, G);
   // ‖G‖∞: the largest absolute row sum, the scale that turns a position error into g.
   Vec row_sums = Vec::Zero(G.rows());
   for (int k = 0; k < G.outerSize(); ++k) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/constraints.hpp"
 #include "problems/fixed_gradient.hpp"
 #include "problems/spec.hpp"
 
@@ -36,8 +37,11 @@ enum Capability : unsigned {
   kPeriod = 1u << 5,           // period()
   kOmegaMax = 1u << 6,         // omega_max(q)
   kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
-  kConstraints = 1u << 8,      // holonomic constraints g(q) = 0: constraint_* (PAPER.md §3)
-  kTimeDependentConstraints = 1u << 9,  // rheonomic g(q, t) = 0: constraint_*_at (car_axis)
+  // Holonomic constraints g(q) = 0 (PAPER.md §3) and rheonomic g(q, t) = 0 (car_axis): derived
+  // from Problem::as_constrained() and HolonomicConstraints::time_dependent(), never declared
+  // (set_capabilities refuses them), so a problem cannot claim one without the other.
+  kConstraints = 1u << 8,
+  kTimeDependentConstraints = 1u << 9,
   // A first-order ODE y' = f(t, y) that is no Lagrangian system (van der Pol, Robertson): y is
   // State::q, State::p is empty, rhs()/rhs_jacobian() define it; V, ∇V, M and H mean nothing
   // (energy() is NaN). Only methods with the flag kFirstOrderCapable run it (applicable()).
@@ -81,8 +85,13 @@ class Problem {
   const std::string& spec() const { return spec_; }
   // Registry name ("pendulum").
   const std::string& name() const { return name_; }
-  unsigned capabilities() const { return capabilities_; }
-  bool has(Capability c) const { return (capabilities_ & c) != 0; }
+  // The declared capabilities plus the ones derived from the structure queries (kConstraints,
+  // kTimeDependentConstraints from as_constrained()). has() asks the query only for those bits.
+  unsigned capabilities() const;
+  bool has(Capability c) const {
+    return ((c & kDerivedCapabilities) != 0 ? capabilities() & c : capabilities_ & c) != 0;
+  }
+  static constexpr unsigned kDerivedCapabilities = kConstraints | kTimeDependentConstraints;
 
   // ---- The kind and the structures the problem offers, each by one query (nullptr: absent) ----
   // A class that offers one derives from its interface as well and returns `this`; the queries
@@ -99,6 +108,9 @@ class Problem {
   virtual const AttitudeProblem* as_attitude() const { return nullptr; }
   // A charged particle's mass, charge, fields and vector potential (charged_particle).
   virtual const ChargedParticleStructure* as_charged_particle() const { return nullptr; }
+  // Holonomic constraints g(q) = 0 or g(q, t) = 0 (problems/constraints.hpp: what a constrained
+  // problem implements). Callers take the pointer once per run or step, not per element.
+  virtual const HolonomicConstraints* as_constrained() const { return nullptr; }
 
   int dof() const { return static_cast<int>(mass_.size()); }
   virtual State initial_state() const = 0;
@@ -122,10 +134,6 @@ class Problem {
   virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
   // Exact solution. Only when has(kExact).
   virtual State exact(double t) const;
-  // The exact motion's multipliers λ(t) (same sign and units as multipliers()), from the problem's
-  // own closed form; nullopt when it has none (the default). The order study fits the methods'
-  // discrete multipliers against it (harness/order.cpp, docs/METHOD.md §3).
-  virtual std::optional<Vec> exact_multipliers(double t) const;
   // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
   virtual Vec linear_momentum(const Vec& q, const Vec& p) const;
   // Total angular momentum Σ q_i × p_i (1 component in 2D, 3 in 3D). Only when
@@ -147,36 +155,11 @@ class Problem {
   // itself (the normal-mode metrics, harness/structure_metrics.hpp).
   virtual bool is_linear() const { return false; }
 
-  // Holonomic constraints g(q) = 0 (PAPER.md §3, docs/METHOD.md §3). Only when
-  // has(kConstraints). The motion is M q̈ = −∇V(q) + F − G(q)ᵀλ, G = ∂g/∂q, with m =
-  // constraint_count() multipliers λ. Problems whose initial state comes from user parameters
-  // get it checked by make_problem (an inconsistent state is an InputError naming the residual).
-  virtual int constraint_count() const;
-  // g = g(q) ∈ Rᵐ; g is resized by the callee.
-  virtual void constraint(const Vec& q, Vec& g) const;
-  // G = ∂g/∂q, m × n, compressed.
-  virtual void constraint_jacobian(const Vec& q, SparseMatrix& G) const;
-  // c = (∂G/∂q · v) v ∈ Rᵐ, so that d²g/dt² = G(q) q̈ + c(q, v): the term index reduction needs.
-  virtual void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const;
-  // K = Σᵢ λᵢ ∇²gᵢ(q), n × n, symmetric, compressed: the constraint part of the Hessian of the
-  // Lagrangian V + λᵀg that Newton/KKT solves of constrained steps need.
-  virtual void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const;
-  // Names of the multipliers for series columns ("tension"); default lambda1 … lambdam.
-  virtual std::vector<std::string> multiplier_names() const;
-
-  // Rheonomic constraints g(q, t) = 0 (has(kTimeDependentConstraints), e.g. a driven joint): g
-  // and G at time t, and the explicit time terms g_t = ∂g/∂t and a_t = 2(∂G/∂t)v + ∂²g/∂t², so
-  // that dg/dt = G v + g_t and d²g/dt² = G q̈ + c(q, v) + a_t (c and K above carry no explicit t).
-  // Defaults: the time-free functions and zero terms. Only methods that declare
-  // kTimeDependentConstraints see such problems (applicable()); the time-free functions of a
-  // rheonomic problem give g and G at t = 0.
-  virtual void constraint_at(double t, const Vec& q, Vec& g) const;
-  virtual void constraint_jacobian_at(double t, const Vec& q, SparseMatrix& G) const;
-  virtual void constraint_time_terms(double t, const Vec& q, const Vec& v, Vec& g_t,
-                                     Vec& a_t) const;
-
+  // ---- Helpers of a constrained problem (has(kConstraints); they throw std::logic_error on one
+  // without). Members of Problem rather than of HolonomicConstraints because each combines the
+  // constraints with the problem's mass, ∇V and force. ----
   // The exact motion's multipliers through (q, p) at time t: the λ that keeps d²g/dt² = 0,
-  // (G M⁻¹ Gᵀ) λ = G M⁻¹ (−∇V + F) + c(q, v) + a_t. Only when has(kConstraints).
+  // (G M⁻¹ Gᵀ) λ = G M⁻¹ (−∇V + F) + c(q, v) + a_t.
   Vec multipliers(double t, const Vec& q, const Vec& p) const;
   // ‖g(q)‖∞ and ‖G(q) M⁻¹p‖∞ (position- and velocity-level constraint residuals); the versions
   // with t evaluate g(q, t) and G(q, t)v + g_t, and are the ones that hold for rheonomic
@@ -229,7 +212,9 @@ class Problem {
  protected:
   // Called once by the factory after construction.
   void set_mass(const Vec& mass);
-  void set_capabilities(unsigned capabilities) { capabilities_ = capabilities; }
+  // Throws std::logic_error for kDerivedCapabilities: a problem declares constraints by
+  // as_constrained(), not by a bit.
+  void set_capabilities(unsigned capabilities);
   void set_defaults(double dt, double t_end) {
     default_dt_ = dt;
     default_t_end_ = t_end;
@@ -245,6 +230,10 @@ class Problem {
   double default_dt_ = 0.01;
   double default_t_end_ = 10.0;
 };
+
+// *problem.as_constrained(), for code that runs only on constrained problems (applicable() checked
+// kConstraints); throws std::logic_error naming the problem when it has none.
+const HolonomicConstraints& constraints_of(const Problem& problem);
 
 // Spec key every problem accepts: `initial=FILE.csv` starts the problem from the state in the
 // file (rows q,p or, under a header "q,v", q,v; one per dof) instead of its own, and drops its

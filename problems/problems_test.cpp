@@ -129,7 +129,7 @@ Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
   }
   if (problem.has(kConstraints)) {
     SparseMatrix G;
-    problem.constraint_jacobian(q, G);
+    constraints_of(problem).constraint_jacobian(q, G);
     rhs.tail(n) -= G.transpose() * problem.multipliers(t, q, p);
   }
   return rhs;
@@ -487,6 +487,19 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   EXPECT_EQ(problem.as_free_rigid_body(), dynamic_cast<const FreeRigidBodyStructure*>(&problem));
   EXPECT_EQ(problem.as_attitude(), dynamic_cast<const AttitudeProblem*>(&problem));
   EXPECT_EQ(problem.as_charged_particle(), dynamic_cast<const ChargedParticleStructure*>(&problem));
+  // Constraints are instance-level (elastic_bar has them only with clamp=constraint|pin): when
+  // present they are the class's own interface; a class that derives from it and declines it has
+  // none (m = 0), so one that forgets to return `this` fails here; the query alone sets the bits.
+  const HolonomicConstraints* constraints = problem.as_constrained();
+  const auto* derived = dynamic_cast<const HolonomicConstraints*>(&problem);
+  if (constraints != nullptr) {
+    EXPECT_EQ(constraints, derived);
+  } else if (derived != nullptr) {
+    EXPECT_EQ(derived->constraint_count(), 0) << "derives from HolonomicConstraints, returns none";
+  }
+  EXPECT_EQ(problem.has(kConstraints), constraints != nullptr);
+  EXPECT_EQ(problem.has(kTimeDependentConstraints),
+            constraints != nullptr && constraints->time_dependent());
   const ProblemKind expected = problem.has(kFirstOrderOnly) ? ProblemKind::kFirstOrder
                                : problem.as_lagrangian()    ? ProblemKind::kLagrangian
                                                             : ProblemKind::kSeparable;

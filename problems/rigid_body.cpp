@@ -38,8 +38,7 @@ class RigidBody final : public AttitudeProblem, public FreeRigidBodyStructure {
  public:
   const FreeRigidBodyStructure* as_free_rigid_body() const override { return this; }
   RigidBody(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude)
-      : AttitudeProblem(parameters, attitude,
-                        kHessian | kAngularMomentum | kConstraints | kCasimir),
+      : AttitudeProblem(parameters, attitude, kHessian | kAngularMomentum | kCasimir),
         flip_axis_(
             FreeBodyMotion(parameters.moments, parameters.moments.cwiseProduct(parameters.omega))
                 .sign_changing_axis()) {}

@@ -52,7 +52,7 @@ class FreeBodyMotion {
 // column) under the 6 constraints QᵀQ = I, masses d_k = ½(I1 + I2 + I3) − I_k (MECHANICS.md §6):
 // the constraints, the initial state Q̇ = QΩ̂ and the spatial angular momentum Σ_k c_k × p_k shared
 // by rigid_body (V = 0) and heavy_top (gravity); each adds its potential and invariants.
-class AttitudeProblem : public Problem {
+class AttitudeProblem : public Problem, public HolonomicConstraints {
  public:
   AttitudeProblem(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude,
                   unsigned capabilities);
@@ -62,6 +62,7 @@ class AttitudeProblem : public Problem {
   Eigen::Matrix3d attitude(const Vec& q) const;
   // Σ_k c_k × p_k = Q J Ω, the spatial angular momentum.
   Vec angular_momentum(const Vec& q, const Vec& p) const override;
+  const HolonomicConstraints* as_constrained() const override { return this; }
   int constraint_count() const override { return 6; }
   void constraint(const Vec& q, Vec& g) const override;
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override;

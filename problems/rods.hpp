@@ -97,9 +97,10 @@ inline void hessian(const std::vector<Rod>& rods, int dim, const Vec& q, const V
 }
 
 // A problem whose constraints are rods between its nodes (dim coordinates each): the constraint
-// capability from the functions above, once for every rod problem.
-class RodProblem : public Problem {
+// interface from the functions above, once for every rod problem.
+class RodProblem : public Problem, public HolonomicConstraints {
  public:
+  const HolonomicConstraints* as_constrained() const override { return this; }
   int constraint_count() const override { return static_cast<int>(rods_.size()); }
   void constraint(const Vec& q, Vec& g) const override { rods::residuals(rods_, dim_, q, g); }
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {

@@ -29,7 +29,7 @@ class SphericalPendulum final : public rods::RodProblem {
   explicit SphericalPendulum(const SphericalParameters& parameters)
       : RodProblem({{rods::kPivot, 0, parameters.length}}, 3), parameters_(parameters) {
     set_mass(Vec::Constant(3, parameters.mass));
-    unsigned capabilities = kHessian | kAngularMomentum | kConstraints;
+    unsigned capabilities = kHessian | kAngularMomentum;
     if (parameters.conical) capabilities |= kExact | kPeriod;
     set_capabilities(capabilities);
     // About 600 steps per small-oscillation period 2π√(L/g), a hundred periods.

@@ -19,12 +19,12 @@ namespace {
 // wells at the diagonals on the circle): ∇²V = −3c·diag(x², y²) makes the step's Hessian
 // M + ¼h²∇²V indefinite at large h, the regime where the minimiser's safeguard and line search
 // act — the catalogue's constrained problems all have linear potentials. A test fixture only.
-class BeadInConcaveWells final : public Problem {
+class BeadInConcaveWells final : public Problem, public HolonomicConstraints {
  public:
   BeadInConcaveWells(double c, double theta0, double speed)
       : c_(c), theta0_(theta0), speed_(speed) {
     set_mass(Vec::Ones(2));
-    set_capabilities(kHessian | kConstraints);
+    set_capabilities(kHessian);
     set_defaults(0.01, 10.0);
   }
   State initial_state() const override {
@@ -45,6 +45,7 @@ class BeadInConcaveWells final : public Problem {
   void hessian(const Vec& q, SparseMatrix& H) const override {
     diagonal(-3 * c_ * q.cwiseAbs2(), H);
   }
+  const HolonomicConstraints* as_constrained() const override { return this; }
   int constraint_count() const override { return 1; }
   void constraint(const Vec& q, Vec& g) const override {
     g = Vec::Constant(1, 0.5 * (q.squaredNorm() - 1));
@@ -106,7 +107,7 @@ TEST(ConstrainedKkt, MidpointStepIsRattleOnALinearPotential) {
     const auto problem = make_problem(problem_spec);
     const double h = problem->default_dt() * 5;
     // The chain is chaotic: round-off differences grow, so it is compared over fewer steps.
-    const long steps = problem->constraint_count() > 1 ? 100 : 2000;
+    const long steps = problem->as_constrained()->constraint_count() > 1 ? 100 : 2000;
     const State reference = integrate("rattle", *problem, h, steps);
     const double size =
         reference.q.lpNorm<Eigen::Infinity>() + reference.p.lpNorm<Eigen::Infinity>();

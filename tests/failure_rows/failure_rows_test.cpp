@@ -27,13 +27,15 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 // (kind=force, the harmonic oscillator with a force that is zero until then) or gradient under
 // holonomic constraints (kind=constrained, the Cartesian pendulum) turns NaN once q[0] falls
 // below half its initial value: after about ten steps of 0.1 from q[0] > 0 towards q[0] < 0.
-class TurnsNan final : public Problem {
+class TurnsNan final : public Problem, public HolonomicConstraints {
  public:
   TurnsNan(std::unique_ptr<Problem> base, bool poison_force)
-      : base_(std::move(base)), poison_force_(poison_force) {
+      : base_(std::move(base)),
+        base_constraints_(base_->as_constrained()),
+        poison_force_(poison_force) {
     threshold_ = 0.5 * base_->initial_state().q[0];
     set_mass(base_->mass());
-    unsigned capabilities = base_->capabilities() & (kHessian | kConstraints);
+    unsigned capabilities = base_->capabilities() & kHessian;
     if (poison_force_) capabilities |= kForce | kForceJacobian;
     set_capabilities(capabilities);
     set_defaults(0.1, 3.0);
@@ -61,18 +63,26 @@ class TurnsNan final : public Problem {
     C.makeCompressed();
   }
 
-  int constraint_count() const override { return base_->constraint_count(); }
-  void constraint(const Vec& q, Vec& g) const override { base_->constraint(q, g); }
+  // The base's time-free constraints (cartesian_pendulum for kind=constrained).
+  const HolonomicConstraints* as_constrained() const override {
+    return base_constraints_ != nullptr ? this : nullptr;
+  }
+  int constraint_count() const override {
+    return base_constraints_ != nullptr ? base_constraints_->constraint_count() : 0;
+  }
+  void constraint(const Vec& q, Vec& g) const override { base_constraints_->constraint(q, g); }
   void constraint_jacobian(const Vec& q, SparseMatrix& G) const override {
-    base_->constraint_jacobian(q, G);
+    base_constraints_->constraint_jacobian(q, G);
   }
   void constraint_curvature(const Vec& q, const Vec& v, Vec& c) const override {
-    base_->constraint_curvature(q, v, c);
+    base_constraints_->constraint_curvature(q, v, c);
   }
   void constraint_hessian(const Vec& q, const Vec& lambda, SparseMatrix& K) const override {
-    base_->constraint_hessian(q, lambda, K);
+    base_constraints_->constraint_hessian(q, lambda, K);
   }
-  std::vector<std::string> multiplier_names() const override { return base_->multiplier_names(); }
+  std::vector<std::string> multiplier_names() const override {
+    return base_constraints_->multiplier_names();
+  }
 
  private:
   // NaN below the threshold, and NaN in, NaN out.
@@ -80,6 +90,7 @@ class TurnsNan final : public Problem {
   bool poisoned_gradient(const Vec& q) const { return !poison_force_ && poisoned(q); }
 
   std::unique_ptr<Problem> base_;
+  const HolonomicConstraints* base_constraints_;  // base_->as_constrained(), or nullptr
   bool poison_force_;
   double threshold_ = 0;
 };
