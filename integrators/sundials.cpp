@@ -616,7 +616,7 @@ class Ida final : public SundialsIntegrator {
       }
       h = std::abs(h);
       q_ = y.head(n);
-      problem_->constraint_jacobian_at(t, q_, G_);
+      constraints_->constraint_jacobian_at(t, q_, G_);
       const Vec& inverse_mass = problem_->inverse_mass();
       Vec on_p = Vec::Zero(m), on_q = Vec::Zero(m);
       for (int col = 0; col < G_.outerSize(); ++col) {
