@@ -80,12 +80,22 @@ fuzz-build: deps
 # that take seconds to minutes each under the sanitizers and run no code that other tests of the
 # same method, problem or scene do not run under them, committed rows that clang's round-off
 # moves, and the Python/browser checks. tests/slow_tests.cmake lists them with the reason for each
-# (`ctest -N -L nosan` in a build prints them). SAN_EXCLUDE is an extra ctest -E regex for a local
-# run (empty by default).
+# (`ctest -N -L nosan` in a build prints them). The GoogleTest tests run in shards of each executable
+# (scripts/test-sanitize.py: a process per test costs a third of the time under the sanitizers),
+# the few others through ctest; SAN_PER_TEST=1 runs every test in a process of its own as ctest does.
+# SAN_EXCLUDE is an extra regex on ctest test names to leave out for a local run (empty by default).
 SAN_EXCLUDE ?=
+SAN_PER_TEST ?= 0
 test-sanitize: sanitize-build
+ifeq ($(SAN_PER_TEST),1)
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan' \
 	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
+else
+	@cd $(SAN_DIR) && $(SAN_ENV) /usr/bin/python3 $(CURDIR)/scripts/test-sanitize.py . $(JOBS) \
+	  $(if $(SAN_EXCLUDE),--exclude '$(SAN_EXCLUDE)')
+	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan|fast' \
+	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
+endif
 
 # Each fuzzer for FUZZ_SECONDS on its committed corpus (fuzz/corpus/<target>/); fails on a finding.
 FUZZ_SECONDS ?= 60

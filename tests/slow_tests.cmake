@@ -116,8 +116,15 @@ set(GEOMINT_NOSAN_TESTS
 # `nosan`, the others with `fast`. Takes gtest_discover_tests' DISCOVERY_TIMEOUT and PROPERTIES.
 # Tests write scratch files under std::filesystem::temp_directory_path(); TMPDIR points it into
 # this build tree so that two builds testing at the same time (clones, CI and a developer) never
-# share /tmp/geomint_* folders.
+# share /tmp/geomint_* folders, and each test process makes its own folder in there
+# (tests/test_main.cpp), so tests that ctest runs at the same time never share one either.
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/test-tmp)
+
+# The filter of the `fast` tests, for scripts/test-sanitize.py, which runs them a shard of an
+# executable at a time instead of a process per test.
+list(JOIN GEOMINT_SLOW_TESTS ":" geomint_slow_filter)
+list(JOIN GEOMINT_NOSAN_TESTS ":" geomint_nosan_filter)
+file(WRITE ${CMAKE_BINARY_DIR}/gtest-fast-filter.txt "-${geomint_slow_filter}:${geomint_nosan_filter}\n")
 
 function(geomint_discover_tests target)
   cmake_parse_arguments(PARSE_ARGV 1 ARG "" "DISCOVERY_TIMEOUT" "PROPERTIES")
