@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
+#include "harness/shard.hpp"
 #include "harness/table.hpp"
 
 namespace geomint {
@@ -110,6 +111,28 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
 
 // Named by scene (Results/CommittedScene.CheapRowsReproduce/fig1_pendulum), so a filter can pick
 // one scene and a failure says which.
+// The committed tables are of the scene file beside them: table.md's "How to cite" block records
+// the scene hash (scene_content_hash of scene.toml, comments included, as `geomint merge` checks
+// shards), so a scene edited without regenerating its tables fails here instead of being cited
+// with a hash no scene file has.
+TEST_P(CommittedScene, TablesAreOfTheSceneFileBesideThem) {
+  const fs::path folder = fs::path(GEOMINT_SOURCE_DIR) / "results" / GetParam();
+  std::ifstream in(folder / "table.md");
+  ASSERT_TRUE(in) << folder / "table.md" << " is missing";
+  const std::string marker = "| scene hash | ";
+  std::string line, recorded;
+  while (std::getline(in, line)) {
+    if (line.rfind(marker, 0) == 0 && line.size() > marker.size() + 2) {
+      recorded = line.substr(marker.size(), line.size() - marker.size() - 2);
+    }
+  }
+  ASSERT_FALSE(recorded.empty()) << folder / "table.md" << " records no scene hash";
+  const std::string current = scene_content_hash((folder / "scene.toml").string(), false);
+  EXPECT_EQ(recorded, current)
+      << "results/" << GetParam() << "/scene.toml changed after its tables were written; "
+      << "regenerate them: bash scripts/reproduce.sh build/geomint " << GetParam();
+}
+
 INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_with_summary()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            std::string name;
