@@ -9,11 +9,11 @@ set grid lw 0.5 lc rgb "#dddddd"
 # One colour, marker and dash per method in every figure of every scene. A method is found by
 # the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
 # ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not
-# be prefixes of one another. Line style i is the i-th key; 30 is any method not listed.
-method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake"
-method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection)"
+# be prefixes of one another. Line style i is the i-th key; 99 is any method not listed.
+method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake rkn_nystrom4 rkn_dprkn6 rkn_dprkn8 rkn_adaptive_dprkn6 rkn_adaptive_dprkn8"
+method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection) rkn:table=nystrom4 rkn:table=dprkn6 rkn:table=dprkn8 rkn_adaptive:pair=dprkn6 rkn_adaptive:pair=dprkn8"
 method_index(name) = sum [i=1:words(method_keys)] (strstrt(name, word(method_keys, i)) == 1 ? i : 0)
-ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 30)
+ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 99)
 mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(method_titles, method_found) : name)
 set style line 1  lw 2 lc rgb "#d62728" pt 5  ps 1.1          # explicit_euler: red, filled square
 set style line 2  lw 2 lc rgb "#1f77b4" pt 6  ps 1.6          # implicit_euler: blue, large open circle
@@ -45,7 +45,14 @@ set style line 25 lw 2 lc rgb "#7f7f7f" pt 1  ps 1.5          # ida_index_2: gre
 set style line 26 lw 2 lc rgb "#1f77b4" pt 2  ps 1.3 dt (5,3) # ida_index_3: blue, cross, dashed
 set style line 27 lw 2 lc rgb "#d62728" pt 9  ps 1.2          # penalty: red, filled triangle
 set style line 28 lw 2 lc rgb "#2ca02c" pt 11 ps 1.2 dt (5,3) # shake (rattle without velocity projection): green, dashed
-set style line 30 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
+# Runge-Kutta-Nystrom methods (results/work_precision*): the fixed-step ones in the explicit_rk
+# family's purple-to-orange, the embedded pairs in the adaptive_geomint family's blues.
+set style line 29 lw 2 lc rgb "#6a3d9a" pt 13 ps 0.9 dt (3,2) # rkn_nystrom4: violet, small filled diamond, dotted
+set style line 30 lw 2 lc rgb "#1b9e77" pt 9  ps 1.0 dt (6,2) # rkn_dprkn6: sea green, filled triangle, dashed
+set style line 31 lw 2 lc rgb "#d95f02" pt 5  ps 0.9          # rkn_dprkn8: dark orange, filled square
+set style line 32 lw 2 lc rgb "#17becf" pt 8  ps 1.2 dt (4,2) # rkn_adaptive_dprkn6: cyan, open triangle, dashed
+set style line 33 lw 2 lc rgb "#0868ac" pt 12 ps 1.3          # rkn_adaptive_dprkn8: dark blue, open diamond
+set style line 99 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
 # Curves that are not methods (a parameter family, step sizes, energies of one method, bodies):
 # an ordered dark-to-light palette, styles 41-48, so they cannot be mistaken for a method.
 set style line 41 lw 2 lc rgb "#440154" pt 7
