@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "harness/gate.hpp"
+#include "harness/shard.hpp"
 #include "harness/sweep.hpp"
 #include "harness/toml_reader.hpp"
 #include "problems/spec.hpp"
@@ -141,6 +142,10 @@ struct ScenePage {
   std::vector<GateOutcome> outcomes;
   std::string narrative_html;
   int passed = 0, failed = 0;
+  // Why the tables are not of the scene.toml beside them ("" when they are, or unknown): set
+  // when table.md's recorded scene hash differs from the file's (published variant only; the
+  // quick tables are rewritten by every `make gate-quick`).
+  std::string stale;
 };
 
 // summary, order and stability first (what table.md shows), then the others by name.
@@ -226,7 +231,11 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
     html += fmt::format("<span class=\"{}\">{} of {} passed</span>", page.failed ? "fail" : "pass",
                         page.passed, page.passed + page.failed);
   }
-  html += ".</p>\n" + page.narrative_html;
+  html += ".</p>\n";
+  if (!page.stale.empty()) {
+    html += "<p class=\"fail\">Stale tables: " + html_escape(page.stale) + "</p>\n";
+  }
+  html += page.narrative_html;
   if (!page.images.empty()) {
     html += "<h2>Figures</h2>\n";
     for (const auto& image : page.images) {
@@ -303,6 +312,7 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
       gates = fmt::format("<span class=\"{}\">{} {}/{}</span>", page.failed ? "fail" : "pass",
                           page.failed ? "FAIL" : "PASS", page.passed, page.passed + page.failed);
     }
+    if (!page.stale.empty()) gates += " <span class=\"fail\">STALE</span>";
     html += fmt::format(
         "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td "
         "class=\"claim\"><strong>{1}</strong><br>{2}</td>"
@@ -389,6 +399,19 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
       if (!outcome.applicable || outcome.gate->scene != page.name) continue;
       (outcome.passed ? page.passed : page.failed) += 1;
       page.outcomes.push_back(std::move(outcome));
+    }
+  }
+  const fs::path table_md = folder / "table.md";
+  if (!options.quick && !page.tables.empty() && fs::exists(table_md)) {
+    const std::string recorded = recorded_scene_hash(table_md.string());
+    const std::string current = scene_content_hash(scene_file.string(), false);
+    if (recorded.empty()) {
+      page.stale = "table.md records no scene hash, so the tables cannot be tied to scene.toml";
+    } else if (recorded != current) {
+      page.stale = fmt::format(
+          "scene.toml changed after these tables were written (tables of {}, scene.toml now "
+          "{}); regenerate them: make reproduce-figures SCENES={}",
+          recorded, current, page.name);
     }
   }
   const fs::path readme = folder / "README.md";
@@ -594,6 +617,7 @@ ReportSummary write_report(const ReportOptions& given) {
       summary.tables += static_cast<int>(page.tables.size());
       summary.gates_passed += page.passed;
       summary.gates_failed += page.failed;
+      if (!page.stale.empty()) ++summary.stale_scenes;
     }
     fs::remove_all(out);
     fs::rename(partial, out);

@@ -22,6 +22,7 @@ struct ReportOptions {
 
 struct ReportSummary {
   int scenes = 0, tables = 0, gates_passed = 0, gates_failed = 0;
+  int stale_scenes = 0;  // scenes whose table.md records another scene hash than scene.toml's
 };
 
 // Writes the site into options.out_dir (built in a sibling temporary folder and renamed, so a

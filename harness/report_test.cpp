@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "harness/shard.hpp"
+#include "harness/sweep.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -138,6 +140,47 @@ TEST_F(ReportTest, RefusesToReplaceAFolderItDidNotWrite) {
   write_fixture_site();  // its own site, replaced
   EXPECT_TRUE(fs::exists(dir_ / "site" / "tiny" / "index.html"));
   EXPECT_FALSE(fs::exists(dir_ / "site" / "notes.txt"));
+}
+
+// A scene whose table.md records another scene hash than its scene.toml's (the scene was edited
+// after its tables were written) is flagged on its page, in the index and in the summary; the
+// same tables with the current hash are not.
+TEST_F(ReportTest, FlagsTablesOfAnEditedScene) {
+  const fs::path results = dir_ / "results";
+  fs::copy(kFixture / "results", results, fs::copy_options::recursive);
+  const fs::path scene = results / "tiny" / "scene.toml";
+  const auto write_table_md = [&](const std::string& hash) {
+    std::ofstream(results / "tiny" / "table.md")
+        << "# tiny\n\n## How to cite\n\n| field | value |\n|---|---|\n| scene hash | " << hash
+        << " |\n| date | 2026-12-04 |\n";
+  };
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site").string();
+  options.generator = "geomint (fixture)";
+
+  write_table_md(scene_content_hash(scene.string(), false));
+  EXPECT_EQ(recorded_scene_hash((results / "tiny" / "table.md").string()),
+            scene_content_hash(scene.string(), false));
+  EXPECT_EQ(write_report(options).stale_scenes, 0);
+  EXPECT_EQ(read_text(dir_ / "site" / "tiny" / "index.html").find("Stale"), std::string::npos);
+
+  std::ofstream(scene, std::ios::app) << "# a comment edited after the tables were written\n";
+  EXPECT_EQ(write_report(options).stale_scenes, 1);
+  const std::string page = read_text(dir_ / "site" / "tiny" / "index.html");
+  EXPECT_NE(page.find("Stale tables: scene.toml changed after these tables were written"),
+            std::string::npos);
+  EXPECT_NE(page.find("make reproduce-figures SCENES=tiny"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "site" / "index.html").find("STALE"), std::string::npos);
+
+  write_table_md("(not recorded)");
+  EXPECT_EQ(recorded_scene_hash((results / "tiny" / "table.md").string()), "");
+  EXPECT_EQ(write_report(options).stale_scenes, 1);
+
+  options.quick = true;  // quick tables are rewritten by every gate-quick: not checked
+  fs::create_directories(results / "tiny" / "quick");
+  fs::copy_file(results / "tiny" / "summary.csv", results / "tiny" / "quick" / "summary.csv");
+  EXPECT_EQ(write_report(options).stale_scenes, 0);
 }
 
 }  // namespace

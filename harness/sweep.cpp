@@ -782,6 +782,8 @@ TableCitation table_citation(const std::vector<std::pair<std::string, std::strin
 namespace {
 
 // "| name | value |" with an absent value shown as such, so a block is never half empty.
+constexpr const char* kSceneHashField = "scene hash";
+
 std::string citation_row(const std::string& name, const std::string& value) {
   return fmt::format("| {} | {} |\n", name, value.empty() ? "(not recorded)" : value);
 }
@@ -805,7 +807,7 @@ std::string how_to_cite(const TableCitation& citation) {
   block += citation_row("geomint version", version);
   block += citation_row("git SHA", sha);
   block += citation_row("scene", scene);
-  block += citation_row("scene hash", citation.scene_hash);
+  block += citation_row(kSceneHashField, citation.scene_hash);
   block += citation_row("date", citation.date);
   block += fmt::format("\n> geomint {}{}, scene {}, scene.toml {}, tables of {}.\n", version,
                        sha.empty() ? "" : " (git " + sha + ")",
@@ -816,6 +818,19 @@ std::string how_to_cite(const TableCitation& citation) {
 }
 
 }  // namespace
+
+std::string recorded_scene_hash(const std::string& table_md_path) {
+  std::ifstream in(table_md_path);
+  const std::string marker = fmt::format("| {} | ", kSceneHashField);
+  std::string line, recorded;
+  while (std::getline(in, line)) {
+    if (line.rfind(marker, 0) == 0 && line.size() > marker.size() + 2 &&
+        line.compare(line.size() - 2, 2, " |") == 0) {
+      recorded = line.substr(marker.size(), line.size() - marker.size() - 2);
+    }
+  }
+  return recorded == "(not recorded)" ? std::string() : recorded;
+}
 
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                            const std::string& command_line, const TableCitation& citation) {

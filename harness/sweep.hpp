@@ -84,6 +84,11 @@ struct TableCitation {
 TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
                              const std::string& scene_hash);
 
+// The scene hash a table.md's "How to cite" block records ("fnv1a64:..."); "" when the file or
+// the row is absent. `geomint report` and the committed-results test compare it with the
+// scene_content_hash of the scene.toml beside it, so tables of an edited scene are flagged.
+std::string recorded_scene_hash(const std::string& table_md_path);
+
 // table.md: the scene's title and description, a Markdown table per non-empty table, the
 // command that produced them and the "How to cite" block.
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,

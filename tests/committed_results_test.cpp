@@ -16,6 +16,7 @@
 
 #include "harness/run.hpp"
 #include "harness/shard.hpp"
+#include "harness/sweep.hpp"
 #include "harness/table.hpp"
 
 namespace geomint {
@@ -117,20 +118,16 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
 // with a hash no scene file has.
 TEST_P(CommittedScene, TablesAreOfTheSceneFileBesideThem) {
   const fs::path folder = fs::path(GEOMINT_SOURCE_DIR) / "results" / GetParam();
-  std::ifstream in(folder / "table.md");
-  ASSERT_TRUE(in) << folder / "table.md" << " is missing";
-  const std::string marker = "| scene hash | ";
-  std::string line, recorded;
-  while (std::getline(in, line)) {
-    if (line.rfind(marker, 0) == 0 && line.size() > marker.size() + 2) {
-      recorded = line.substr(marker.size(), line.size() - marker.size() - 2);
-    }
-  }
-  ASSERT_FALSE(recorded.empty()) << folder / "table.md" << " records no scene hash";
+  ASSERT_TRUE(fs::exists(folder / "table.md")) << folder / "table.md"
+                                               << " is missing";
+  const std::string recorded = recorded_scene_hash((folder / "table.md").string());
+  ASSERT_FALSE(recorded.empty()) << folder / "table.md"
+                                 << " records no scene hash";
   const std::string current = scene_content_hash((folder / "scene.toml").string(), false);
-  EXPECT_EQ(recorded, current)
-      << "results/" << GetParam() << "/scene.toml changed after its tables were written; "
-      << "regenerate them: bash scripts/reproduce.sh build/geomint " << GetParam();
+  EXPECT_EQ(recorded, current) << "results/" << GetParam()
+                               << "/scene.toml changed after its tables were written; "
+                               << "regenerate them: bash scripts/reproduce.sh build/geomint "
+                               << GetParam();
 }
 
 INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_with_summary()),

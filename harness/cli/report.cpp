@@ -27,10 +27,14 @@ Verb add_report(CLI::App& app) {
             const ReportSummary summary = write_report(*options);
             // 0 once written: the gate verdicts are in the pages (`geomint gate` is what fails).
             inform(context,
-                   fmt::format("report: {} scenes, {} tables, gates {} passed, {} failed; open {}",
-                               summary.scenes, summary.tables, summary.gates_passed,
-                               summary.gates_failed,
-                               (std::filesystem::path(options->out_dir) / "index.html").string()));
+                   fmt::format(
+                       "report: {} scenes, {} tables, gates {} passed, {} failed{}; open {}",
+                       summary.scenes, summary.tables, summary.gates_passed, summary.gates_failed,
+                       summary.stale_scenes == 0
+                           ? std::string()
+                           : fmt::format(", {} scenes with stale tables (marked STALE)",
+                                         summary.stale_scenes),
+                       (std::filesystem::path(options->out_dir) / "index.html").string()));
             return kExitOk;
           }};
 }
