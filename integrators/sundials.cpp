@@ -519,6 +519,7 @@ class Ida final : public SundialsIntegrator {
       return;
     }
     first_step_ = 0;
+    index3_started_ = false;
     matrix_.reset(SUNDenseMatrix(n_, n_, context_.get()));
     if (matrix_) linear_solver_.reset(SUNLinSol_Dense(y_.get(), matrix_.get(), context_.get()));
     if (!matrix_ || !linear_solver_) {
@@ -548,9 +549,11 @@ class Ida final : public SundialsIntegrator {
       first_step_ = initial_step(t_stop);
       flag = IDASetInitStep(ida, first_step_);
     }
-    if (flag >= 0 && index_ == 3 && first_step_ == 0) {
-      first_step_ = index3_initial_step(t_stop);
-      flag = IDASetInitStep(ida, first_step_);
+    if (flag >= 0 && index_ == 3 && !index3_started_) {
+      index3_started_ = true;
+      if (const double step = index3_initial_step(t_stop); step > 0) {
+        flag = IDASetInitStep(ida, step);
+      }
     }
     double t_returned = t_;
     if (flag >= 0) flag = IDASolve(ida, t_stop, &t_returned, y_.get(), yp_.get(), IDA_ONE_STEP);
@@ -669,24 +672,28 @@ class Ida final : public SundialsIntegrator {
     return h;
   }
 
-  // Index 3: IDA's first step (above) bounds h by 0.5/‖y'‖, which on a start in motion with tight
-  // weights is ~1e-9 (the rigid bodies: ‖Q'‖ ≈ 1, weights 1/(1e-8|Q| + 1e-10)), and there the
+  // Index 3: IDA's own first step, 0.001 |t_stop − t0| cut to 0.5/‖q'‖ (its weighted RMS norm
+  // skips the components outside the error test, here p and λ), is ~5e-9 on a start in motion
+  // with tight weights (the rigid bodies: ‖Q'‖ ≈ 1, weights 1/(1e-8|Q| + 1e-10)); there the
   // index-3 Newton matrix, whose λ block scales as 1/h², turns the round-off of g(q) into
   // corrections no convergence test accepts: IDA_CONV_FAIL at t ≈ 1e-8 (results/rigid_body/
-  // README.md). The error test sees only q at index 3, and a first BDF step integrates a constant
-  // q' exactly: its local error is ½h²q''. So the first step is the one where that error is 1 in
-  // the error weights, ‖q''‖_w h² = 1 with q'' = M⁻¹p' from the consistent start, when IDA's is
-  // shorter; never longer than IDA's 0.001 |t_stop − t0|.
+  // README.md). A first BDF step integrates a constant q' exactly: its local error is ½h²q''. So
+  // when IDA's step is shorter than the one where that error is 1 in the error weights,
+  // ‖q''‖_w h² = 1 with q'' = M⁻¹p' from the consistent start, the first step is that one, never
+  // longer than 0.001 |t_stop − t0|. 0 = IDA's own (a start at rest: q' = 0 gives IDA's upper
+  // bound), so those runs are unchanged.
   double index3_initial_step(double t_stop) const {
-    const double ida_step = initial_step(t_stop);
-    const double upper = 0.001 * std::abs(t_stop - t_);
     const auto y = view(y_.get());
     const auto yp = view(yp_.get());
     const Vec weights = (settings_.rtol * y.head(dof_).array().abs() + settings_.atol).inverse();
+    const double upper = 0.001 * std::abs(t_stop - t_);
+    const double q_rate_norm = std::sqrt(yp.head(dof_).cwiseProduct(weights).squaredNorm() / n_);
+    const double ida_step = q_rate_norm * upper > 0.5 ? 0.5 / q_rate_norm : upper;
     const Vec q_second = problem_->inverse_mass().cwiseProduct(yp.segment(dof_, dof_));
     const double q_second_norm = std::sqrt(q_second.cwiseProduct(weights).squaredNorm() / dof_);
-    if (!(q_second_norm > 0) || !std::isfinite(q_second_norm)) return ida_step;
-    return std::min(upper, std::max(ida_step, 1.0 / std::sqrt(q_second_norm)));
+    if (!(q_second_norm > 0) || !std::isfinite(q_second_norm)) return 0;
+    const double error_step = std::min(upper, 1.0 / std::sqrt(q_second_norm));
+    return error_step > ida_step ? error_step : 0;
   }
 
   // id = 1 for the components in the error test, 0 for the rest (suppressed).
@@ -793,8 +800,8 @@ class Ida final : public SundialsIntegrator {
   // Absolute tolerance of λ (and μ) in the Newton convergence test when given; otherwise atol,
   // at index 2 with the cap of evaluate_step_scaled_weights.
   std::optional<double> multiplier_atol_;
-  // The step IDA starts with (index 2 with step-scaled weights, and index 3).
-  double first_step_ = 0;
+  double first_step_ = 0;        // index 2 with step-scaled weights: the step IDA starts with
+  bool index3_started_ = false;  // index 3: the first step has been chosen
   int constraint_count_ = 0;
   const HolonomicConstraints* constraints_ = nullptr;  // the problem's, set by reset (index 2, 3)
   bool analytic_jacobian_ = false;
