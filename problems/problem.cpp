@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <limits>
 
+#include "problems/first_order.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -133,7 +134,7 @@ const char* kind_name(ProblemKind kind) {
 }
 
 ProblemKind Problem::kind() const {
-  if (has(kFirstOrderOnly)) return ProblemKind::kFirstOrder;
+  if (as_first_order() != nullptr) return ProblemKind::kFirstOrder;
   if (as_lagrangian() != nullptr) return ProblemKind::kLagrangian;
   return ProblemKind::kSeparable;
 }
@@ -165,16 +166,40 @@ unsigned Problem::capabilities() const {
     derived |= kConstraints;
     if (constraints->time_dependent()) derived |= kTimeDependentConstraints;
   }
+  if (as_first_order() != nullptr) derived |= kFirstOrderOnly;
   return capabilities_ | derived;
+}
+
+bool Problem::has_derived(Capability c) const {
+  switch (c) {
+    case kFirstOrderOnly:
+      return as_first_order() != nullptr;
+    case kConstraints:
+      return as_constrained() != nullptr;
+    case kTimeDependentConstraints: {
+      const HolonomicConstraints* constraints = as_constrained();
+      return constraints != nullptr && constraints->time_dependent();
+    }
+    default:
+      return (capabilities() & c) != 0;
+  }
 }
 
 void Problem::set_capabilities(unsigned capabilities) {
   if ((capabilities & kDerivedCapabilities) != 0) {
-    throw std::logic_error(
-        "Problem::set_capabilities: kConstraints and kTimeDependentConstraints are derived from "
-        "as_constrained() (problems/constraints.hpp), not declared");
+    throw std::logic_error(fmt::format(
+        "Problem::set_capabilities: {} derived from the structure queries, not declared "
+        "(kConstraints and kTimeDependentConstraints from as_constrained(), problems/"
+        "constraints.hpp; kFirstOrderOnly from as_first_order(), problems/first_order.hpp)",
+        fmt::join(capability_names(capabilities & kDerivedCapabilities), ", ")));
   }
   capabilities_ = capabilities;
+}
+
+const FirstOrderSystem& first_order_system_of(const Problem& problem) {
+  const FirstOrderSystem* system = problem.as_first_order();
+  if (system == nullptr) missing(problem, "first-order system y' = f(t, y)");
+  return *system;
 }
 
 const HolonomicConstraints& constraints_of(const Problem& problem) {
@@ -303,16 +328,12 @@ void Problem::unpack_first_order(const double* y, State& state) const {
   }
 }
 
-void Problem::rhs(double, const Vec&, Vec&) const { missing(*this, "first-order rhs"); }
-void Problem::rhs_jacobian(double, const Vec&, SparseMatrix&) const {
-  missing(*this, "first-order rhs_jacobian");
-}
 double Problem::end_reference_time() const { missing(*this, "end reference"); }
 State Problem::end_reference() const { missing(*this, "end reference"); }
 
 void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
-  if (has(kFirstOrderOnly)) {
-    rhs(t, y, ydot);
+  if (const FirstOrderSystem* system = as_first_order()) {
+    system->rhs(t, y, ydot);
     return;
   }
   const int n = dof();
@@ -343,8 +364,8 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
 }
 
 void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const {
-  if (has(kFirstOrderOnly)) {
-    rhs_jacobian(t, y, J);
+  if (const FirstOrderSystem* system = as_first_order()) {
+    system->rhs_jacobian(t, y, J);
     return;
   }
   const int n = dof();

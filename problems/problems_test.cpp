@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "problems/charged_particle.hpp"
+#include "problems/first_order.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 #include "problems/rigid_body.hpp"
@@ -100,9 +101,9 @@ std::vector<Vec> sample_configurations(const Problem& problem) {
 // constraint force with the exact motion's multipliers λ(t, q, p) on constrained problems; on a
 // first-order-only problem y = q and its y' = f(t, y) (p is empty).
 Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
-  if (problem.has(kFirstOrderOnly)) {
+  if (const FirstOrderSystem* system = problem.as_first_order()) {
     Vec ydot;
-    problem.rhs(t, q, ydot);
+    system->rhs(t, q, ydot);
     return ydot;
   }
   const int n = problem.dof();
@@ -500,9 +501,13 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   EXPECT_EQ(problem.has(kConstraints), constraints != nullptr);
   EXPECT_EQ(problem.has(kTimeDependentConstraints),
             constraints != nullptr && constraints->time_dependent());
-  const ProblemKind expected = problem.has(kFirstOrderOnly) ? ProblemKind::kFirstOrder
-                               : problem.as_lagrangian()    ? ProblemKind::kLagrangian
-                                                            : ProblemKind::kSeparable;
+  // The first-order kind: the query is the class's own interface, and alone sets the bit.
+  EXPECT_EQ(problem.as_first_order(), dynamic_cast<const FirstOrderSystem*>(&problem));
+  EXPECT_EQ(problem.has(kFirstOrderOnly), problem.as_first_order() != nullptr);
+  EXPECT_EQ((problem.capabilities() & kFirstOrderOnly) != 0, problem.as_first_order() != nullptr);
+  const ProblemKind expected = problem.as_first_order()  ? ProblemKind::kFirstOrder
+                               : problem.as_lagrangian() ? ProblemKind::kLagrangian
+                                                         : ProblemKind::kSeparable;
   EXPECT_EQ(problem.kind(), expected) << kind_name(problem.kind());
 }
 
