@@ -1,6 +1,7 @@
 // The Problem interface (docs/DESIGN.md §2): a Lagrangian system L(q, v) = ½ vᵀMv − V(q) with a
-// constant diagonal (lumped) mass matrix, optional non-conservative force, exact solution and
-// momentum maps. Problems declare capabilities; the harness runs only what applies.
+// constant diagonal (lumped) mass matrix, exact solution and momentum maps, and the queries for
+// what else a kind of system offers (a first-order ODE, a general Lagrangian, constraints, a
+// non-conservative force). Problems declare capabilities; the harness runs only what applies.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,13 +31,14 @@ struct State {
 // solution only when it librates, a spring network has angular momentum only when free.
 enum Capability : unsigned {
   kHessian = 1u << 0,          // hessian(q, H)
-  kForce = 1u << 1,            // force(q, v, t): non-conservative (damping, driving)
+  kForce = 1u << 1,            // as_forced(): a non-conservative force F(q, v, t) (derived)
   kExact = 1u << 2,            // exact(t)
   kLinearMomentum = 1u << 3,   // linear_momentum(q, p) is a conserved quantity
   kAngularMomentum = 1u << 4,  // angular_momentum(q, p) is a conserved quantity
   kPeriod = 1u << 5,           // period()
   kOmegaMax = 1u << 6,         // omega_max(q)
-  kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
+  // as_forced()->has_force_jacobian(): C = −∂F/∂v for implicit dissipative solves (derived)
+  kForceJacobian = 1u << 7,
   // Holonomic constraints g(q) = 0 (PAPER.md §3) and rheonomic g(q, t) = 0 (car_axis): derived
   // from Problem::as_constrained() and HolonomicConstraints::time_dependent(), never declared
   // (set_capabilities refuses them), so a problem cannot claim one without the other.
@@ -57,9 +59,11 @@ enum Capability : unsigned {
 std::vector<std::string> capability_names(unsigned capabilities);
 
 // The interfaces a problem may offer beyond Problem (problems/first_order.hpp,
-// problems/lagrangian.hpp, problems/rigid_body.hpp, problems/charged_particle.hpp).
+// problems/lagrangian.hpp, problems/force.hpp, problems/rigid_body.hpp,
+// problems/charged_particle.hpp).
 class FirstOrderSystem;
 class LagrangianSystem;
+class NonConservativeForce;
 class FreeRigidBodyStructure;
 class AttitudeProblem;
 class ChargedParticleStructure;
@@ -88,14 +92,15 @@ class Problem {
   // Registry name ("pendulum").
   const std::string& name() const { return name_; }
   // The declared capabilities plus the ones derived from the structure queries (kConstraints,
-  // kTimeDependentConstraints from as_constrained(), kFirstOrderOnly from as_first_order()).
+  // kTimeDependentConstraints from as_constrained(), kFirstOrderOnly from as_first_order(),
+  // kForce and kForceJacobian from as_forced()).
   // has() asks only the one query a derived bit comes from.
   unsigned capabilities() const;
   bool has(Capability c) const {
     return (c & kDerivedCapabilities) != 0 ? has_derived(c) : (capabilities_ & c) != 0;
   }
   static constexpr unsigned kDerivedCapabilities =
-      kConstraints | kTimeDependentConstraints | kFirstOrderOnly;
+      kConstraints | kTimeDependentConstraints | kFirstOrderOnly | kForce | kForceJacobian;
 
   // ---- The kind and the structures the problem offers, each by one query (nullptr: absent) ----
   // A class that offers one derives from its interface as well and returns `this`; the queries
@@ -118,6 +123,10 @@ class Problem {
   // Holonomic constraints g(q) = 0 or g(q, t) = 0 (problems/constraints.hpp: what a constrained
   // problem implements). Callers take the pointer once per run or step, not per element.
   virtual const HolonomicConstraints* as_constrained() const { return nullptr; }
+  // A non-conservative generalized force F(q, v, t) (damping, driving) added to −∇V
+  // (problems/force.hpp: what a forced problem implements). Instance-level like the constraints:
+  // a damped oscillator with ζ = 0 and no drive returns nullptr and conserves H.
+  virtual const NonConservativeForce* as_forced() const { return nullptr; }
 
   int dof() const { return static_cast<int>(mass_.size()); }
   virtual State initial_state() const = 0;
@@ -134,11 +143,6 @@ class Problem {
   virtual FixedGradient fixed_gradient() const { return {}; }
   // H = ∇²V(q), symmetric, compressed. Only when has(kHessian).
   virtual void hessian(const Vec& q, SparseMatrix& H) const;
-  // Non-conservative generalized force F(q, v, t) (added to −∇V). Only when has(kForce).
-  virtual void force(const Vec& q, const Vec& v, double t, Vec& f) const;
-  // C = −∂F/∂v (damping matrix, symmetric PSD for dissipative forces). Only when
-  // has(kForceJacobian).
-  virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
   // Exact solution. Only when has(kExact).
   virtual State exact(double t) const;
   // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
@@ -220,7 +224,8 @@ class Problem {
   // Called once by the factory after construction.
   void set_mass(const Vec& mass);
   // Throws std::logic_error for kDerivedCapabilities: a problem declares constraints by
-  // as_constrained() and a first-order ODE by as_first_order(), not by a bit.
+  // as_constrained(), a first-order ODE by as_first_order() and a force by as_forced(), not by a
+  // bit.
   void set_capabilities(unsigned capabilities);
   void set_defaults(double dt, double t_end) {
     default_dt_ = dt;
@@ -246,6 +251,9 @@ const HolonomicConstraints& constraints_of(const Problem& problem);
 // *problem.as_first_order(), the same for code that runs only on first-order problems
 // (problems/first_order.hpp); throws std::logic_error naming the problem when it is none.
 const FirstOrderSystem& first_order_system_of(const Problem& problem);
+// *problem.as_forced(), for code that runs only on forced problems (checked has(kForce)); throws
+// std::logic_error naming the problem when it has no force.
+const NonConservativeForce& force_of(const Problem& problem);
 
 // Spec key every problem accepts: `initial=FILE.csv` starts the problem from the state in the
 // file (rows q,p or, under a header "q,v", q,v; one per dof) instead of its own, and drops its
