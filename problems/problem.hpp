@@ -201,8 +201,10 @@ class Problem {
   // First-order view y = (q, p), y' = (M⁻¹p, −∇V(q) + F(q, M⁻¹p, t)) for ODE solvers; on a
   // kFirstOrderOnly problem y = q and y' = rhs(t, y).
   void first_order_rhs(double t, const Vec& y, Vec& ydot) const;
-  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs has_first_order_jacobian(); uses
-  // kForceJacobian if kForce, otherwise the force's q/v dependence is differenced numerically).
+  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs has_first_order_jacobian()). A force's
+  // ∂F/∂q is differenced numerically; its ∂F/∂p = −C M⁻¹ comes from force_jacobian_v when
+  // has(kForceJacobian) and is left out otherwise (the catalogue's forces without a Jacobian,
+  // car_axis and parametric_oscillator, do not depend on v).
   void first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const;
   // Whether first_order_jacobian is analytic: a Hessian, or a first-order problem's
   // FirstOrderSystem::rhs_jacobian.
