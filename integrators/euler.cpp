@@ -200,7 +200,7 @@ class ImplicitEuler final : public Integrator {
   void add_force_jacobian(const Problem& problem, const Vec& q_start, const Vec& v, double t_next,
                           double h, SparseMatrix& jacobian) {
     if (problem.has(kForceJacobian)) {
-      problem.force_jacobian_v(q_next_, v, t_next, damping_);
+      force_of(problem).force_jacobian_v(q_next_, v, t_next, damping_);
       jacobian += h * damping_;
       return;
     }

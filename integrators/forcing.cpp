@@ -25,9 +25,9 @@ void minus_impulse(const Problem& problem, const Forcing& forcing, const Impulse
                    const Vec& v, Vec& impulse, Counters& counters) {
   ++counters.force_evals;
   if (forcing.at == ForceAt::kNode) {
-    problem.force(step.q0, v, step.t0, impulse);
+    force_of(problem).force(step.q0, v, step.t0, impulse);
   } else {
-    problem.force(step.q0 + (step.h / 2) * v, v, step.t0 + step.h / 2, impulse);
+    force_of(problem).force(step.q0 + (step.h / 2) * v, v, step.t0 + step.h / 2, impulse);
   }
   impulse *= step.minus_weight * step.h;
 }
@@ -38,15 +38,15 @@ void add_minus_impulse_jacobian(const Problem& problem, const Forcing& forcing,
   const bool node = forcing.at == ForceAt::kNode;
   const double h = step.h;
   if (problem.has(kForceJacobian)) {
-    problem.force_jacobian_v(node ? step.q0 : Vec(step.q0 + (h / 2) * v), v,
-                             node ? step.t0 : step.t0 + h / 2, damping);
+    force_of(problem).force_jacobian_v(node ? step.q0 : Vec(step.q0 + (h / 2) * v), v,
+                                       node ? step.t0 : step.t0 + h / 2, damping);
     jacobian += (step.minus_weight * h) * damping;
     return;
   }
   jacobian -= central_difference_jacobian(
       [&](const Vec& x, Vec& impulse) {
-        problem.force(node ? step.q0 : Vec(step.q0 + (h / 2) * x), x,
-                      node ? step.t0 : step.t0 + h / 2, impulse);
+        force_of(problem).force(node ? step.q0 : Vec(step.q0 + (h / 2) * x), x,
+                                node ? step.t0 : step.t0 + h / 2, impulse);
         impulse *= step.minus_weight * h;
       },
       v);
@@ -58,15 +58,15 @@ void add_plus_impulse(const Problem& problem, const Forcing& forcing, const Stat
                       Vec& force, Counters& counters) {
   const bool node = forcing.at == ForceAt::kNode;
   ++counters.force_evals;
-  problem.force(node ? q1 : Vec(start.q + (h / 2) * v), v, node ? start.t + h : start.t + h / 2,
-                force);
+  force_of(problem).force(node ? q1 : Vec(start.q + (h / 2) * v), v,
+                          node ? start.t + h : start.t + h / 2, force);
   p1 += (plus_weight * h) * force;
 }
 
 void decide_damping_symmetry(const Problem& problem, const Vec& q, const Vec& v, double t,
                              SparseMatrix& damping, std::optional<bool>& symmetric) {
   if (symmetric || !problem.has(kForceJacobian)) return;
-  problem.force_jacobian_v(q, v, t, damping);
+  force_of(problem).force_jacobian_v(q, v, t, damping);
   symmetric = (damping - SparseMatrix(damping.transpose())).norm() == 0.0;
 }
 

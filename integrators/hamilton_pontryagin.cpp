@@ -263,7 +263,7 @@ class HamiltonPontryagin final : public Integrator,
       if (*dissipation_potential_) {
         // F(q_k, v) = F₀ − C₀v for this step; the residual uses the same model, so ∇E_k = R.
         eval_counted_force(problem, q0_, Vec::Zero(v.size()), t0_, force_zero_);
-        problem.force_jacobian_v(q0_, Vec::Zero(v.size()), t0_, damping_zero_);
+        force_of(problem).force_jacobian_v(q0_, Vec::Zero(v.size()), t0_, damping_zero_);
         linearised_ = true;
       }
     }
@@ -375,8 +375,8 @@ class HamiltonPontryagin final : public Integrator,
     SparseMatrix c_zero, c_test;
     eval_counted_force(problem, state.q, Vec::Zero(v_test.size()), state.t, f_zero);
     eval_counted_force(problem, state.q, v_test, state.t, f_test);
-    problem.force_jacobian_v(state.q, Vec::Zero(v_test.size()), state.t, c_zero);
-    problem.force_jacobian_v(state.q, v_test, state.t, c_test);
+    force_of(problem).force_jacobian_v(state.q, Vec::Zero(v_test.size()), state.t, c_zero);
+    force_of(problem).force_jacobian_v(state.q, v_test, state.t, c_test);
     const Vec model = f_zero - c_zero * v_test;
     const double scale = f_test.norm() + f_zero.norm() + (c_zero * v_test).norm();
     return (f_test - model).norm() <= 1e-12 * scale &&

@@ -93,7 +93,7 @@ class ImplicitMidpoint final : public Integrator {
       jacobian = mass_matrix_ + (h * h / 4) * hessian_;
       if (!forced) return;
       if (problem.has(kForceJacobian)) {
-        problem.force_jacobian_v(q_mid, x, t_mid, damping_);
+        force_of(problem).force_jacobian_v(q_mid, x, t_mid, damping_);
         jacobian += (h / 2) * damping_;
       } else {
         jacobian -= (h / 2) * central_difference_jacobian(

@@ -390,7 +390,7 @@ void Integrator::eval_hessian(const Problem& problem, const Vec& q, SparseMatrix
 }
 
 void Integrator::eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f) {
-  problem.force(q, v, t, f);
+  force_of(problem).force(q, v, t, f);
 }
 
 StepStatus Integrator::solve_force_kick(const Problem& problem, const Vec& q, double t,
@@ -421,8 +421,8 @@ void Integrator::eval_total_force(const Problem& problem, const Vec& q, const Ve
                                   Vec& f) {
   eval_gradient(problem, q, f);
   f = -f;
-  if (problem.has(kForce)) {
-    problem.force(q, v, t, extra_force_);
+  if (const NonConservativeForce* forced = problem.as_forced()) {
+    forced->force(q, v, t, extra_force_);
     f += extra_force_;
   }
 }

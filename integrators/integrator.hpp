@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {

@@ -25,24 +25,19 @@ SparseMatrix sparse_from(const Eigen::MatrixXd& dense) { return dense.sparseView
 // Local test problems (independent of problems/ so these tests pin the methods alone).
 
 // H = p²/2m + k q²/2 with an optional linear damping force F = −c v.
-class Oscillator final : public Problem {
+class Oscillator final : public Problem, public NonConservativeForce {
  public:
   struct Options {
     double mass = 1.0;
     double stiffness = 1.0;
     double damping = 0.0;
-    bool damping_jacobian = true;  // declare kForceJacobian when damped
+    bool damping_jacobian = true;  // offer force_jacobian_v (kForceJacobian) when damped
     double q0 = 1.0;
     double p0 = 0.5;
   };
   explicit Oscillator(const Options& options) : options_(options) {
     set_mass(Vec::Constant(1, options.mass));
-    unsigned capabilities = kHessian;
-    if (options.damping != 0.0) {
-      capabilities |= kForce;
-      if (options.damping_jacobian) capabilities |= kForceJacobian;
-    }
-    set_capabilities(capabilities);
+    set_capabilities(kHessian);
   }
   State initial_state() const override {
     return {0.0, Vec::Constant(1, options_.q0), Vec::Constant(1, options_.p0)};
@@ -54,6 +49,10 @@ class Oscillator final : public Problem {
   void hessian(const Vec&, SparseMatrix& H) const override {
     H = sparse_from(Eigen::MatrixXd::Constant(1, 1, options_.stiffness));
   }
+  const NonConservativeForce* as_forced() const override {
+    return options_.damping != 0.0 ? this : nullptr;
+  }
+  bool has_force_jacobian() const override { return options_.damping_jacobian; }
   void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -options_.damping * v; }
   void force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix& C) const override {
     C = sparse_from(Eigen::MatrixXd::Constant(1, 1, options_.damping));

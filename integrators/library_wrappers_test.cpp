@@ -59,11 +59,11 @@ class HessianFreeOscillator final : public Problem {
 
 // Damped oscillator m q'' = −k q − c q' (underdamped), with the exact solution: forces must flow
 // through first_order_rhs into the first-order solvers.
-class DampedOscillator final : public Problem {
+class DampedOscillator final : public Problem, public NonConservativeForce {
  public:
   DampedOscillator() {
     set_mass(Vec::Constant(1, kMass));
-    set_capabilities(kHessian | kForce | kForceJacobian | kExact);
+    set_capabilities(kHessian | kExact);
   }
   State initial_state() const override {
     return {0.0, Vec::Constant(1, 1.0), Vec::Constant(1, 0.0)};
@@ -71,6 +71,8 @@ class DampedOscillator final : public Problem {
   double potential(const Vec& q) const override { return 0.5 * kStiffness * q.squaredNorm(); }
   void gradient(const Vec& q, Vec& g) const override { g = kStiffness * q; }
   void hessian(const Vec&, SparseMatrix& H) const override { H = sparse_scalar(kStiffness); }
+  const NonConservativeForce* as_forced() const override { return this; }
+  bool has_force_jacobian() const override { return true; }
   void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -kDamping * v; }
   void force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix& C) const override {
     C = sparse_scalar(kDamping);

@@ -152,7 +152,7 @@ class Newmark final : public Integrator {
         if (forced) {
           const Vec v1 = v_predict + (h * gamma_) * a;
           if (problem.has(kForceJacobian)) {
-            problem.force_jacobian_v(q1, v1, t1, damping_);
+            force_of(problem).force_jacobian_v(q1, v1, t1, damping_);
             jacobian += (gamma_ * h) * damping_;
           } else {
             // −∂F(q₁(a), v₁(a))/∂a, differenced; divided by h since the jacobian is scaled below.

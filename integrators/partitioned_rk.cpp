@@ -244,7 +244,7 @@ class ImplicitPartitionedRk final : public Integrator {
   // C = −∂F/∂v at a stage: the problem's force_jacobian_v, or central differences.
   void damping_at(const Problem& problem, const Vec& q, const Vec& v, double t, SparseMatrix& C) {
     if (problem.has(kForceJacobian)) {
-      problem.force_jacobian_v(q, v, t, C);
+      force_of(problem).force_jacobian_v(q, v, t, C);
       return;
     }
     C = -central_difference_jacobian([&](const Vec& y, Vec& f) { eval_force(problem, q, y, t, f); },

@@ -21,8 +21,7 @@ class PenalisedProblem final : public Problem {
   PenalisedProblem(const Problem& base, double stiffness)
       : base_(base), constraints_(constraints_of(base)), stiffness_(stiffness) {
     set_mass(base.mass());
-    set_capabilities(base.capabilities() &
-                     (kHessian | kForce | kForceJacobian | kLinearMomentum | kAngularMomentum));
+    set_capabilities(base.capabilities() & (kHessian | kLinearMomentum | kAngularMomentum));
     set_defaults(base.default_dt(), base.default_t_end());
   }
 
@@ -50,12 +49,8 @@ class PenalisedProblem final : public Problem {
     H = H + stiffness_ * gauss_newton + curvature;
     H.makeCompressed();
   }
-  void force(const Vec& q, const Vec& v, double t, Vec& f) const override {
-    base_.force(q, v, t, f);
-  }
-  void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const override {
-    base_.force_jacobian_v(q, v, t, C);
-  }
+  // The base's force and its Jacobian, unchanged (kForce, kForceJacobian follow from it).
+  const NonConservativeForce* as_forced() const override { return base_.as_forced(); }
   Vec linear_momentum(const Vec& q, const Vec& p) const override {
     return base_.linear_momentum(q, p);
   }

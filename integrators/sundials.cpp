@@ -726,7 +726,7 @@ class Ida final : public SundialsIntegrator {
       problem.gradient(q_, force_);
       force_ = -force_;
       if (problem.has(kForce)) {
-        problem.force(q_, v, t, applied_);
+        force_of(problem).force(q_, v, t, applied_);
         force_ += applied_;
       }
       constraints_->constraint_jacobian_at(t, q_, G_);

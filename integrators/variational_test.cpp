@@ -327,7 +327,7 @@ TEST(ForceSlots, MidpointDriftFollowsTheSignedImpulseTorqueOfItsSlot) {
       Vec force;
       for (int k = 0; k < steps; ++k) {
         const Vec v = (path[k + 1].q - path[k].q) / h;
-        problem->force(path[k].q + (h / 2) * v, v, path[k].t + h / 2, force);
+        force_of(*problem).force(path[k].q + (h / 2) * v, v, path[k].t + h / 2, force);
         double torque = 0;  // Σ_i v_i × F_i (planar)
         for (Eigen::Index i = 0; i + 1 < v.size(); i += 2) {
           torque += v[i] * force[i + 1] - v[i + 1] * force[i];

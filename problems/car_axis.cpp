@@ -10,6 +10,7 @@
 // equations read k q̈ = … + Gᵀλ).
 #include <cmath>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -19,11 +20,11 @@ struct CarAxisParameters {
   double eps, big_mass, length, rest_length, amplitude, frequency, gravity;
 };
 
-class CarAxis final : public Problem, public HolonomicConstraints {
+class CarAxis final : public Problem, public HolonomicConstraints, public NonConservativeForce {
  public:
   explicit CarAxis(const CarAxisParameters& p) : p_(p), mass_(p.big_mass * p.eps * p.eps / 2) {
     set_mass(Vec::Constant(4, mass_));
-    set_capabilities(kHessian | kForce);
+    set_capabilities(kHessian);
     // The Test Set's interval is [0, 3]; the wheels oscillate at ~√(1/k) ≈ 45 rad per time unit.
     set_defaults(1e-3, 3.0);
   }
@@ -61,7 +62,9 @@ class CarAxis final : public Problem, public HolonomicConstraints {
     H.insert(1, 1) = diagonal + outer * q[1] * q[1];
     H.makeCompressed();
   }
-  // The right spring, from the driven point B(t).
+  // The right spring, from the driven point B(t): a force without a Jacobian (it depends on q
+  // and t, not on v).
+  const NonConservativeForce* as_forced() const override { return this; }
   void force(const Vec& q, const Vec&, double t, Vec& f) const override {
     const Driver b = driver(t);
     const double dx = q[2] - b.x, dy = q[3] - b.y;

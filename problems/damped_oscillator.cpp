@@ -4,12 +4,13 @@
 // time in it; undriven, H = ½p² + ½ω²q² decays at exactly dH/dt = −2ζω v².
 #include <cmath>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
 namespace {
 
-class DampedOscillator final : public Problem {
+class DampedOscillator final : public Problem, public NonConservativeForce {
  public:
   DampedOscillator(double omega, double zeta, double q0, double v0, double drive_amplitude,
                    double drive_omega)
@@ -21,11 +22,7 @@ class DampedOscillator final : public Problem {
         drive_amplitude_(drive_amplitude),
         drive_omega_(drive_omega) {
     set_mass(Vec::Ones(1));
-    unsigned capabilities = kHessian | kExact | kOmegaMax;
-    // Without damping and driving this is the harmonic oscillator, and the harness can use the
-    // conserved H.
-    if (zeta > 0 || drive_amplitude != 0) capabilities |= kForce | kForceJacobian;
-    set_capabilities(capabilities);
+    set_capabilities(kHessian | kExact | kOmegaMax);
     // 0.05 and 50 at ω = 1; scaled by 1/ω so that every ω gets the same steps per cycle and
     // stays inside the explicit methods' stability limits (hω < 2).
     set_defaults(0.05 / omega, 50.0 / omega);
@@ -47,6 +44,12 @@ class DampedOscillator final : public Problem {
     H.makeCompressed();
   }
 
+  // Without damping and driving this is the harmonic oscillator, and the harness can use the
+  // conserved H: no force then.
+  const NonConservativeForce* as_forced() const override {
+    return zeta_ > 0 || drive_amplitude_ != 0 ? this : nullptr;
+  }
+  bool has_force_jacobian() const override { return true; }
   void force(const Vec&, const Vec& v, double t, Vec& f) const override {
     f = Vec::Constant(1, -2 * decay_rate_ * v[0] + drive(t));
   }

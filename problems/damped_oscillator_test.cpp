@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 #include "tests/test_util.hpp"
 
@@ -91,7 +92,7 @@ TEST(DampedOscillator, ExactSolvesEquationOfMotion) {
       EXPECT_NEAR(p_rate, acceleration, 1e-7 * rate_scale * scale) << c.spec << " t = " << t;
       // The problem's own force is the same driving (the integrators see only force()).
       Vec f;
-      problem->force(at.q, at.p, t, f);
+      force_of(*problem).force(at.q, at.p, t, f);
       EXPECT_NEAR(f[0] - c.omega * c.omega * at.q[0], acceleration, 1e-12 * c.omega * scale)
           << c.spec;
     }
@@ -104,10 +105,10 @@ TEST(DampedOscillator, ForceAndDampingMatrixAgree) {
   ASSERT_TRUE(problem->has(kForceJacobian));
   const Vec q = Vec::Constant(1, 0.3);
   Vec f;
-  problem->force(q, Vec::Constant(1, -1.5), 0.0, f);
+  force_of(*problem).force(q, Vec::Constant(1, -1.5), 0.0, f);
   EXPECT_NEAR(f[0], 2 * 0.25 * 2 * 1.5, 4 * DBL_EPSILON);
   SparseMatrix C;
-  problem->force_jacobian_v(q, Vec::Constant(1, -1.5), 0.0, C);
+  force_of(*problem).force_jacobian_v(q, Vec::Constant(1, -1.5), 0.0, C);
   EXPECT_NEAR(C.coeff(0, 0), 2 * 0.25 * 2, 4 * DBL_EPSILON);
 }
 
@@ -182,6 +183,87 @@ TEST(DampedOscillator, RejectsNegativeDampingAndBadFrequency) {
            {"damped_oscillator:omega=0", "omega=0"},
        }) {
     EXPECT_TRUE(test::input_error_names(make_problem, spec, key));
+  }
+}
+
+// Linear drag F = −c v with c = 350 on a particle of mass 0.02 in a well of stiffness 8e3
+// (non-unit scales), built without the registry: kForce and kForceJacobian come from the
+// interface alone. `offer` makes as_forced() return it, `jacobian` is has_force_jacobian(),
+// `claim` goes to set_capabilities (a problem that tries to declare the bits itself).
+class Drag final : public Problem, public NonConservativeForce {
+ public:
+  Drag(bool offer, bool jacobian, unsigned claim) : offer_(offer), jacobian_(jacobian) {
+    set_mass(Vec::Constant(1, 0.02));
+    set_capabilities(kHessian | claim);
+  }
+  const NonConservativeForce* as_forced() const override { return offer_ ? this : nullptr; }
+  bool has_force_jacobian() const override { return jacobian_; }
+  State initial_state() const override {
+    return {0.0, Vec::Constant(1, 1e-3), Vec::Constant(1, 0.02 * 4.0)};
+  }
+  double potential(const Vec& q) const override { return 0.5 * 8e3 * q.squaredNorm(); }
+  void gradient(const Vec& q, Vec& g) const override { g = 8e3 * q; }
+  void hessian(const Vec&, SparseMatrix& H) const override {
+    H.resize(1, 1);
+    H.insert(0, 0) = 8e3;
+    H.makeCompressed();
+  }
+  void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -350.0 * v; }
+  void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const override {
+    if (!jacobian_) return NonConservativeForce::force_jacobian_v(q, v, t, C);  // throws
+    C.resize(1, 1);
+    C.insert(0, 0) = 350.0;
+    C.makeCompressed();
+  }
+
+ private:
+  bool offer_, jacobian_;
+};
+
+// One source of truth for kForce and kForceJacobian: as_forced() and has_force_jacobian() set
+// them, the first-order view and the multipliers go through the query, and a problem that
+// declares either bit is refused at construction.
+TEST(NonConservativeForce, CapabilitiesFollowTheQueryAndCannotBeClaimed) {
+  const Drag drag(true, true, 0);
+  EXPECT_TRUE(drag.has(kForce));
+  EXPECT_TRUE(drag.has(kForceJacobian));
+  EXPECT_EQ(capability_names(drag.capabilities()),
+            (std::vector<std::string>{"hessian", "force", "force_jacobian"}));
+  EXPECT_EQ(&force_of(drag), static_cast<const NonConservativeForce*>(&drag));
+  // ṗ = −k q − c v at q = 1e-3, v = 4: −8 − 1400.
+  const State start = drag.initial_state();
+  Vec y(2), ydot;
+  drag.pack_first_order(start, y.data());
+  drag.first_order_rhs(0.0, y, ydot);
+  EXPECT_DOUBLE_EQ(ydot[0], 4.0);
+  EXPECT_DOUBLE_EQ(ydot[1], -8.0 - 1400.0);
+  // ∂ṗ/∂p = −c/m from the damping matrix.
+  SparseMatrix J;
+  drag.first_order_jacobian(0.0, y, J);
+  EXPECT_DOUBLE_EQ(J.coeff(1, 1), -350.0 / 0.02);
+  const Drag without_jacobian(true, false, 0);
+  EXPECT_TRUE(without_jacobian.has(kForce));
+  EXPECT_FALSE(without_jacobian.has(kForceJacobian));
+  EXPECT_EQ(capability_names(without_jacobian.capabilities()),
+            (std::vector<std::string>{"hessian", "force"}));
+  SparseMatrix C;
+  EXPECT_THROW(force_of(without_jacobian).force_jacobian_v(start.q, ydot, 0.0, C),
+               std::logic_error);
+  // Declining: no force anywhere, H is conserved (ṗ = −k q alone).
+  const Drag declined(false, true, 0);
+  EXPECT_FALSE(declined.has(kForce));
+  EXPECT_FALSE(declined.has(kForceJacobian));
+  EXPECT_THROW(force_of(declined), std::logic_error);
+  declined.first_order_rhs(0.0, y, ydot);
+  EXPECT_DOUBLE_EQ(ydot[1], -8.0);
+  for (const unsigned claim : {unsigned{kForce}, unsigned{kForceJacobian}}) {
+    try {
+      Drag claimed(true, true, claim);
+      ADD_FAILURE() << "set_capabilities accepted " << capability_names(claim)[0];
+    } catch (const std::logic_error& error) {
+      EXPECT_NE(std::string(error.what()).find(capability_names(claim)[0]), std::string::npos)
+          << error.what();
+    }
   }
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/parallel.hpp"
 #include "problems/problem.hpp"
 
@@ -198,7 +199,7 @@ void element_matrix(const Mat9& A, const Mat43& G, double volume, Mat12& K) {
   K = 0.5 * sum;
 }
 
-class ElasticBar final : public Problem, public HolonomicConstraints {
+class ElasticBar final : public Problem, public HolonomicConstraints, public NonConservativeForce {
  public:
   explicit ElasticBar(const BarConfig& config)
       : config_(config),
@@ -206,7 +207,6 @@ class ElasticBar final : public Problem, public HolonomicConstraints {
         lambda_(config.young * config.poisson / ((1 + config.poisson) * (1 - 2 * config.poisson))) {
     build_mesh();
     unsigned capabilities = kHessian | kOmegaMax;
-    if (config_.damping > 0) capabilities |= kForce | kForceJacobian;
     // Internal forces are sums over elements of functions of F, invariant under rigid motions;
     // only the clamp and gravity break the symmetry, and the factory forbids gravity unclamped.
     if (config_.clamp == Clamp::kNone) capabilities |= kLinearMomentum | kAngularMomentum;
@@ -289,6 +289,10 @@ class ElasticBar final : public Problem, public HolonomicConstraints {
   // ν h vol (μ tr(d²) + (λ/2)(tr d)²), whose force −∂/∂q_{k+1} = −(1/h) ∂/∂v is this one with d
   // in place of Ė: equal at small strain, and both are C = νK at rest (docs/METHOD.md §6). Ė is
   // used because it keeps D an exact quadratic form in v (a constant, PSD C) at any F.
+  const NonConservativeForce* as_forced() const override {
+    return config_.damping > 0 ? this : nullptr;
+  }
+  bool has_force_jacobian() const override { return true; }
   void force(const Vec& q, const Vec& v, double, Vec& f) const override {
     const double nu = config_.damping;
     assemble_nodal(

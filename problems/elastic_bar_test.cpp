@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 #include "tests/test_util.hpp"
 
@@ -226,7 +227,7 @@ TEST(ElasticBar, DampingIsFrameInvariantDissipativeAndLinear) {
   const Vec q = map_nodes(problem->initial_state().q + 0.03 * random_vector(n, 13),
                           random_rotation(14), Vec3(1, 1, -2));
   SparseMatrix C;
-  problem->force_jacobian_v(q, Vec::Zero(n), 0.0, C);
+  force_of(*problem).force_jacobian_v(q, Vec::Zero(n), 0.0, C);
   const Dense dense(C);
   EXPECT_EQ((dense - dense.transpose()).cwiseAbs().maxCoeff(), 0.0);
   const Vec eigenvalues = Eigen::SelfAdjointEigenSolver<Dense>(dense).eigenvalues();
@@ -238,7 +239,7 @@ TEST(ElasticBar, DampingIsFrameInvariantDissipativeAndLinear) {
   for (unsigned seed : {15u, 16u, 17u}) {
     const Vec v = random_vector(n, seed);
     Vec f;
-    problem->force(q, v, 0.0, f);
+    force_of(*problem).force(q, v, 0.0, f);
     // Dissipation vᵀf = −2D < 0, zero net force and torque (Ė depends on relative motion).
     EXPECT_LT(v.dot(f), -1e-3 * v.norm() * f.norm());
     EXPECT_LE(net(f).lpNorm<Eigen::Infinity>(), 256 * DBL_EPSILON * f.lpNorm<1>());
@@ -248,7 +249,7 @@ TEST(ElasticBar, DampingIsFrameInvariantDissipativeAndLinear) {
     // C against central differences of −f in v, exact up to rounding because f is linear.
     const auto minus_force = [&](const Vec& w) {
       Vec y;
-      problem->force(q, w, 0.0, y);
+      force_of(*problem).force(q, w, 0.0, y);
       return Vec(-y);
     };
     for (int j = 0; j < n; j += 7) {
@@ -264,8 +265,8 @@ TEST(ElasticBar, DampingIsFrameInvariantDissipativeAndLinear) {
   for (int i = 0; i < n; i += 3) rigid.segment<3>(i) = omega.cross(Vec3(q.segment<3>(i))) + drift;
   const Vec generic = random_vector(n, 18);
   Vec f_rigid, f_generic;
-  problem->force(q, rigid, 0.0, f_rigid);
-  problem->force(q, generic, 0.0, f_generic);
+  force_of(*problem).force(q, rigid, 0.0, f_rigid);
+  force_of(*problem).force(q, generic, 0.0, f_generic);
   EXPECT_LE(inf_norm(f_rigid), 1e-12 * inf_norm(f_generic) / inf_norm(generic) * inf_norm(rigid));
 }
 
@@ -276,7 +277,7 @@ TEST(ElasticBar, DampingAtRestIsStiffnessProportional) {
     const auto problem = make_problem("elastic_bar:nx=3,damping=0.01,material=" + material);
     const Vec rest = problem->initial_state().q;
     SparseMatrix C, K;
-    problem->force_jacobian_v(rest, Vec::Zero(problem->dof()), 0.0, C);
+    force_of(*problem).force_jacobian_v(rest, Vec::Zero(problem->dof()), 0.0, C);
     problem->hessian(rest, K);
     const Dense difference = Dense(C) - 0.01 * Dense(K);
     EXPECT_LE(difference.cwiseAbs().maxCoeff(), 1e-13 * Dense(C).cwiseAbs().maxCoeff()) << material;
@@ -487,7 +488,7 @@ TEST(ElasticBar, DampedFreeBarConservesMomenta) {
     Vec g, f;
     const Vec v = problem->inverse_mass().cwiseProduct(state.p);
     problem->gradient(state.q, g);
-    problem->force(state.q, v, state.t, f);
+    force_of(*problem).force(state.q, v, state.t, f);
     state.p += h * (f - g);
     state.q += h * problem->inverse_mass().cwiseProduct(state.p);
     state.t += h;

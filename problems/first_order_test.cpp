@@ -1,6 +1,8 @@
-// The first-order-only problems (capability kFirstOrderOnly, docs/DESIGN.md §2): sizes, the
-// Test Set's initial values and end references, and rhs_jacobian against central differences
-// of rhs, for every registered problem that declares the capability.
+// The first-order-only problems (FirstOrderSystem, capability kFirstOrderOnly, docs/DESIGN.md §2):
+// sizes, the Test Set's initial values and end references, and rhs_jacobian against central
+// differences of rhs, for every registered problem that offers the interface.
+#include "problems/first_order.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -50,6 +52,7 @@ TEST(FirstOrderProblems, StateIsYAloneAndThereIsNoEnergy) {
 TEST(FirstOrderProblems, RhsJacobianMatchesFiniteDifferences) {
   for (const auto& spec : first_order_specs()) {
     const auto problem = make_problem(spec);
+    const FirstOrderSystem& system = first_order_system_of(*problem);
     const Vec y0 = problem->initial_state().q;
     Vec f0;
     problem->first_order_rhs(0.0, y0, f0);
@@ -69,10 +72,10 @@ TEST(FirstOrderProblems, RhsJacobianMatchesFiniteDifferences) {
         Vec plus = y, minus = y, plus2 = y, minus2 = y;
         plus[j] += h, minus[j] -= h, plus2[j] += 2 * h, minus2[j] -= 2 * h;
         Vec fp, fm, fp2, fm2;
-        problem->rhs(0.0, plus, fp);
-        problem->rhs(0.0, minus, fm);
-        problem->rhs(0.0, plus2, fp2);
-        problem->rhs(0.0, minus2, fm2);
+        system.rhs(0.0, plus, fp);
+        system.rhs(0.0, minus, fm);
+        system.rhs(0.0, plus2, fp2);
+        system.rhs(0.0, minus2, fm2);
         const Vec column = (8 * (fp - fm) - (fp2 - fm2)) / (12 * h);
         for (int i = 0; i < y.size(); ++i) {
           EXPECT_NEAR(dense(i, j), column[i], 1e-7 * size)
@@ -110,6 +113,63 @@ TEST(FirstOrderProblems, TestSetInitialValuesAndReferences) {
   // Mass conservation: Σ y' = 0.
   rober->first_order_rhs(0.0, (Vec(3) << 0.5, 1e-5, 0.3).finished(), f);
   EXPECT_NEAR(f.sum(), 0.0, 1e-12);
+}
+
+// Exponential decay y' = −k y with k = 250 and y0 = 3e-4 (non-unit scales), built without the
+// registry and without FirstOrderProblem: its kind comes from the interface alone. `offer` makes
+// as_first_order() return it, `claim` is passed to set_capabilities (a problem that tries to
+// declare the bit itself).
+class Decay final : public Problem, public FirstOrderSystem {
+ public:
+  Decay(bool offer, unsigned claim) : offer_(offer) {
+    set_mass(Vec::Ones(1));
+    set_capabilities(kExact | claim);
+  }
+  const FirstOrderSystem* as_first_order() const override { return offer_ ? this : nullptr; }
+  State initial_state() const override { return {0.0, Vec::Constant(1, 3e-4), Vec()}; }
+  double potential(const Vec&) const override { return 0.0; }
+  void gradient(const Vec& q, Vec& g) const override { g = Vec::Zero(q.size()); }
+  void rhs(double, const Vec& y, Vec& ydot) const override { ydot = -250.0 * y; }
+  void rhs_jacobian(double, const Vec&, SparseMatrix& J) const override {
+    J.resize(1, 1);
+    J.insert(0, 0) = -250.0;
+    J.makeCompressed();
+  }
+
+ private:
+  bool offer_;
+};
+
+// One source of truth for kFirstOrderOnly and the kind kFirstOrder: as_first_order() sets them,
+// the first-order view goes through it, and a problem that declares the bit is refused.
+TEST(FirstOrderProblems, KindFollowsTheQueryAndCannotBeClaimed) {
+  const Decay decay(true, 0);
+  EXPECT_TRUE(decay.has(kFirstOrderOnly));
+  EXPECT_EQ(decay.kind(), ProblemKind::kFirstOrder);
+  EXPECT_EQ(capability_names(decay.capabilities()),
+            (std::vector<std::string>{"exact", "first_order_only"}));
+  EXPECT_EQ(decay.first_order_size(), 1);
+  Vec ydot;
+  decay.first_order_rhs(0.0, decay.initial_state().q, ydot);
+  EXPECT_EQ(ydot[0], -250.0 * 3e-4);
+  SparseMatrix J;
+  decay.first_order_jacobian(0.0, decay.initial_state().q, J);
+  EXPECT_EQ(J.coeff(0, 0), -250.0);
+  EXPECT_EQ(&first_order_system_of(decay), static_cast<const FirstOrderSystem*>(&decay));
+  // Declining the interface: a separable problem with y = (q, p), whatever the class derives from.
+  const Decay declined(false, 0);
+  EXPECT_FALSE(declined.has(kFirstOrderOnly));
+  EXPECT_EQ(declined.kind(), ProblemKind::kSeparable);
+  EXPECT_EQ(declined.first_order_size(), 2);
+  EXPECT_THROW(first_order_system_of(declined), std::logic_error);
+  try {
+    Decay claimed(false, kFirstOrderOnly);
+    ADD_FAILURE() << "set_capabilities accepted kFirstOrderOnly";
+  } catch (const std::logic_error& error) {
+    EXPECT_NE(std::string(error.what()).find("first_order_only"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_THROW(Decay(true, kFirstOrderOnly), std::logic_error);
 }
 
 }  // namespace

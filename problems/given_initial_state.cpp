@@ -23,7 +23,7 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
         initial_(std::move(initial)) {
     set_mass(base_->mass());
     // The exact solution, period and tabulated end state belong to the problem's own start;
-    // the constraint capabilities follow from as_constrained() below.
+    // the constraint and force capabilities follow from as_constrained() and as_forced() below.
     set_capabilities(base_->capabilities() &
                      ~(kExact | kPeriod | kEndReference | kDerivedCapabilities));
     set_defaults(base_->default_dt(), base_->default_t_end());
@@ -34,12 +34,8 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
   void gradient(const Vec& q, Vec& g) const override { base_->gradient(q, g); }
   FixedGradient fixed_gradient() const override { return base_->fixed_gradient(); }
   void hessian(const Vec& q, SparseMatrix& H) const override { base_->hessian(q, H); }
-  void force(const Vec& q, const Vec& v, double t, Vec& f) const override {
-    base_->force(q, v, t, f);
-  }
-  void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const override {
-    base_->force_jacobian_v(q, v, t, C);
-  }
+  // The base's force (and its Jacobian) as they are: they do not depend on the start.
+  const NonConservativeForce* as_forced() const override { return base_->as_forced(); }
   Vec linear_momentum(const Vec& q, const Vec& p) const override {
     return base_->linear_momentum(q, p);
   }

@@ -7,22 +7,24 @@
 #include <cmath>
 #include <numbers>
 
+#include "problems/force.hpp"
 #include "problems/oscillator_base.hpp"
 
 namespace geomint {
 namespace {
 
-class ParametricOscillator final : public OscillatorBase {
+class ParametricOscillator final : public OscillatorBase, public NonConservativeForce {
  public:
   ParametricOscillator(double omega, double epsilon, double nu, double mass, double q0, double v0)
       : OscillatorBase(omega, mass, q0, v0), epsilon_(epsilon), nu_(nu) {
-    // kForceJacobian would claim ∂F/∂v is the whole force derivative; F depends on q here, so
-    // the implicit solvers difference it instead.
-    set_capabilities(kHessian | kForce | kOmegaMax);
+    set_capabilities(kHessian | kOmegaMax);
     // 125 steps per unmodulated period, ten periods.
     set_defaults(0.05 / omega, 20 * std::numbers::pi / omega);
   }
 
+  // No has_force_jacobian(): it would claim ∂F/∂v is the whole force derivative; F depends on q
+  // here, so the implicit solvers difference it instead.
+  const NonConservativeForce* as_forced() const override { return this; }
   void force(const Vec& q, const Vec&, double t, Vec& f) const override {
     f = Vec::Constant(1, -stiffness() * epsilon_ * std::cos(nu_ * t) * q[0]);
   }

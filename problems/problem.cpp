@@ -6,6 +6,8 @@
 #include <Eigen/Cholesky>
 #include <limits>
 
+#include "problems/first_order.hpp"
+#include "problems/force.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -133,7 +135,7 @@ const char* kind_name(ProblemKind kind) {
 }
 
 ProblemKind Problem::kind() const {
-  if (has(kFirstOrderOnly)) return ProblemKind::kFirstOrder;
+  if (as_first_order() != nullptr) return ProblemKind::kFirstOrder;
   if (as_lagrangian() != nullptr) return ProblemKind::kLagrangian;
   return ProblemKind::kSeparable;
 }
@@ -149,9 +151,10 @@ const LagrangianSystem& general_system(const Problem& problem) { return *problem
 
 void Problem::hessian(const Vec&, SparseMatrix&) const { missing(*this, "hessian"); }
 double Problem::casimir(const Vec&, const Vec&) const { missing(*this, "casimir"); }
-void Problem::force(const Vec&, const Vec&, double, Vec&) const { missing(*this, "force"); }
-void Problem::force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix&) const {
-  missing(*this, "force Jacobian");
+void NonConservativeForce::force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix&) const {
+  throw std::logic_error(
+      "NonConservativeForce::force_jacobian_v: this force has no Jacobian (has_force_jacobian() "
+      "is false, so the problem lacks kForceJacobian)");
 }
 State Problem::exact(double) const { missing(*this, "exact solution"); }
 Vec Problem::linear_momentum(const Vec&, const Vec&) const { missing(*this, "linear momentum"); }
@@ -165,16 +168,57 @@ unsigned Problem::capabilities() const {
     derived |= kConstraints;
     if (constraints->time_dependent()) derived |= kTimeDependentConstraints;
   }
+  if (as_first_order() != nullptr) derived |= kFirstOrderOnly;
+  if (const NonConservativeForce* forced = as_forced()) {
+    derived |= kForce;
+    if (forced->has_force_jacobian()) derived |= kForceJacobian;
+  }
   return capabilities_ | derived;
+}
+
+bool Problem::has_derived(Capability c) const {
+  switch (c) {
+    case kFirstOrderOnly:
+      return as_first_order() != nullptr;
+    case kForce:
+      return as_forced() != nullptr;
+    case kForceJacobian: {
+      const NonConservativeForce* forced = as_forced();
+      return forced != nullptr && forced->has_force_jacobian();
+    }
+    case kConstraints:
+      return as_constrained() != nullptr;
+    case kTimeDependentConstraints: {
+      const HolonomicConstraints* constraints = as_constrained();
+      return constraints != nullptr && constraints->time_dependent();
+    }
+    default:
+      return (capabilities() & c) != 0;
+  }
 }
 
 void Problem::set_capabilities(unsigned capabilities) {
   if ((capabilities & kDerivedCapabilities) != 0) {
-    throw std::logic_error(
-        "Problem::set_capabilities: kConstraints and kTimeDependentConstraints are derived from "
-        "as_constrained() (problems/constraints.hpp), not declared");
+    throw std::logic_error(fmt::format(
+        "Problem::set_capabilities: {} derived from the structure queries, not declared "
+        "(kConstraints and kTimeDependentConstraints from as_constrained(), problems/"
+        "constraints.hpp; kFirstOrderOnly from as_first_order(), problems/first_order.hpp; "
+        "kForce and kForceJacobian from as_forced(), problems/force.hpp)",
+        fmt::join(capability_names(capabilities & kDerivedCapabilities), ", ")));
   }
   capabilities_ = capabilities;
+}
+
+const NonConservativeForce& force_of(const Problem& problem) {
+  const NonConservativeForce* forced = problem.as_forced();
+  if (forced == nullptr) missing(problem, "force");
+  return *forced;
+}
+
+const FirstOrderSystem& first_order_system_of(const Problem& problem) {
+  const FirstOrderSystem* system = problem.as_first_order();
+  if (system == nullptr) missing(problem, "first-order system y' = f(t, y)");
+  return *system;
 }
 
 const HolonomicConstraints& constraints_of(const Problem& problem) {
@@ -188,9 +232,9 @@ Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
   Vec force_total;
   gradient(q, force_total);
   force_total = -force_total;
-  if (has(kForce)) {
+  if (const NonConservativeForce* forced = as_forced()) {
     Vec f;
-    force(q, v, t, f);
+    forced->force(q, v, t, f);
     force_total += f;
   }
   const HolonomicConstraints& constraints = constraints_of(*this);
@@ -303,16 +347,12 @@ void Problem::unpack_first_order(const double* y, State& state) const {
   }
 }
 
-void Problem::rhs(double, const Vec&, Vec&) const { missing(*this, "first-order rhs"); }
-void Problem::rhs_jacobian(double, const Vec&, SparseMatrix&) const {
-  missing(*this, "first-order rhs_jacobian");
-}
 double Problem::end_reference_time() const { missing(*this, "end reference"); }
 State Problem::end_reference() const { missing(*this, "end reference"); }
 
 void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
-  if (has(kFirstOrderOnly)) {
-    rhs(t, y, ydot);
+  if (const FirstOrderSystem* system = as_first_order()) {
+    system->rhs(t, y, ydot);
     return;
   }
   const int n = dof();
@@ -335,16 +375,16 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
   gradient(y.head(n), g);
   ydot.head(n) = v;
   ydot.tail(n) = -g;
-  if (has(kForce)) {
+  if (const NonConservativeForce* forced = as_forced()) {
     Vec f;
-    force(y.head(n), v, t, f);
+    forced->force(y.head(n), v, t, f);
     ydot.tail(n) += f;
   }
 }
 
 void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const {
-  if (has(kFirstOrderOnly)) {
-    rhs_jacobian(t, y, J);
+  if (const FirstOrderSystem* system = as_first_order()) {
+    system->rhs_jacobian(t, y, J);
     return;
   }
   const int n = dof();
@@ -372,12 +412,12 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
       triplets.emplace_back(n + it.row(), it.col(), -it.value());
     }
   }
-  if (has(kForce)) {
+  if (const NonConservativeForce* forced = as_forced()) {
     // ∂F/∂p = −C M⁻¹ from the analytic damping matrix; ∂F/∂q by central differences, because
     // forces (damping, driving) rarely provide it and it only shapes the Newton matrix.
-    if (has(kForceJacobian)) {
+    if (forced->has_force_jacobian()) {
       SparseMatrix C;
-      force_jacobian_v(q, v, t, C);
+      forced->force_jacobian_v(q, v, t, C);
       for (int k = 0; k < C.outerSize(); ++k) {
         for (SparseMatrix::InnerIterator it(C, k); it; ++it) {
           triplets.emplace_back(n + it.row(), n + it.col(), -it.value() * inverse_mass_[it.col()]);
@@ -393,9 +433,9 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
       const double size = std::max(std::abs(q[j]), q_size);
       const double delta = 1e-7 * (size > 0.0 && std::isfinite(size) ? size : 1.0);
       q_shift[j] = q[j] + delta;
-      force(q_shift, v, t, f_plus);
+      forced->force(q_shift, v, t, f_plus);
       q_shift[j] = q[j] - delta;
-      force(q_shift, v, t, f_minus);
+      forced->force(q_shift, v, t, f_minus);
       q_shift[j] = q[j];
       for (int i = 0; i < n; ++i) {
         const double d = (f_plus[i] - f_minus[i]) / (2 * delta);

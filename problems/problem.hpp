@@ -1,6 +1,7 @@
 // The Problem interface (docs/DESIGN.md §2): a Lagrangian system L(q, v) = ½ vᵀMv − V(q) with a
-// constant diagonal (lumped) mass matrix, optional non-conservative force, exact solution and
-// momentum maps. Problems declare capabilities; the harness runs only what applies.
+// constant diagonal (lumped) mass matrix, exact solution and momentum maps, and the queries for
+// what else a kind of system offers (a first-order ODE, a general Lagrangian, constraints, a
+// non-conservative force). Problems declare capabilities; the harness runs only what applies.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,21 +31,23 @@ struct State {
 // solution only when it librates, a spring network has angular momentum only when free.
 enum Capability : unsigned {
   kHessian = 1u << 0,          // hessian(q, H)
-  kForce = 1u << 1,            // force(q, v, t): non-conservative (damping, driving)
+  kForce = 1u << 1,            // as_forced(): a non-conservative force F(q, v, t) (derived)
   kExact = 1u << 2,            // exact(t)
   kLinearMomentum = 1u << 3,   // linear_momentum(q, p) is a conserved quantity
   kAngularMomentum = 1u << 4,  // angular_momentum(q, p) is a conserved quantity
   kPeriod = 1u << 5,           // period()
   kOmegaMax = 1u << 6,         // omega_max(q)
-  kForceJacobian = 1u << 7,    // force_jacobian_v(q, v, t, C) for implicit dissipative solves
+  // as_forced()->has_force_jacobian(): C = −∂F/∂v for implicit dissipative solves (derived)
+  kForceJacobian = 1u << 7,
   // Holonomic constraints g(q) = 0 (PAPER.md §3) and rheonomic g(q, t) = 0 (car_axis): derived
   // from Problem::as_constrained() and HolonomicConstraints::time_dependent(), never declared
   // (set_capabilities refuses them), so a problem cannot claim one without the other.
   kConstraints = 1u << 8,
   kTimeDependentConstraints = 1u << 9,
   // A first-order ODE y' = f(t, y) that is no Lagrangian system (van der Pol, Robertson): y is
-  // State::q, State::p is empty, rhs()/rhs_jacobian() define it; V, ∇V, M and H mean nothing
-  // (energy() is NaN). Only methods with the flag kFirstOrderCapable run it (applicable()).
+  // State::q, State::p is empty, its FirstOrderSystem (problems/first_order.hpp) defines it; V,
+  // ∇V, M and H mean nothing (energy() is NaN). Only methods with the flag kFirstOrderCapable run
+  // it (applicable()). Derived from Problem::as_first_order(), never declared.
   kFirstOrderOnly = 1u << 10,
   kEndReference = 1u << 11,  // end_reference(): a tabulated state at one time (IVP Test Set)
   // casimir(q, p): a Casimir of the problem's Poisson structure that the motion keeps whatever
@@ -55,9 +58,12 @@ enum Capability : unsigned {
 // Capability names for `geomint list` and error messages.
 std::vector<std::string> capability_names(unsigned capabilities);
 
-// The interfaces a problem may offer beyond Problem (problems/lagrangian.hpp,
-// problems/rigid_body.hpp, problems/charged_particle.hpp).
+// The interfaces a problem may offer beyond Problem (problems/first_order.hpp,
+// problems/lagrangian.hpp, problems/force.hpp, problems/rigid_body.hpp,
+// problems/charged_particle.hpp).
+class FirstOrderSystem;
 class LagrangianSystem;
+class NonConservativeForce;
 class FreeRigidBodyStructure;
 class AttitudeProblem;
 class ChargedParticleStructure;
@@ -65,7 +71,7 @@ class ChargedParticleStructure;
 // The kind of system a problem is (docs/DESIGN.md §2): which interface defines its motion, and so
 // which methods can run it (MethodInfo's kinds, integrators/integrator.hpp).
 enum class ProblemKind : unsigned {
-  // y' = f(t, y) and nothing more (van der Pol, Robertson): rhs()/rhs_jacobian(); y is State::q,
+  // y' = f(t, y) and nothing more (van der Pol, Robertson): as_first_order(); y is State::q,
   // State::p is empty, and V, ∇V, M and H mean nothing (has(kFirstOrderOnly)).
   kFirstOrder = 1u << 0,
   // L = ½vᵀMv − V(q) with a constant diagonal M: mass(), potential(), gradient() and the fast
@@ -86,18 +92,24 @@ class Problem {
   // Registry name ("pendulum").
   const std::string& name() const { return name_; }
   // The declared capabilities plus the ones derived from the structure queries (kConstraints,
-  // kTimeDependentConstraints from as_constrained()). has() asks the query only for those bits.
+  // kTimeDependentConstraints from as_constrained(), kFirstOrderOnly from as_first_order(),
+  // kForce and kForceJacobian from as_forced()).
+  // has() asks only the one query a derived bit comes from.
   unsigned capabilities() const;
   bool has(Capability c) const {
-    return ((c & kDerivedCapabilities) != 0 ? capabilities() & c : capabilities_ & c) != 0;
+    return (c & kDerivedCapabilities) != 0 ? has_derived(c) : (capabilities_ & c) != 0;
   }
-  static constexpr unsigned kDerivedCapabilities = kConstraints | kTimeDependentConstraints;
+  static constexpr unsigned kDerivedCapabilities =
+      kConstraints | kTimeDependentConstraints | kFirstOrderOnly | kForce | kForceJacobian;
 
   // ---- The kind and the structures the problem offers, each by one query (nullptr: absent) ----
   // A class that offers one derives from its interface as well and returns `this`; the queries
   // replace dynamic_casts and are checked against them for every registered problem
   // (problems/problems_test.cpp, ProblemKinds).
   ProblemKind kind() const;
+  // The first-order ODE y' = f(t, y) of a kFirstOrder problem (problems/first_order.hpp, whose
+  // FirstOrderProblem base returns it); such a problem has no Lagrangian pieces at all.
+  virtual const FirstOrderSystem* as_first_order() const { return nullptr; }
   // The general Lagrangian interface (problems/lagrangian.hpp) of a kLagrangian problem. Such a
   // problem's mass() is a placeholder of ones that only sets dof(), p = M(q)v + a(q), energy() is
   // H(q, p) and first_order_rhs() Hamilton's equations.
@@ -111,6 +123,10 @@ class Problem {
   // Holonomic constraints g(q) = 0 or g(q, t) = 0 (problems/constraints.hpp: what a constrained
   // problem implements). Callers take the pointer once per run or step, not per element.
   virtual const HolonomicConstraints* as_constrained() const { return nullptr; }
+  // A non-conservative generalized force F(q, v, t) (damping, driving) added to −∇V
+  // (problems/force.hpp: what a forced problem implements). Instance-level like the constraints:
+  // a damped oscillator with ζ = 0 and no drive returns nullptr and conserves H.
+  virtual const NonConservativeForce* as_forced() const { return nullptr; }
 
   int dof() const { return static_cast<int>(mass_.size()); }
   virtual State initial_state() const = 0;
@@ -127,11 +143,6 @@ class Problem {
   virtual FixedGradient fixed_gradient() const { return {}; }
   // H = ∇²V(q), symmetric, compressed. Only when has(kHessian).
   virtual void hessian(const Vec& q, SparseMatrix& H) const;
-  // Non-conservative generalized force F(q, v, t) (added to −∇V). Only when has(kForce).
-  virtual void force(const Vec& q, const Vec& v, double t, Vec& f) const;
-  // C = −∂F/∂v (damping matrix, symmetric PSD for dissipative forces). Only when
-  // has(kForceJacobian).
-  virtual void force_jacobian_v(const Vec& q, const Vec& v, double t, SparseMatrix& C) const;
   // Exact solution. Only when has(kExact).
   virtual State exact(double t) const;
   // Total linear momentum Σ p_i per spatial direction. Only when has(kLinearMomentum).
@@ -190,10 +201,13 @@ class Problem {
   // First-order view y = (q, p), y' = (M⁻¹p, −∇V(q) + F(q, M⁻¹p, t)) for ODE solvers; on a
   // kFirstOrderOnly problem y = q and y' = rhs(t, y).
   void first_order_rhs(double t, const Vec& y, Vec& ydot) const;
-  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs has_first_order_jacobian(); uses
-  // kForceJacobian if kForce, otherwise the force's q/v dependence is differenced numerically).
+  // Sparse Jacobian ∂y'/∂y of first_order_rhs (needs has_first_order_jacobian()). A force's
+  // ∂F/∂q is differenced numerically; its ∂F/∂p = −C M⁻¹ comes from force_jacobian_v when
+  // has(kForceJacobian) and is left out otherwise (the catalogue's forces without a Jacobian,
+  // car_axis and parametric_oscillator, do not depend on v).
   void first_order_jacobian(double t, const Vec& y, SparseMatrix& J) const;
-  // Whether first_order_jacobian is analytic: a Hessian, or a first-order problem's rhs_jacobian.
+  // Whether first_order_jacobian is analytic: a Hessian, or a first-order problem's
+  // FirstOrderSystem::rhs_jacobian.
   bool has_first_order_jacobian() const { return has(kHessian) || has(kFirstOrderOnly); }
   // Length of y: 2·dof, or dof on a kFirstOrderOnly problem.
   int first_order_size() const { return has(kFirstOrderOnly) ? dof() : 2 * dof(); }
@@ -201,11 +215,10 @@ class Problem {
   void pack_first_order(const State& state, double* y) const;
   void unpack_first_order(const double* y, State& state) const;
 
-  // kFirstOrderOnly problems: y' = f(t, y) and its Jacobian ∂f/∂y (sparse, n × n).
-  virtual void rhs(double t, const Vec& y, Vec& ydot) const;
-  virtual void rhs_jacobian(double t, const Vec& y, SparseMatrix& J) const;
   // kEndReference: a reference state at end_reference_time() (the IVP Test Set's tabulated
-  // solution at its end time), for error_final and scd (harness/observers.cpp).
+  // solution at its end time), for error_final and scd (harness/observers.cpp). On Problem, not
+  // on FirstOrderSystem: the second-order nbody (preset=pleiades, the Test Set's PLEI) offers one
+  // as well.
   virtual double end_reference_time() const;
   virtual State end_reference() const;
 
@@ -213,7 +226,8 @@ class Problem {
   // Called once by the factory after construction.
   void set_mass(const Vec& mass);
   // Throws std::logic_error for kDerivedCapabilities: a problem declares constraints by
-  // as_constrained(), not by a bit.
+  // as_constrained(), a first-order ODE by as_first_order() and a force by as_forced(), not by a
+  // bit.
   void set_capabilities(unsigned capabilities);
   void set_defaults(double dt, double t_end) {
     default_dt_ = dt;
@@ -222,6 +236,8 @@ class Problem {
 
  private:
   friend std::unique_ptr<Problem> make_problem(const std::string& spec_text);
+  // has() of a bit in kDerivedCapabilities: asks the one query it comes from.
+  bool has_derived(Capability c) const;
   std::string name_;
   std::string spec_;
   unsigned capabilities_ = 0;
@@ -234,6 +250,12 @@ class Problem {
 // *problem.as_constrained(), for code that runs only on constrained problems (applicable() checked
 // kConstraints); throws std::logic_error naming the problem when it has none.
 const HolonomicConstraints& constraints_of(const Problem& problem);
+// *problem.as_first_order(), the same for code that runs only on first-order problems
+// (problems/first_order.hpp); throws std::logic_error naming the problem when it is none.
+const FirstOrderSystem& first_order_system_of(const Problem& problem);
+// *problem.as_forced(), for code that runs only on forced problems (checked has(kForce)); throws
+// std::logic_error naming the problem when it has no force.
+const NonConservativeForce& force_of(const Problem& problem);
 
 // Spec key every problem accepts: `initial=FILE.csv` starts the problem from the state in the
 // file (rows q,p or, under a header "q,v", q,v; one per dof) instead of its own, and drops its

@@ -22,6 +22,8 @@
 #include <vector>
 
 #include "problems/charged_particle.hpp"
+#include "problems/first_order.hpp"
+#include "problems/force.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 #include "problems/rigid_body.hpp"
@@ -100,9 +102,9 @@ std::vector<Vec> sample_configurations(const Problem& problem) {
 // constraint force with the exact motion's multipliers λ(t, q, p) on constrained problems; on a
 // first-order-only problem y = q and its y' = f(t, y) (p is empty).
 Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
-  if (problem.has(kFirstOrderOnly)) {
+  if (const FirstOrderSystem* system = problem.as_first_order()) {
     Vec ydot;
-    problem.rhs(t, q, ydot);
+    system->rhs(t, q, ydot);
     return ydot;
   }
   const int n = problem.dof();
@@ -124,7 +126,7 @@ Vec hamilton_rhs(const Problem& problem, double t, const Vec& q, const Vec& p) {
   rhs.tail(n) = -g;
   if (problem.has(kForce)) {
     Vec f;
-    problem.force(q, v, t, f);
+    force_of(problem).force(q, v, t, f);
     rhs.tail(n) += f;
   }
   if (problem.has(kConstraints)) {
@@ -500,9 +502,42 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   EXPECT_EQ(problem.has(kConstraints), constraints != nullptr);
   EXPECT_EQ(problem.has(kTimeDependentConstraints),
             constraints != nullptr && constraints->time_dependent());
-  const ProblemKind expected = problem.has(kFirstOrderOnly) ? ProblemKind::kFirstOrder
-                               : problem.as_lagrangian()    ? ProblemKind::kLagrangian
-                                                            : ProblemKind::kSeparable;
+  // The force, instance-level like the constraints: when offered it is the class's own
+  // interface; a class that derives from it and declines it (an undamped spring net) has F = 0 at
+  // the start, so one that forgets to return `this` on a forced instance fails here. kForce and
+  // kForceJacobian come from the query alone, and a force offers force_jacobian_v exactly when
+  // has_force_jacobian() says so (one that computes it without saying so would be lost).
+  const NonConservativeForce* forced = problem.as_forced();
+  const auto* force_class = dynamic_cast<const NonConservativeForce*>(&problem);
+  const State start = problem.initial_state();
+  const Vec v0 = problem.inverse_mass().cwiseProduct(start.p);
+  if (forced != nullptr) {
+    EXPECT_EQ(forced, force_class);
+    SparseMatrix C;
+    if (forced->has_force_jacobian()) {
+      forced->force_jacobian_v(start.q, v0, start.t, C);
+      EXPECT_EQ(C.rows(), problem.dof());
+      EXPECT_EQ(C.cols(), problem.dof());
+    } else {
+      EXPECT_THROW(forced->force_jacobian_v(start.q, v0, start.t, C), std::logic_error);
+    }
+  } else if (force_class != nullptr) {
+    Vec f;
+    force_class->force(start.q, v0, start.t, f);
+    EXPECT_EQ(f.cwiseAbs().maxCoeff(), 0.0) << "derives from NonConservativeForce, returns none";
+  }
+  EXPECT_EQ(problem.has(kForce), forced != nullptr);
+  EXPECT_EQ(problem.has(kForceJacobian), forced != nullptr && forced->has_force_jacobian());
+  EXPECT_EQ((problem.capabilities() & kForce) != 0, forced != nullptr);
+  EXPECT_EQ((problem.capabilities() & kForceJacobian) != 0,
+            forced != nullptr && forced->has_force_jacobian());
+  // The first-order kind: the query is the class's own interface, and alone sets the bit.
+  EXPECT_EQ(problem.as_first_order(), dynamic_cast<const FirstOrderSystem*>(&problem));
+  EXPECT_EQ(problem.has(kFirstOrderOnly), problem.as_first_order() != nullptr);
+  EXPECT_EQ((problem.capabilities() & kFirstOrderOnly) != 0, problem.as_first_order() != nullptr);
+  const ProblemKind expected = problem.as_first_order()  ? ProblemKind::kFirstOrder
+                               : problem.as_lagrangian() ? ProblemKind::kLagrangian
+                                                         : ProblemKind::kSeparable;
   EXPECT_EQ(problem.kind(), expected) << kind_name(problem.kind());
 }
 

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 
+#include "problems/first_order.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -181,7 +182,7 @@ TEST(RigidBodyEuler, IsEulersEquationsWithTheEllipticSolution) {
     EXPECT_DOUBLE_EQ(body->casimir(start.q, start.p), pi0.squaredNorm());
     const double T = euler->period();
     Vec rate;
-    euler->rhs(0, euler->initial_state().q, rate);
+    first_order_system_of(*euler).rhs(0, euler->initial_state().q, rate);
     // J from the masses: I_k = (d1 + d2 + d3) − d_k.
     const Eigen::Vector3d d(body->mass()[0], body->mass()[3], body->mass()[6]);
     const Eigen::Vector3d J = Eigen::Vector3d::Constant(d.sum()) - d;

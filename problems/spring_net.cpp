@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -40,7 +41,7 @@ struct Spring {
 };
 
 template <int Dim>
-class SpringNet final : public Problem {
+class SpringNet final : public Problem, public NonConservativeForce {
   using Point = Eigen::Matrix<double, Dim, 1>;
   using Block = Eigen::Matrix<double, Dim, Dim>;
   using Triplets = std::vector<Eigen::Triplet<double>>;
@@ -52,9 +53,7 @@ class SpringNet final : public Problem {
         quartic_(config.quartic),
         damping_(config.damping) {
     set_mass(Vec::Constant(Dim * nodes_, config.mass));
-    unsigned capabilities = kHessian | kLinearMomentum | kAngularMomentum | kOmegaMax;
-    if (damping_ > 0) capabilities |= kForce | kForceJacobian;
-    set_capabilities(capabilities);
+    set_capabilities(kHessian | kLinearMomentum | kAngularMomentum | kOmegaMax);
     set_defaults(0.01, 10.0);
     build(config);
   }
@@ -95,6 +94,8 @@ class SpringNet final : public Problem {
 
   // The damping force c ṙ n acts along the spring in equal and opposite pairs, so it has zero net
   // force and torque; its power −c ṙ² ≤ 0 with ṙ = n·(v_j − v_i) the extension rate.
+  const NonConservativeForce* as_forced() const override { return damping_ > 0 ? this : nullptr; }
+  bool has_force_jacobian() const override { return true; }
   void force(const Vec& q, const Vec& v, double, Vec& f) const override {
     f.setZero(dof());
     for (const Spring& spring : springs_) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "problems/force.hpp"
 #include "problems/problem.hpp"
 #include "tests/test_util.hpp"
 
@@ -140,7 +141,7 @@ TEST(SpringNet, DampingHasZeroForceAndTorqueAndDissipates) {
     for (unsigned seed : {7u, 8u, 9u}) {
       const Vec v = random_vector(problem->dof(), seed);
       Vec f;
-      problem->force(q, v, 0.0, f);
+      force_of(*problem).force(q, v, 0.0, f);
       ASSERT_GT(f.norm(), 0.0);
       EXPECT_LE(total_force(f, dim).lpNorm<Eigen::Infinity>(), 64 * DBL_EPSILON * f.lpNorm<1>())
           << spec;
@@ -166,8 +167,8 @@ TEST(SpringNet, DampingHasZeroForceAndTorqueAndDissipates) {
     }
     const Vec v_generic = random_vector(problem->dof(), 13);
     Vec f_generic, f_rigid;
-    problem->force(q, v_generic, 0.0, f_generic);
-    problem->force(q, rigid, 0.0, f_rigid);
+    force_of(*problem).force(q, v_generic, 0.0, f_generic);
+    force_of(*problem).force(q, rigid, 0.0, f_rigid);
     const double force_per_velocity =
         f_generic.lpNorm<Eigen::Infinity>() / v_generic.lpNorm<Eigen::Infinity>();
     EXPECT_LE(f_rigid.lpNorm<Eigen::Infinity>(),
@@ -183,7 +184,7 @@ TEST(SpringNet, DampingMatrixMatchesFiniteDifferencesAndIsPsd) {
   const Vec q = deformed(*problem, 15);
   const Vec v = random_vector(n, 16);
   SparseMatrix C;
-  problem->force_jacobian_v(q, v, 0.0, C);
+  force_of(*problem).force_jacobian_v(q, v, 0.0, C);
   const Eigen::MatrixXd dense(C);
   // F is linear in v, so the central difference is exact up to rounding of F / h.
   const double h = 1e-3;
@@ -192,8 +193,8 @@ TEST(SpringNet, DampingMatrixMatchesFiniteDifferencesAndIsPsd) {
     Vec plus = v, minus = v;
     plus[j] += h;
     minus[j] -= h;
-    problem->force(q, plus, 0.0, f_plus);
-    problem->force(q, minus, 0.0, f_minus);
+    force_of(*problem).force(q, plus, 0.0, f_plus);
+    force_of(*problem).force(q, minus, 0.0, f_minus);
     const Vec column = -(f_plus - f_minus) / (2 * h);
     EXPECT_LE((dense.col(j) - column).lpNorm<Eigen::Infinity>(), 1e-11) << "column " << j;
   }
@@ -357,7 +358,7 @@ TEST(SpringNet, TenThousandDofNetEvaluates) {
   // 2·70·71 axis + 2·70·70 diagonal springs = 19 740.
   EXPECT_EQ(H.nonZeros(), 4L * (71 * 71 + 2 * 19'740));
   SparseMatrix C;
-  problem->force_jacobian_v(start.q, start.p, 0.0, C);
+  force_of(*problem).force_jacobian_v(start.q, start.p, 0.0, C);
   EXPECT_EQ(C.nonZeros(), H.nonZeros());
   const double omega = problem->omega_max(start.q);
   EXPECT_TRUE(std::isfinite(omega) && omega > 0);

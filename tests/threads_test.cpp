@@ -61,8 +61,8 @@ Evaluations evaluate(const Problem& bar, const Vec& q, const Vec& v) {
   out.energy = bar.potential(q);
   bar.gradient(q, out.gradient);
   bar.hessian(q, out.hessian);
-  bar.force(q, v, 0.0, out.force);
-  bar.force_jacobian_v(q, v, 0.0, out.damping_jacobian);
+  force_of(bar).force(q, v, 0.0, out.force);
+  force_of(bar).force_jacobian_v(q, v, 0.0, out.damping_jacobian);
   return out;
 }
 

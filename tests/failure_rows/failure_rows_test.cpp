@@ -27,7 +27,7 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 // (kind=force, the harmonic oscillator with a force that is zero until then) or gradient under
 // holonomic constraints (kind=constrained, the Cartesian pendulum) turns NaN once q[0] falls
 // below half its initial value: after about ten steps of 0.1 from q[0] > 0 towards q[0] < 0.
-class TurnsNan final : public Problem, public HolonomicConstraints {
+class TurnsNan final : public Problem, public HolonomicConstraints, public NonConservativeForce {
  public:
   TurnsNan(std::unique_ptr<Problem> base, bool poison_force)
       : base_(std::move(base)),
@@ -35,9 +35,7 @@ class TurnsNan final : public Problem, public HolonomicConstraints {
         poison_force_(poison_force) {
     threshold_ = 0.5 * base_->initial_state().q[0];
     set_mass(base_->mass());
-    unsigned capabilities = base_->capabilities() & kHessian;
-    if (poison_force_) capabilities |= kForce | kForceJacobian;
-    set_capabilities(capabilities);
+    set_capabilities(base_->capabilities() & kHessian);
     set_defaults(0.1, 3.0);
   }
 
@@ -53,6 +51,8 @@ class TurnsNan final : public Problem, public HolonomicConstraints {
     base_->hessian(q, H);
     if (poisoned_gradient(q)) H = Eigen::MatrixXd::Constant(dof(), dof(), kNan).sparseView();
   }
+  const NonConservativeForce* as_forced() const override { return poison_force_ ? this : nullptr; }
+  bool has_force_jacobian() const override { return true; }
   void force(const Vec& q, const Vec&, double, Vec& f) const override {
     f = Vec::Constant(dof(), poisoned(q) ? kNan : 0.0);
   }
