@@ -212,6 +212,8 @@ struct NewtonSolver::Factorisation {
   // Modified Newton: the last solve ended contracting fast, so its factorisation may start the
   // next one.
   bool keep_factor = false;
+  // NewtonSystem::inner_term_scale at the iterate of the held Jacobian (modified Newton).
+  double held_inner_term_scale = 0.0;
   // Set by the caller before solve(): the residual the CG iteration must reach; set by solve():
   // the residual ‖rhs − A·out‖ it reached (CG only).
   double cg_target = 0.0;
@@ -662,7 +664,9 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
 
   Vec direction, trial, trial_residual;
   f.kind = resolve_linear_solver(options_.linear.kind, x.size());
-  const bool modified = options_.linear.modified_newton && !f.is_cg();
+  // Modified Newton applies to CG as well: CG then iterates on the held Newton matrix (of an
+  // earlier iterate or step), so the Hessian is not reassembled while the residual contracts fast.
+  const bool modified = options_.linear.modified_newton;
   // Inexact Newton: the CG iteration stops at forcing·‖R‖ (forcing terms: kFirstForcing, then
   // Eisenstat–Walker's, updated after every accepted step below) and below the threshold (the
   // last correction does not leave an error the stopping test would see). The stopping test on R
@@ -732,6 +736,14 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   // solve, or of the last one when it ended contracting fast).
   bool reuse_factor = modified && f.keep_factor && f.has_factor && f.rows == x.size() &&
                       f.pattern_symmetric == system.symmetric;
+  // The threshold's inner-term part comes with a Jacobian evaluation; a solve that starts on the
+  // held matrix takes it from the iterate that matrix was evaluated at (its Hessian is the one
+  // held), so reusing a matrix does not tighten the stopping test below the round-off of R.
+  if (reuse_factor && system.inner_term_scale && std::isfinite(f.held_inner_term_scale)) {
+    result.threshold =
+        std::max({relative_tolerance * scale, kRoundoffFloor * (scale + f.held_inner_term_scale),
+                  kSubnormalResidual});
+  }
   while (true) {
     if (result.residual_norm <= result.threshold) {
       result.converged = true;
@@ -772,6 +784,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       if (!all_finite(f.jacobian)) return fail("nan");
       if (system.inner_term_scale) {
         const double inner = system.inner_term_scale();
+        f.held_inner_term_scale = inner;
         if (std::isfinite(inner)) {
           result.threshold = std::max(
               {relative_tolerance * scale, kRoundoffFloor * (scale + inner), kSubnormalResidual});
