@@ -1,4 +1,4 @@
-// The thread count setting of problems/parallel.hpp (issue 30 item 2).
+// The thread count setting and the persistent chunk pool (problems/parallel.hpp, issue 30 item 2).
 #include "problems/parallel.hpp"
 
 #include <fmt/format.h>
@@ -6,8 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <condition_variable>
 #include <cstdlib>
+#include <functional>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include "problems/spec.hpp"
 
@@ -89,6 +93,98 @@ int chunk_count(std::size_t items, std::size_t min_items_per_chunk) {
   if (most == 1) return 1;  // too little work to split, whatever the setting
   return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(thread_count()), most));
 }
+
+namespace {
+
+std::atomic<long> started_threads{0};
+
+// Workers 1, 2, … of run_chunks, each running the chunk of its own index of the current loop. One
+// loop at a time (`in_use`); the caller runs chunk 0 and waits until every other chunk is done.
+class ChunkPool {
+ public:
+  ~ChunkPool() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& worker : workers_) worker.join();
+  }
+
+  // False (nothing run) when another loop holds the pool.
+  bool try_run(int chunks, const std::function<void(int)>& run) {
+    const std::unique_lock<std::mutex> use(in_use_, std::try_to_lock);
+    if (!use.owns_lock()) return false;
+    while (static_cast<int>(workers_.size()) < chunks - 1) {
+      const int index = static_cast<int>(workers_.size()) + 1;
+      workers_.emplace_back([this, index] { work(index); });
+      started_threads.fetch_add(1, std::memory_order_relaxed);
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      job_ = &run;
+      job_chunks_ = chunks;
+      pending_ = chunks - 1;
+      ++generation_;
+    }
+    wake_.notify_all();
+    run(0);
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    job_ = nullptr;
+    return true;
+  }
+
+ private:
+  void work(int index) {
+    unsigned long seen = 0;
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      if (stop_) return;
+      seen = generation_;
+      if (index >= job_chunks_) continue;  // this loop has fewer chunks than workers
+      const std::function<void(int)>* job = job_;
+      lock.unlock();
+      (*job)(index);
+      lock.lock();
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::mutex in_use_;
+  std::mutex mutex_;  // guards everything below
+  std::condition_variable wake_, done_;
+  std::vector<std::thread> workers_;
+  const std::function<void(int)>* job_ = nullptr;
+  int job_chunks_ = 0;
+  int pending_ = 0;  // chunks ≥ 1 of the current loop not yet finished
+  unsigned long generation_ = 0;
+  bool stop_ = false;
+};
+
+ChunkPool& chunk_pool() {
+  static ChunkPool pool;
+  return pool;
+}
+
+}  // namespace
+
+void run_chunks(int chunks, const std::function<void(int)>& run) {
+  if (chunks <= 1) {
+    run(0);
+    return;
+  }
+  if (chunk_pool().try_run(chunks, run)) return;
+  std::vector<std::thread> workers;
+  workers.reserve(static_cast<std::size_t>(chunks - 1));
+  for (int chunk = 1; chunk < chunks; ++chunk) workers.emplace_back(run, chunk);
+  started_threads.fetch_add(chunks - 1, std::memory_order_relaxed);
+  run(0);
+  for (std::thread& worker : workers) worker.join();
+}
+
+long threads_started() { return started_threads.load(std::memory_order_relaxed); }
 
 namespace {
 
