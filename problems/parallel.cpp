@@ -7,10 +7,12 @@
 #include <atomic>
 #include <cerrno>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdlib>
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "problems/spec.hpp"
@@ -229,6 +231,130 @@ void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::Vector
                  [&](int chunk, std::size_t, std::size_t) {
                    multiply(first_column[static_cast<std::size_t>(chunk)],
                             first_column[static_cast<std::size_t>(chunk) + 1]);
+                 });
+}
+
+namespace {
+
+// First block column of each chunk when [0, columns) is cut into `chunks` pieces of about equal
+// non-zero counts (outer: the prefix sums of the non-zeros per column).
+std::vector<Eigen::Index> balanced_columns(const int* outer, Eigen::Index columns, int chunks) {
+  const auto nonzeros = static_cast<std::size_t>(outer[columns] - outer[0]);
+  std::vector<Eigen::Index> first(static_cast<std::size_t>(chunks) + 1, columns);
+  first[0] = 0;
+  for (int chunk = 1; chunk < chunks; ++chunk) {
+    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
+    first[static_cast<std::size_t>(chunk)] =
+        std::lower_bound(outer, outer + columns, target) - outer;
+  }
+  return first;
+}
+
+}  // namespace
+
+bool to_symmetric_blocks(const Eigen::SparseMatrix<double>& A, SymmetricBlockMatrix& blocks) {
+  blocks = SymmetricBlockMatrix{};
+  if (!A.isCompressed() || A.rows() != A.cols() || A.cols() % 3 != 0) return false;
+  const Eigen::Index block_columns = A.cols() / 3;
+  const int* outer = A.outerIndexPtr();
+  const int* rows = A.innerIndexPtr();
+  const double* values = A.valuePtr();
+  // The three columns of a block column hold equally many entries, a multiple of 3.
+  std::vector<int> block_outer(static_cast<std::size_t>(block_columns) + 1, 0);
+  for (Eigen::Index I = 0; I < block_columns; ++I) {
+    const int count = outer[3 * I + 1] - outer[3 * I];
+    if (count % 3 != 0 || outer[3 * I + 2] - outer[3 * I + 1] != count ||
+        outer[3 * I + 3] - outer[3 * I + 2] != count) {
+      return false;
+    }
+    block_outer[static_cast<std::size_t>(I) + 1] =
+        block_outer[static_cast<std::size_t>(I)] + count / 3;
+  }
+  const auto block_count = static_cast<std::size_t>(block_outer.back());
+  std::vector<int> block_row(block_count);
+  std::vector<double> block_values(9 * block_count);
+  std::atomic<bool> aligned{true};
+  const auto copy = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index I = first; I < last; ++I) {
+      const int blocks_here =
+          block_outer[static_cast<std::size_t>(I) + 1] - block_outer[static_cast<std::size_t>(I)];
+      for (int m = 0; m < blocks_here; ++m) {
+        const auto k = static_cast<std::size_t>(block_outer[static_cast<std::size_t>(I)] + m);
+        const int J = rows[outer[3 * I] + 3 * m] / 3;
+        block_row[k] = J;
+        for (int a = 0; a < 3; ++a) {
+          const int start = outer[3 * I + a] + 3 * m;
+          for (int b = 0; b < 3; ++b) {
+            if (rows[start + b] != 3 * J + b) {
+              aligned.store(false, std::memory_order_relaxed);
+              return;
+            }
+            block_values[9 * k + 3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(b)] =
+                values[start + b];
+          }
+        }
+      }
+    }
+  };
+  const auto nonzeros = static_cast<std::size_t>(outer[A.cols()] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  const std::vector<Eigen::Index> first =
+      balanced_columns(block_outer.data(), block_columns, chunks);
+  for_each_chunk(
+      chunks, static_cast<std::size_t>(chunks), [&](int chunk, std::size_t, std::size_t) {
+        copy(first[static_cast<std::size_t>(chunk)], first[static_cast<std::size_t>(chunk) + 1]);
+      });
+  if (!aligned.load(std::memory_order_relaxed)) return false;
+  blocks.block_columns = block_columns;
+  blocks.outer = std::move(block_outer);
+  blocks.block_row = std::move(block_row);
+  blocks.values = std::move(block_values);
+  return true;
+}
+
+void symmetric_product(const SymmetricBlockMatrix& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y) {
+  const Eigen::Index block_columns = A.block_columns;
+  y.resize(3 * block_columns);
+  const int* outer = A.outer.data();
+  const int* block_row = A.block_row.data();
+  const double* values = A.values.data();
+  const double* in = x.data();
+  double* out = y.data();
+  const auto multiply = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index I = first; I < last; ++I) {
+      // Three sums, each over its column's rows in ascending order (block rows ascending, then
+      // the three rows of a block): the order of symmetric_product on the scalar matrix.
+      double s0 = 0, s1 = 0, s2 = 0;
+      for (int k = outer[I]; k < outer[I + 1]; ++k) {
+        const double* v = values + 9 * static_cast<std::ptrdiff_t>(k);
+        const double* xb = in + 3 * static_cast<std::ptrdiff_t>(block_row[k]);
+        s0 += v[0] * xb[0];
+        s0 += v[1] * xb[1];
+        s0 += v[2] * xb[2];
+        s1 += v[3] * xb[0];
+        s1 += v[4] * xb[1];
+        s1 += v[5] * xb[2];
+        s2 += v[6] * xb[0];
+        s2 += v[7] * xb[1];
+        s2 += v[8] * xb[2];
+      }
+      out[3 * I] = s0;
+      out[3 * I + 1] = s1;
+      out[3 * I + 2] = s2;
+    }
+  };
+  const auto nonzeros = 9 * static_cast<std::size_t>(outer[block_columns] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  if (chunks == 1) {
+    multiply(0, block_columns);
+    return;
+  }
+  const std::vector<Eigen::Index> first = balanced_columns(outer, block_columns, chunks);
+  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
+                 [&](int chunk, std::size_t, std::size_t) {
+                   multiply(first[static_cast<std::size_t>(chunk)],
+                            first[static_cast<std::size_t>(chunk) + 1]);
                  });
 }
 

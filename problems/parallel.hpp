@@ -79,4 +79,26 @@ void for_each_chunk(int chunks, std::size_t items, const Body& body) {
 void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
                        Eigen::VectorXd& y);
 
+// A symmetric matrix stored in full as 3×3 blocks (block-compressed columns: one row index per
+// block instead of one per entry, 8.4 instead of 12 bytes per non-zero): the Newton matrices of
+// problems with three coordinates per node (M + c∇²V of the elastic bar) in the form the CG product
+// reads (docs/PERF.md "Block product").
+struct SymmetricBlockMatrix {
+  Eigen::Index block_columns = 0;
+  std::vector<int> outer;      // blocks of block column I: [outer[I], outer[I + 1])
+  std::vector<int> block_row;  // block row J of each block
+  // Block k at block row J, block column I: values[9k + 3a + b] = A(3J + b, 3I + a).
+  std::vector<double> values;
+};
+
+// Copies A (compressed, square) into `blocks` when its pattern is made of full 3×3 blocks
+// (every column of a block column has the same rows, in whole aligned triples); false, and
+// `blocks` emptied, otherwise. Threaded like symmetric_product.
+bool to_symmetric_blocks(const Eigen::SparseMatrix<double>& A, SymmetricBlockMatrix& blocks);
+
+// y = A x for A as copied by to_symmetric_blocks: y_i is summed over the rows of column i in
+// ascending order, as symmetric_product does, so the result has the same bits as
+// symmetric_product(A, x, y) at any thread count.
+void symmetric_product(const SymmetricBlockMatrix& A, const Eigen::VectorXd& x, Eigen::VectorXd& y);
+
 }  // namespace geomint

@@ -1,9 +1,9 @@
 // Threaded element loops (issue 30 item 2, problems/parallel.hpp, docs/PERF.md "Threads"): the
-// elastic bar's energy, gradient, Hessian and damping, and the product H x, give the same bits
-// at 1, 2, 3 and 4 threads, and implicit steps repeated at 2 threads and at 1 give the same bytes
-// (also with modified Newton); the chunking covers every item once and passes exceptions on, also
-// for concurrent and nested loops; the pool's workers persist; the setting refuses what it cannot
-// use.
+// elastic bar's energy, gradient, Hessian and damping, and the products H x (scalar and 3×3-block),
+// give the same bits at 1, 2, 3 and 4 threads, and implicit steps repeated at 2 threads and at 1
+// give the same bytes (also with modified Newton); the chunking covers every item once and passes
+// exceptions on, also for concurrent and nested loops; the pool's workers persist; the setting
+// refuses what it cannot use.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,7 +104,52 @@ TEST(ElasticBarThreads, EvaluationsAreBitIdenticalAtAnyThreadCount) {
     const Vec reference = serial.hessian * v;
     EXPECT_TRUE(same_bits(product, reference))
         << threads << " threads: H x off by " << (product - reference).lpNorm<Eigen::Infinity>();
+    // The 3×3-block copy CG multiplies with (three coordinates per node): the same bits, also for
+    // a matrix of size 1e-150 or 1e+150.
+    for (double scale : {1.0, 1e-150, 1e150}) {
+      const SparseMatrix scaled = scale * serial.hessian;
+      SymmetricBlockMatrix blocks;
+      ASSERT_TRUE(to_symmetric_blocks(scaled, blocks)) << threads;
+      Vec block_product = Vec::Constant(bar->dof(), std::numeric_limits<double>::quiet_NaN());
+      symmetric_product(blocks, v, block_product);
+      const Vec scaled_reference = scaled * v;
+      EXPECT_TRUE(same_bits(block_product, scaled_reference))
+          << threads << " threads, scale " << scale << ": block H x off by "
+          << (block_product - scaled_reference).lpNorm<Eigen::Infinity>();
+    }
   }
+}
+
+// Patterns that are not made of whole aligned 3×3 blocks stay with the scalar product.
+TEST(ParallelChunks, BlockCopyRefusesPatternsNotMadeOf3x3Blocks) {
+  const auto matrix = [](int n, const std::vector<std::pair<int, int>>& entries) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (const auto& [row, column] : entries) triplets.emplace_back(row, column, 1.0);
+    SparseMatrix A(n, n);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    return A;
+  };
+  std::vector<std::pair<int, int>> full;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) full.emplace_back(i, j);
+  }
+  SymmetricBlockMatrix blocks;
+  EXPECT_TRUE(to_symmetric_blocks(matrix(6, full), blocks));
+  EXPECT_EQ(blocks.values.size(), 36u);
+  std::vector<std::pair<int, int>> missing = full;
+  missing.erase(missing.begin() + 7);  // (1, 1): one entry of the first block left out
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, missing), blocks));
+  EXPECT_TRUE(blocks.values.empty());
+  std::vector<std::pair<int, int>> diagonal;  // 1×1 "blocks" on the diagonal only
+  for (int i = 0; i < 6; ++i) diagonal.emplace_back(i, i);
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, diagonal), blocks));
+  // Shifted by one row: every column holds three entries, but not an aligned block.
+  std::vector<std::pair<int, int>> shifted;
+  for (int j = 0; j < 6; ++j) {
+    for (int i = 1; i < 4; ++i) shifted.emplace_back(i, j);
+  }
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, shifted), blocks));
+  EXPECT_FALSE(to_symmetric_blocks(matrix(5, {{0, 0}}), blocks));  // not a multiple of 3
 }
 
 // One step of the HP integrator (Newton with CG on the threaded Hessian and gradient) from a
