@@ -42,7 +42,7 @@ inline std::size_t chunk_begin(std::size_t items, int chunk, int chunks) {
 // Runs run(chunk) for every chunk in [0, chunks): chunk 0 on the calling thread, chunk c ≥ 1 on
 // worker c of a persistent pool (started on first use, kept until the process ends), so a loop
 // costs a wake-up per chunk instead of a thread start (~180 products per implicit step of the
-// elastic bar: docs/PERF.md "Thread pool"). While another loop holds the pool (a sweep's
+// elastic bar: docs/PERF.md "Persistent thread pool"). While another loop holds the pool (a sweep's
 // concurrent runs, or a loop inside a chunk) the chunks run on threads of their own instead.
 // Which thread runs a chunk never changes what it computes. `run` must not throw.
 void run_chunks(int chunks, const std::function<void(int)>& run);
