@@ -128,7 +128,9 @@ constexpr double kForcingSafeguardExponent = 1.618033988749895;
 // on the strength of loaded CPU times (11.4 s cg against 9.92 s cg_amg per step at 544 320
 // unknowns); on the quiet machine (load 1.3, docs/PERF.md "Implicit step") cg took 5.06 s and
 // cg_amg 5.31 s per step at that size, 463 against 482 ms at 56 355 unknowns: no size measured
-// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra.
+// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra. `auto` leaves
+// modified Newton off: with CG it is the faster elastic-bar step (docs/PERF.md "Hessian reuse"),
+// but it moves every committed `cg` trajectory within the Newton tolerance, so it stays opt-in.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
   return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
