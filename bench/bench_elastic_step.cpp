@@ -103,6 +103,7 @@ GEOMINT_STEP(hp_ldlt, "hp:alpha=0.5,linear_solver=ldlt", 0, 1);
 GEOMINT_STEP(hp_cholmod, "hp:alpha=0.5,linear_solver=cholmod", 0, 2);
 GEOMINT_STEP(hp_cg, "hp:alpha=0.5,linear_solver=cg", 0, 3);
 GEOMINT_STEP(hp_cg_amg, "hp:alpha=0.5,linear_solver=cg_amg", 0, 3);
+GEOMINT_STEP(hp_cg_modified, "hp:alpha=0.5,linear_solver=cg,modified_newton=true", 0, 3);
 GEOMINT_STEP(hp_auto, "hp:alpha=0.5", 0, 2);
 // Paper claim 5 at scale: minimiser, Newton on the momentum residual and implicit Euler with the
 // same linear solver and the same stopping rule (tol 1e-12 relative, every method's default).

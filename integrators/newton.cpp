@@ -35,8 +35,9 @@ using MetisLdlt = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::Metis
 // Preconditioned conjugate gradients on A (stored in full, both triangles), from x = 0, until
 // ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient for the curvature test:
 // pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD safeguard needs to know
-// (Nocedal & Wright §5.1 and §7.1, truncated CG). The product A p is the threaded
-// geomint::symmetric_product (problems/parallel.hpp), the same bits at any thread count.
+// (Nocedal & Wright §5.1 and §7.1, truncated CG). `multiply(p, Ap)` is the threaded
+// geomint::symmetric_product (problems/parallel.hpp) on the scalar or the 3×3-block copy of A,
+// the same bits either way and at any thread count.
 enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
 
 // ‖r‖₂ as robust_norm gives it, from one pass over r where the sum of squares is far from under-
@@ -47,8 +48,8 @@ double residual_norm(const Vec& r) {
   return squares > 1e-200 && squares < 1e300 ? std::sqrt(squares) : robust_norm(r);
 }
 
-template <class Preconditioner>
-CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& preconditioner,
+template <class Multiply, class Preconditioner>
+CgOutcome preconditioned_cg(const Multiply& multiply, const Preconditioner& preconditioner,
                             const Vec& b, double target, int max_iterations, Vec& x,
                             int& iterations, double& final_residual) {
   iterations = 0;
@@ -61,7 +62,7 @@ CgOutcome preconditioned_cg(const SparseMatrix& A, const Preconditioner& precond
   double rz = r.dot(z);
   for (int k = 0; k < max_iterations; ++k) {
     ++iterations;
-    symmetric_product(A, p, Ap);
+    multiply(p, Ap);
     const double curvature = p.dot(Ap);
     if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
     const double alpha = rz / curvature;
@@ -127,7 +128,9 @@ constexpr double kForcingSafeguardExponent = 1.618033988749895;
 // on the strength of loaded CPU times (11.4 s cg against 9.92 s cg_amg per step at 544 320
 // unknowns); on the quiet machine (load 1.3, docs/PERF.md "Implicit step") cg took 5.06 s and
 // cg_amg 5.31 s per step at that size, 463 against 482 ms at 56 355 unknowns: no size measured
-// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra.
+// favours cg_amg, whose set-up also costs 0.4 GB more memory at 10⁶ tetrahedra. `auto` leaves
+// modified Newton off: with CG it is the faster elastic-bar step (docs/PERF.md "Hessian reuse"),
+// but it moves every committed `cg` trajectory within the Newton tolerance, so it stays opt-in.
 LinearSolverKind resolve_linear_solver(LinearSolverKind kind, long unknowns) {
   if (kind != LinearSolverKind::kAuto) return kind;
   return unknowns < kAutoIterativeFrom ? LinearSolverKind::kLdlt : LinearSolverKind::kCg;
@@ -206,12 +209,16 @@ struct NewtonSolver::Factorisation {
   // (every Newton matrix of geomint does), else its lower triangle mirrored into full_matrix.
   const SparseMatrix* cg_matrix = nullptr;
   SparseMatrix full_matrix;
+  SymmetricBlockMatrix cg_blocks;  // *cg_matrix in 3×3 blocks, when cg_blocked
+  bool cg_blocked = false;
   bool pattern_in_full = true;   // the remembered pattern has both triangles
   bool has_factor = false;       // a usable factorisation of the current system's size is held
   bool direct_fallback = false;  // CG/CHOLMOD found J indefinite: this factor is an LDLT of it
   // Modified Newton: the last solve ended contracting fast, so its factorisation may start the
   // next one.
   bool keep_factor = false;
+  // NewtonSystem::inner_term_scale at the iterate of the held Jacobian (modified Newton).
+  double held_inner_term_scale = 0.0;
   // Set by the caller before solve(): the residual the CG iteration must reach; set by solve():
   // the residual ‖rhs − A·out‖ it reached (CG only).
   double cg_target = 0.0;
@@ -318,6 +325,9 @@ struct NewtonSolver::Factorisation {
         full_matrix = matrix.selfadjointView<Eigen::Lower>();
         cg_matrix = &full_matrix;
       }
+      // The CG product reads the 3×3-block copy when the matrix is made of such blocks (three
+      // coordinates per node): a third less memory traffic per product, same bits.
+      cg_blocked = ok && is_cg() && to_symmetric_blocks(*cg_matrix, cg_blocks);
     }
     has_factor = ok;
     return ok;
@@ -341,6 +351,17 @@ struct NewtonSolver::Factorisation {
     return amg.setup(matrix);
   }
 
+  // y = A x for the CG iteration, from the block copy when there is one.
+  auto cg_product() const {
+    return [this](const Vec& p, Vec& Ap) {
+      if (cg_blocked) {
+        symmetric_product(cg_blocks, p, Ap);
+      } else {
+        symmetric_product(*cg_matrix, p, Ap);
+      }
+    };
+  }
+
   bool is_cg() const {
     return !direct_fallback &&
            (kind == LinearSolverKind::kCg || kind == LinearSolverKind::kCgIchol ||
@@ -355,12 +376,12 @@ struct NewtonSolver::Factorisation {
     int iterations = 0;
     const bool fresh = amg_baseline_iterations < 0;
     CgOutcome outcome =
-        preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
+        preconditioned_cg(cg_product(), amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
     *cg_iterations_counter += iterations;
     if (outcome == CgOutcome::kNoConvergence && !fresh) {
       if (!setup_amg(*factored)) return outcome;
-      outcome =
-          preconditioned_cg(*cg_matrix, amg, rhs, cg_target, max_cg, out, iterations, cg_residual);
+      outcome = preconditioned_cg(cg_product(), amg, rhs, cg_target, max_cg, out, iterations,
+                                  cg_residual);
       *cg_iterations_counter += iterations;
     }
     if (outcome != CgOutcome::kConverged) return outcome;
@@ -419,12 +440,12 @@ struct NewtonSolver::Factorisation {
         out = cholmod.solve(rhs);
         break;
       case LinearSolverKind::kCg:
-        outcome = preconditioned_cg(*cg_matrix, diagonal, rhs, cg_target, max_cg, out, iterations,
+        outcome = preconditioned_cg(cg_product(), diagonal, rhs, cg_target, max_cg, out, iterations,
                                     cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgIchol:
-        outcome = preconditioned_cg(*cg_matrix, ichol, rhs, cg_target, max_cg, out, iterations,
+        outcome = preconditioned_cg(cg_product(), ichol, rhs, cg_target, max_cg, out, iterations,
                                     cg_residual);
         *cg_iterations_counter += iterations;
         break;
@@ -662,7 +683,9 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
 
   Vec direction, trial, trial_residual;
   f.kind = resolve_linear_solver(options_.linear.kind, x.size());
-  const bool modified = options_.linear.modified_newton && !f.is_cg();
+  // Modified Newton applies to CG as well: CG then iterates on the held Newton matrix (of an
+  // earlier iterate or step), so the Hessian is not reassembled while the residual contracts fast.
+  const bool modified = options_.linear.modified_newton;
   // Inexact Newton: the CG iteration stops at forcing·‖R‖ (forcing terms: kFirstForcing, then
   // Eisenstat–Walker's, updated after every accepted step below) and below the threshold (the
   // last correction does not leave an error the stopping test would see). The stopping test on R
@@ -732,6 +755,14 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
   // solve, or of the last one when it ended contracting fast).
   bool reuse_factor = modified && f.keep_factor && f.has_factor && f.rows == x.size() &&
                       f.pattern_symmetric == system.symmetric;
+  // The threshold's inner-term part comes with a Jacobian evaluation; a solve that starts on the
+  // held matrix takes it from the iterate that matrix was evaluated at (its Hessian is the one
+  // held), so reusing a matrix does not tighten the stopping test below the round-off of R.
+  if (reuse_factor && system.inner_term_scale && std::isfinite(f.held_inner_term_scale)) {
+    result.threshold =
+        std::max({relative_tolerance * scale, kRoundoffFloor * (scale + f.held_inner_term_scale),
+                  kSubnormalResidual});
+  }
   while (true) {
     if (result.residual_norm <= result.threshold) {
       result.converged = true;
@@ -772,6 +803,7 @@ NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double resi
       if (!all_finite(f.jacobian)) return fail("nan");
       if (system.inner_term_scale) {
         const double inner = system.inner_term_scale();
+        f.held_inner_term_scale = inner;
         if (std::isfinite(inner)) {
           result.threshold = std::max(
               {relative_tolerance * scale, kRoundoffFloor * (scale + inner), kSubnormalResidual});

@@ -42,7 +42,10 @@ struct LinearSolverOptions {
   LinearSolverKind kind = LinearSolverKind::kAuto;
   // Modified Newton: keep the last factorisation while the iteration contracts the residual by at
   // least kModifiedNewtonContraction per iteration, across iterations and steps (a new Jacobian
-  // is factorised as soon as it does not). Direct solvers only; CG always uses the current matrix.
+  // is factorised as soon as it does not, and at once when a direction from the held one fails:
+  // CG does not converge, no descent, no acceptable step). With the CG solvers the held Newton
+  // matrix (and its preconditioner) is what CG iterates on, so the Hessian is not reassembled
+  // (docs/PERF.md "Hessian reuse").
   bool modified_newton = false;
   // cg_amg keeps its multigrid set-up (built from an earlier matrix: a preconditioner need not be
   // of the current one) until a CG solve takes more than amg_refresh_growth × (the iterations per

@@ -1,4 +1,4 @@
-// The thread count setting of problems/parallel.hpp (issue 30 item 2).
+// The thread count setting and the persistent chunk pool (problems/parallel.hpp, issue 30 item 2).
 #include "problems/parallel.hpp"
 
 #include <fmt/format.h>
@@ -6,8 +6,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <condition_variable>
+#include <cstddef>
 #include <cstdlib>
+#include <functional>
+#include <mutex>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "problems/spec.hpp"
 
@@ -92,6 +98,98 @@ int chunk_count(std::size_t items, std::size_t min_items_per_chunk) {
 
 namespace {
 
+std::atomic<long> started_threads{0};
+
+// Workers 1, 2, … of run_chunks, each running the chunk of its own index of the current loop. One
+// loop at a time (`in_use`); the caller runs chunk 0 and waits until every other chunk is done.
+class ChunkPool {
+ public:
+  ~ChunkPool() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& worker : workers_) worker.join();
+  }
+
+  // False (nothing run) when another loop holds the pool.
+  bool try_run(int chunks, const std::function<void(int)>& run) {
+    const std::unique_lock<std::mutex> use(in_use_, std::try_to_lock);
+    if (!use.owns_lock()) return false;
+    while (static_cast<int>(workers_.size()) < chunks - 1) {
+      const int index = static_cast<int>(workers_.size()) + 1;
+      workers_.emplace_back([this, index] { work(index); });
+      started_threads.fetch_add(1, std::memory_order_relaxed);
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      job_ = &run;
+      job_chunks_ = chunks;
+      pending_ = chunks - 1;
+      ++generation_;
+    }
+    wake_.notify_all();
+    run(0);
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_ == 0; });
+    job_ = nullptr;
+    return true;
+  }
+
+ private:
+  void work(int index) {
+    unsigned long seen = 0;
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      if (stop_) return;
+      seen = generation_;
+      if (index >= job_chunks_) continue;  // this loop has fewer chunks than workers
+      const std::function<void(int)>* job = job_;
+      lock.unlock();
+      (*job)(index);
+      lock.lock();
+      if (--pending_ == 0) done_.notify_one();
+    }
+  }
+
+  std::mutex in_use_;
+  std::mutex mutex_;  // guards everything below
+  std::condition_variable wake_, done_;
+  std::vector<std::thread> workers_;
+  const std::function<void(int)>* job_ = nullptr;
+  int job_chunks_ = 0;
+  int pending_ = 0;  // chunks ≥ 1 of the current loop not yet finished
+  unsigned long generation_ = 0;
+  bool stop_ = false;
+};
+
+ChunkPool& chunk_pool() {
+  static ChunkPool pool;
+  return pool;
+}
+
+}  // namespace
+
+void run_chunks(int chunks, const std::function<void(int)>& run) {
+  if (chunks <= 1) {
+    run(0);
+    return;
+  }
+  if (chunk_pool().try_run(chunks, run)) return;
+  std::vector<std::thread> workers;
+  workers.reserve(static_cast<std::size_t>(chunks - 1));
+  for (int chunk = 1; chunk < chunks; ++chunk) workers.emplace_back(run, chunk);
+  started_threads.fetch_add(chunks - 1, std::memory_order_relaxed);
+  run(0);
+  for (std::thread& worker : workers) worker.join();
+}
+
+long threads_started() { return started_threads.load(std::memory_order_relaxed); }
+
+namespace {
+
 // Below this many non-zeros per chunk a thread costs more than it saves (docs/PERF.md).
 constexpr std::size_t kMinNonZerosPerChunk = 1 << 16;
 
@@ -133,6 +231,130 @@ void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::Vector
                  [&](int chunk, std::size_t, std::size_t) {
                    multiply(first_column[static_cast<std::size_t>(chunk)],
                             first_column[static_cast<std::size_t>(chunk) + 1]);
+                 });
+}
+
+namespace {
+
+// First block column of each chunk when [0, columns) is cut into `chunks` pieces of about equal
+// non-zero counts (outer: the prefix sums of the non-zeros per column).
+std::vector<Eigen::Index> balanced_columns(const int* outer, Eigen::Index columns, int chunks) {
+  const auto nonzeros = static_cast<std::size_t>(outer[columns] - outer[0]);
+  std::vector<Eigen::Index> first(static_cast<std::size_t>(chunks) + 1, columns);
+  first[0] = 0;
+  for (int chunk = 1; chunk < chunks; ++chunk) {
+    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
+    first[static_cast<std::size_t>(chunk)] =
+        std::lower_bound(outer, outer + columns, target) - outer;
+  }
+  return first;
+}
+
+}  // namespace
+
+bool to_symmetric_blocks(const Eigen::SparseMatrix<double>& A, SymmetricBlockMatrix& blocks) {
+  blocks = SymmetricBlockMatrix{};
+  if (!A.isCompressed() || A.rows() != A.cols() || A.cols() % 3 != 0) return false;
+  const Eigen::Index block_columns = A.cols() / 3;
+  const int* outer = A.outerIndexPtr();
+  const int* rows = A.innerIndexPtr();
+  const double* values = A.valuePtr();
+  // The three columns of a block column hold equally many entries, a multiple of 3.
+  std::vector<int> block_outer(static_cast<std::size_t>(block_columns) + 1, 0);
+  for (Eigen::Index I = 0; I < block_columns; ++I) {
+    const int count = outer[3 * I + 1] - outer[3 * I];
+    if (count % 3 != 0 || outer[3 * I + 2] - outer[3 * I + 1] != count ||
+        outer[3 * I + 3] - outer[3 * I + 2] != count) {
+      return false;
+    }
+    block_outer[static_cast<std::size_t>(I) + 1] =
+        block_outer[static_cast<std::size_t>(I)] + count / 3;
+  }
+  const auto block_count = static_cast<std::size_t>(block_outer.back());
+  std::vector<int> block_row(block_count);
+  std::vector<double> block_values(9 * block_count);
+  std::atomic<bool> aligned{true};
+  const auto copy = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index I = first; I < last; ++I) {
+      const int blocks_here =
+          block_outer[static_cast<std::size_t>(I) + 1] - block_outer[static_cast<std::size_t>(I)];
+      for (int m = 0; m < blocks_here; ++m) {
+        const auto k = static_cast<std::size_t>(block_outer[static_cast<std::size_t>(I)] + m);
+        const int J = rows[outer[3 * I] + 3 * m] / 3;
+        block_row[k] = J;
+        for (int a = 0; a < 3; ++a) {
+          const int start = outer[3 * I + a] + 3 * m;
+          for (int b = 0; b < 3; ++b) {
+            if (rows[start + b] != 3 * J + b) {
+              aligned.store(false, std::memory_order_relaxed);
+              return;
+            }
+            block_values[9 * k + 3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(b)] =
+                values[start + b];
+          }
+        }
+      }
+    }
+  };
+  const auto nonzeros = static_cast<std::size_t>(outer[A.cols()] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  const std::vector<Eigen::Index> first =
+      balanced_columns(block_outer.data(), block_columns, chunks);
+  for_each_chunk(
+      chunks, static_cast<std::size_t>(chunks), [&](int chunk, std::size_t, std::size_t) {
+        copy(first[static_cast<std::size_t>(chunk)], first[static_cast<std::size_t>(chunk) + 1]);
+      });
+  if (!aligned.load(std::memory_order_relaxed)) return false;
+  blocks.block_columns = block_columns;
+  blocks.outer = std::move(block_outer);
+  blocks.block_row = std::move(block_row);
+  blocks.values = std::move(block_values);
+  return true;
+}
+
+void symmetric_product(const SymmetricBlockMatrix& A, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& y) {
+  const Eigen::Index block_columns = A.block_columns;
+  y.resize(3 * block_columns);
+  const int* outer = A.outer.data();
+  const int* block_row = A.block_row.data();
+  const double* values = A.values.data();
+  const double* in = x.data();
+  double* out = y.data();
+  const auto multiply = [&](Eigen::Index first, Eigen::Index last) {
+    for (Eigen::Index I = first; I < last; ++I) {
+      // Three sums, each over its column's rows in ascending order (block rows ascending, then
+      // the three rows of a block): the order of symmetric_product on the scalar matrix.
+      double s0 = 0, s1 = 0, s2 = 0;
+      for (int k = outer[I]; k < outer[I + 1]; ++k) {
+        const double* v = values + 9 * static_cast<std::ptrdiff_t>(k);
+        const double* xb = in + 3 * static_cast<std::ptrdiff_t>(block_row[k]);
+        s0 += v[0] * xb[0];
+        s0 += v[1] * xb[1];
+        s0 += v[2] * xb[2];
+        s1 += v[3] * xb[0];
+        s1 += v[4] * xb[1];
+        s1 += v[5] * xb[2];
+        s2 += v[6] * xb[0];
+        s2 += v[7] * xb[1];
+        s2 += v[8] * xb[2];
+      }
+      out[3 * I] = s0;
+      out[3 * I + 1] = s1;
+      out[3 * I + 2] = s2;
+    }
+  };
+  const auto nonzeros = 9 * static_cast<std::size_t>(outer[block_columns] - outer[0]);
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  if (chunks == 1) {
+    multiply(0, block_columns);
+    return;
+  }
+  const std::vector<Eigen::Index> first = balanced_columns(outer, block_columns, chunks);
+  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
+                 [&](int chunk, std::size_t, std::size_t) {
+                   multiply(first[static_cast<std::size_t>(chunk)],
+                            first[static_cast<std::size_t>(chunk) + 1]);
                  });
 }
 

@@ -1,8 +1,9 @@
 // Threaded element loops (issue 30 item 2, problems/parallel.hpp, docs/PERF.md "Threads"): the
-// elastic bar's energy, gradient, Hessian and damping, and the product H x, give the same bits
-// at 1, 2, 3 and 4 threads, and implicit steps repeated at 2 threads and at 1 give the same bytes;
-// the chunking covers every item once and passes exceptions on; the setting refuses what it cannot
-// use.
+// elastic bar's energy, gradient, Hessian and damping, and the products H x (scalar and 3×3-block),
+// give the same bits at 1, 2, 3 and 4 threads, and implicit steps repeated at 2 threads and at 1
+// give the same bytes (also with modified Newton); the chunking covers every item once and passes
+// exceptions on, also for concurrent and nested loops; the pool's workers persist; the setting
+// refuses what it cannot use.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "integrators/integrator.hpp"
@@ -101,7 +104,52 @@ TEST(ElasticBarThreads, EvaluationsAreBitIdenticalAtAnyThreadCount) {
     const Vec reference = serial.hessian * v;
     EXPECT_TRUE(same_bits(product, reference))
         << threads << " threads: H x off by " << (product - reference).lpNorm<Eigen::Infinity>();
+    // The 3×3-block copy CG multiplies with (three coordinates per node): the same bits, also for
+    // a matrix of size 1e-150 or 1e+150.
+    for (double scale : {1.0, 1e-150, 1e150}) {
+      const SparseMatrix scaled = scale * serial.hessian;
+      SymmetricBlockMatrix blocks;
+      ASSERT_TRUE(to_symmetric_blocks(scaled, blocks)) << threads;
+      Vec block_product = Vec::Constant(bar->dof(), std::numeric_limits<double>::quiet_NaN());
+      symmetric_product(blocks, v, block_product);
+      const Vec scaled_reference = scaled * v;
+      EXPECT_TRUE(same_bits(block_product, scaled_reference))
+          << threads << " threads, scale " << scale << ": block H x off by "
+          << (block_product - scaled_reference).lpNorm<Eigen::Infinity>();
+    }
   }
+}
+
+// Patterns that are not made of whole aligned 3×3 blocks stay with the scalar product.
+TEST(ParallelChunks, BlockCopyRefusesPatternsNotMadeOf3x3Blocks) {
+  const auto matrix = [](int n, const std::vector<std::pair<int, int>>& entries) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (const auto& [row, column] : entries) triplets.emplace_back(row, column, 1.0);
+    SparseMatrix A(n, n);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    return A;
+  };
+  std::vector<std::pair<int, int>> full;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) full.emplace_back(i, j);
+  }
+  SymmetricBlockMatrix blocks;
+  EXPECT_TRUE(to_symmetric_blocks(matrix(6, full), blocks));
+  EXPECT_EQ(blocks.values.size(), 36u);
+  std::vector<std::pair<int, int>> missing = full;
+  missing.erase(missing.begin() + 7);  // (1, 1): one entry of the first block left out
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, missing), blocks));
+  EXPECT_TRUE(blocks.values.empty());
+  std::vector<std::pair<int, int>> diagonal;  // 1×1 "blocks" on the diagonal only
+  for (int i = 0; i < 6; ++i) diagonal.emplace_back(i, i);
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, diagonal), blocks));
+  // Shifted by one row: every column holds three entries, but not an aligned block.
+  std::vector<std::pair<int, int>> shifted;
+  for (int j = 0; j < 6; ++j) {
+    for (int i = 1; i < 4; ++i) shifted.emplace_back(i, j);
+  }
+  EXPECT_FALSE(to_symmetric_blocks(matrix(6, shifted), blocks));
+  EXPECT_FALSE(to_symmetric_blocks(matrix(5, {{0, 0}}), blocks));  // not a multiple of 3
 }
 
 // One step of the HP integrator (Newton with CG on the threaded Hessian and gradient) from a
@@ -112,22 +160,28 @@ TEST(ElasticBarThreads, ImplicitStepsAreBitIdenticalAtOneAndTwoThreads) {
   const auto bar = make_problem(
       "elastic_bar:nx=12,ny=8,nz=8,length=1.5,width=0.4,height=0.3,young=3e6,density=700,"
       "damping=0.02,init=twist,twist=0.2");
-  const auto run = [&bar](int threads) {
-    set_thread_count(threads);
-    const auto method = make_integrator("hp:alpha=0.5,solver=newton,linear_solver=cg");
-    State state = bar->initial_state();
-    const double h = 2e-4;
-    method->reset(*bar, state, h);
-    for (int k = 0; k < 1; ++k) {
-      EXPECT_TRUE(method->step(*bar, state, h).ok) << "step " << k << " at " << threads;
-    }
-    return state;
-  };
-  const State first = run(2), second = run(2), serial = run(1);
-  EXPECT_GT((first.q - bar->initial_state().q).norm(), 0);
-  EXPECT_TRUE(same_bits(first.q, second.q) && same_bits(first.p, second.p));
-  EXPECT_TRUE(same_bits(first.q, serial.q) && same_bits(first.p, serial.p))
-      << "1 vs 2 threads: q off by " << (first.q - serial.q).lpNorm<Eigen::Infinity>();
+  // Also the minimiser with modified Newton (the Newton matrix kept across iterations and steps),
+  // over three steps so that later steps start on a held matrix.
+  for (const auto& [spec, steps] : std::vector<std::pair<std::string, int>>{
+           {"hp:alpha=0.5,solver=newton,linear_solver=cg", 1},
+           {"hp:alpha=0.5,linear_solver=cg,modified_newton=true", 3}}) {
+    const auto run = [&bar, &spec = spec, steps = steps](int threads) {
+      set_thread_count(threads);
+      const auto method = make_integrator(spec);
+      State state = bar->initial_state();
+      const double h = 2e-4;
+      method->reset(*bar, state, h);
+      for (int k = 0; k < steps; ++k) {
+        EXPECT_TRUE(method->step(*bar, state, h).ok) << spec << " step " << k << " at " << threads;
+      }
+      return state;
+    };
+    const State first = run(2), second = run(2), serial = run(1);
+    EXPECT_GT((first.q - bar->initial_state().q).norm(), 0) << spec;
+    EXPECT_TRUE(same_bits(first.q, second.q) && same_bits(first.p, second.p)) << spec;
+    EXPECT_TRUE(same_bits(first.q, serial.q) && same_bits(first.p, serial.p))
+        << spec << ": 1 vs 2 threads: q off by " << (first.q - serial.q).lpNorm<Eigen::Infinity>();
+  }
 }
 
 TEST(ParallelChunks, CoverEveryItemOnceInContiguousRanges) {
@@ -157,6 +211,58 @@ TEST(ParallelChunks, AnExceptionOfAnyChunkReachesTheCaller) {
                  std::runtime_error)
         << failing;
   }
+}
+
+// The pool's workers persist: after a first loop has started them, a thousand more loops start no
+// thread, and chunk 1 runs on the same thread every time.
+TEST(ParallelChunks, LoopsReuseThePoolsWorkers) {
+  for_each_chunk(3, 3, [](int, std::size_t, std::size_t) {});
+  const long started = threads_started();
+  const std::thread::id caller = std::this_thread::get_id();
+  std::thread::id first_runner;
+  std::atomic<long> sum{0};
+  for (int loop = 0; loop < 1000; ++loop) {
+    for_each_chunk(3, 300, [&](int chunk, std::size_t begin, std::size_t end) {
+      if (chunk == 1) {
+        if (loop == 0) first_runner = std::this_thread::get_id();
+        EXPECT_EQ(std::this_thread::get_id(), first_runner) << loop;
+        EXPECT_NE(std::this_thread::get_id(), caller) << loop;
+      }
+      for (std::size_t i = begin; i < end; ++i) sum += static_cast<long>(i);
+    });
+  }
+  EXPECT_EQ(threads_started(), started);
+  EXPECT_EQ(sum.load(), 1000L * (299 * 300 / 2));
+}
+
+// Loops from several threads at once (a sweep's concurrent runs) and a loop inside a chunk: the
+// pool serves one loop at a time and the others run on threads of their own; every item is
+// still covered exactly once by every loop.
+TEST(ParallelChunks, ConcurrentAndNestedLoopsCoverEveryItemOnce) {
+  constexpr std::size_t kItems = 1000;
+  const auto covered_once = [](int chunks) {
+    std::vector<std::atomic<int>> hits(kItems);
+    for_each_chunk(chunks, kItems, [&](int, std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) ++hits[i];
+    });
+    return std::all_of(hits.begin(), hits.end(), [](const std::atomic<int>& h) { return h == 1; });
+  };
+  std::atomic<int> failures{0};
+  std::vector<std::thread> callers;
+  for (int caller = 0; caller < 4; ++caller) {
+    callers.emplace_back([&, caller] {
+      for (int loop = 0; loop < 50; ++loop) {
+        if (!covered_once(2 + (caller + loop) % 3)) ++failures;
+      }
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  EXPECT_EQ(failures.load(), 0);
+  std::atomic<int> nested_failures{0};
+  for_each_chunk(2, 2, [&](int, std::size_t, std::size_t) {
+    if (!covered_once(3)) ++nested_failures;
+  });
+  EXPECT_EQ(nested_failures.load(), 0);
 }
 
 TEST(ThreadSetting, RefusesCountsOutsideItsRangeAndLimitsChunks) {
