@@ -11,6 +11,7 @@
 #include "harness/metrics.hpp"
 #include "harness/run_spec.hpp"
 #include "integrators/constrained_step.hpp"
+#include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -33,6 +34,13 @@ double block_scale(const Vec& block, double fallback) {
   if (own > 0 && std::isfinite(own)) return own;
   if (fallback > 0 && std::isfinite(fallback)) return fallback;
   return 1.0;
+}
+
+// The velocity q̇ at (q, p) by the problem's kind: M⁻¹p with a constant mass, ∂H/∂p = v(q, p) of
+// the LagrangianSystem on the general kind (which has no constant mass).
+Vec velocity_of(const Problem& problem, const Vec& q, const Vec& p) {
+  if (const LagrangianSystem* general = problem.as_lagrangian()) return general->velocity(q, p);
+  return problem.inverse_mass().cwiseProduct(p);
 }
 
 // The central difference of the map at `state` in direction k with step δ; false on failure.
@@ -108,8 +116,8 @@ MapJacobian computed_map_jacobian(Integrator& method, const Problem& problem, co
   const long n = state.q.size();
   Vec gradient;
   problem.gradient(state.q, gradient);
-  const double q_scale = block_scale(
-      state.q, h * (problem.inverse_mass().cwiseProduct(state.p)).cwiseAbs().maxCoeff());
+  const double q_scale =
+      block_scale(state.q, h * velocity_of(problem, state.q, state.p).cwiseAbs().maxCoeff());
   const double p_scale = block_scale(state.p, h * gradient.cwiseAbs().maxCoeff());
   // D(δ/2^m) for m = 0 … levels−1, the coarsest δ the first of kMapDefectRelativeSteps, column
   // by column; every three consecutive levels give a J and its error estimate.
@@ -217,8 +225,8 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
   const long n = state.q.size();
   Vec gradient;
   problem.gradient(state.q, gradient);
-  const double q_scale = block_scale(
-      state.q, h * (problem.inverse_mass().cwiseProduct(state.p)).cwiseAbs().maxCoeff());
+  const double q_scale =
+      block_scale(state.q, h * velocity_of(problem, state.q, state.p).cwiseAbs().maxCoeff());
   const double p_scale = block_scale(state.p, h * gradient.cwiseAbs().maxCoeff());
   const Eigen::MatrixXd directions = chart_directions(problem, state);
   const long k = directions.cols() / 2;

@@ -33,15 +33,15 @@ class Field {
       : problem_(problem),
         dof_(problem.dof()),
         non_separable_(problem.kind() == ProblemKind::kLagrangian) {
-    inverse_mass_ = problem.inverse_mass().cast<Real>();
+    // Only the separable kind has a constant mass (mass() throws on the others).
+    if (!non_separable_) inverse_mass_ = problem.inverse_mass().cast<Real>();
   }
   void operator()(Real t, const VecL& y, VecL& ydot) {
     y_double_ = y.cast<double>();
     problem_.first_order_rhs(static_cast<double>(t), y_double_, ydot_double_);
     ydot.resize(2 * dof_);
     // The general kind has a position-dependent mass: q' = v(q, p) = M(q)⁻¹(p − a(q)) comes
-    // from the problem's Hamilton equations, in double like the forces (M⁻¹p with the
-    // placeholder mass of ones was a silently wrong field).
+    // from the problem's Hamilton equations, in double like the forces (it has no constant M⁻¹).
     if (non_separable_) {
       ydot.head(dof_) = ydot_double_.head(dof_).cast<Real>();
     } else {

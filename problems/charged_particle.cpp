@@ -30,7 +30,7 @@ class ChargedParticle final : public Problem,
   const LagrangianSystem* as_lagrangian() const override { return this; }
   const ChargedParticleStructure* as_charged_particle() const override { return this; }
   explicit ChargedParticle(const ChargedParticleParameters& parameters) : p_(parameters) {
-    set_mass(Vec::Ones(3));  // placeholder for dof(): the Lagrangian is non-separable
+    set_dof(3);  // no constant mass: the Lagrangian is non-separable
     const bool axisymmetric = p_.electric[0] == 0 && p_.electric[1] == 0;
     unsigned capabilities = kOmegaMax;
     if (!p_.bottle) capabilities |= kExact;

@@ -22,7 +22,7 @@ class DoublePendulum final : public Problem, public LagrangianSystem {
         g_(g),
         theta_(std::move(theta)),
         omega_(std::move(omega)) {
-    set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is M(θ) (is_non_separable)
+    set_dof(2);  // no constant mass: the mass is M(θ)
     set_capabilities(kOmegaMax);
     // The faster small-amplitude mode of the equal pendulum is √(g/l)·√(2 + √2) ≈ 1.85 √(g/l).
     set_defaults(0.01 * std::sqrt(std::min(l1, l2) / g), 10.0);

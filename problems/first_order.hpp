@@ -41,10 +41,10 @@ class FirstOrderProblem : public Problem, public FirstOrderSystem {
   State end_reference() const override { return reference_; }
 
  protected:
-  // y0 fixes the dimension (the unit "mass" only sizes dof() = n); `capabilities` are what the
+  // y0 fixes the dimension dof() = n (no mass: mass() throws); `capabilities` are what the
   // problem declares beyond kFirstOrderOnly, which as_first_order() sets.
   FirstOrderProblem(Vec y0, unsigned capabilities) : y0_(std::move(y0)) {
-    set_mass(Vec::Ones(y0_.size()));
+    set_dof(static_cast<int>(y0_.size()));
     set_capabilities(capabilities);
   }
   // The tabulated solution y_ref at time t (kEndReference).

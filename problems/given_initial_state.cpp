@@ -21,7 +21,12 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
       : base_(std::move(base)),
         base_constraints_(base_->as_constrained()),
         initial_(std::move(initial)) {
-    set_mass(base_->mass());
+    // The base's constant mass if it has one (the kSeparable kind), else only its dof.
+    if (base_->kind() == ProblemKind::kSeparable) {
+      set_mass(base_->mass());
+    } else {
+      set_dof(base_->dof());
+    }
     // The exact solution, period and tabulated end state belong to the problem's own start;
     // the constraint and force capabilities follow from as_constrained() and as_forced() below.
     set_capabilities(base_->capabilities() &
@@ -98,8 +103,8 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
 };
 
 // A non-separable problem from a file: the forwarding above plus the base's LagrangianSystem, so
-// that energy(), first_order_rhs() and the general integrators see its M(q), a(q) and V, not the
-// placeholder unit mass (docs/MECHANICS_GENERAL.md §8, the paragraph on initial=).
+// that energy(), first_order_rhs() and the general integrators see its M(q), a(q) and V (it has
+// no constant mass; docs/MECHANICS_GENERAL.md §8, the paragraph on initial=).
 class GivenInitialLagrangian final : public GivenInitialState, public LagrangianSystem {
  public:
   GivenInitialLagrangian(std::unique_ptr<Problem> base, State initial)

@@ -132,7 +132,7 @@ class KeplerPolar final : public Problem, public LagrangianSystem {
  public:
   const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit KeplerPolar(double e) : cartesian_(e), e_(e) {
-    set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is diag(1, r²) (is_non_separable)
+    set_dof(2);  // no constant mass: the mass is diag(1, r²)
     // p_φ is the angular momentum (φ is cyclic): the momentum observer reads it through
     // angular_momentum().
     set_capabilities(kExact | kPeriod | kAngularMomentum | kOmegaMax);

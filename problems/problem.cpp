@@ -228,7 +228,7 @@ const HolonomicConstraints& constraints_of(const Problem& problem) {
 }
 
 Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
-  const Vec v = inverse_mass_.cwiseProduct(p);
+  const Vec v = inverse_mass().cwiseProduct(p);
   Vec force_total;
   gradient(q, force_total);
   force_total = -force_total;
@@ -246,7 +246,7 @@ Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
   c += a_t;
   // m is small for every catalogue problem (rods, pins), so a dense solve of G M⁻¹ Gᵀ is the
   // simplest correct choice; LDLT copes with the semidefinite case of redundant constraints.
-  const Eigen::MatrixXd GMinv = Eigen::MatrixXd(G) * inverse_mass_.asDiagonal();
+  const Eigen::MatrixXd GMinv = Eigen::MatrixXd(G) * inverse_mass().asDiagonal();
   const Eigen::MatrixXd S = GMinv * Eigen::MatrixXd(G).transpose();
   const Vec rhs = GMinv * force_total + c;
   return S.ldlt().solve(rhs);
@@ -281,7 +281,7 @@ double Problem::constraint_velocity_residual(double t, const Vec& q, const Vec& 
   const HolonomicConstraints& constraints = constraints_of(*this);
   SparseMatrix G;
   constraints.constraint_jacobian_at(t, q, G);
-  const Vec v = inverse_mass_.cwiseProduct(p);
+  const Vec v = inverse_mass().cwiseProduct(p);
   Vec g_t, a_t;
   constraints.constraint_time_terms(t, q, v, g_t, a_t);
   const Vec rate = G * v + g_t;
@@ -297,7 +297,7 @@ void Problem::check_consistent(const State& state, const std::string& what, doub
     for (SparseMatrix::InnerIterator it(G, k); it; ++it) row_sums[it.row()] += std::abs(it.value());
   }
   const double G_norm = row_sums.size() > 0 ? row_sums.maxCoeff() : 0.0;
-  const Vec v = inverse_mass_.cwiseProduct(state.p);
+  const Vec v = inverse_mass().cwiseProduct(state.p);
   const double q_norm = state.q.size() > 0 ? state.q.cwiseAbs().maxCoeff() : 0.0;
   const double v_norm = v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0;
   const double position = constraint_residual(state.t, state.q);
@@ -319,11 +319,30 @@ void Problem::check_consistent(const State& state, const std::string& what, doub
 }
 
 void Problem::set_mass(const Vec& mass) {
+  dof_ = static_cast<int>(mass.size());
+  has_constant_mass_ = true;
   mass_ = mass;
   inverse_mass_ = mass.cwiseInverse();
 }
 
-double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass_.cwiseProduct(p)); }
+void Problem::set_dof(int dof) {
+  dof_ = dof;
+  has_constant_mass_ = false;
+  mass_.resize(0);
+  inverse_mass_.resize(0);
+}
+
+void Problem::no_constant_mass() const {
+  const ProblemKind problem_kind = kind();
+  const char* instead = problem_kind == ProblemKind::kLagrangian
+                            ? "use its LagrangianSystem (H, ∂H/∂p)"
+                            : "use its FirstOrderSystem y' = f(t, y)";
+  throw std::logic_error(
+      fmt::format("problem '{}' is of kind {}: it has no constant mass matrix; {}", name(),
+                  kind_name(problem_kind), instead));
+}
+
+double Problem::kinetic(const Vec& p) const { return 0.5 * p.dot(inverse_mass().cwiseProduct(p)); }
 
 double Problem::energy(const Vec& q, const Vec& p) const {
   if (has(kFirstOrderOnly)) return std::numeric_limits<double>::quiet_NaN();
@@ -370,7 +389,7 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
     ydot.tail(n) = L_q;
     return;
   }
-  const Vec v = inverse_mass_.cwiseProduct(y.tail(n));
+  const Vec v = inverse_mass().cwiseProduct(y.tail(n));
   Vec g;
   gradient(y.head(n), g);
   ydot.head(n) = v;
@@ -402,11 +421,11 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
     return;
   }
   const Vec q = y.head(n);
-  const Vec v = inverse_mass_.cwiseProduct(y.tail(n));
+  const Vec v = inverse_mass().cwiseProduct(y.tail(n));
   SparseMatrix H;
   hessian(q, H);
   std::vector<Eigen::Triplet<double>> triplets;
-  for (int i = 0; i < n; ++i) triplets.emplace_back(i, n + i, inverse_mass_[i]);
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, n + i, inverse_mass()[i]);
   for (int k = 0; k < H.outerSize(); ++k) {
     for (SparseMatrix::InnerIterator it(H, k); it; ++it) {
       triplets.emplace_back(n + it.row(), it.col(), -it.value());
@@ -420,7 +439,7 @@ void Problem::first_order_jacobian(double t, const Vec& y, SparseMatrix& J) cons
       forced->force_jacobian_v(q, v, t, C);
       for (int k = 0; k < C.outerSize(); ++k) {
         for (SparseMatrix::InnerIterator it(C, k); it; ++it) {
-          triplets.emplace_back(n + it.row(), n + it.col(), -it.value() * inverse_mass_[it.col()]);
+          triplets.emplace_back(n + it.row(), n + it.col(), -it.value() * inverse_mass()[it.col()]);
         }
       }
     }

@@ -111,8 +111,8 @@ class Problem {
   // FirstOrderProblem base returns it); such a problem has no Lagrangian pieces at all.
   virtual const FirstOrderSystem* as_first_order() const { return nullptr; }
   // The general Lagrangian interface (problems/lagrangian.hpp) of a kLagrangian problem. Such a
-  // problem's mass() is a placeholder of ones that only sets dof(), p = M(q)v + a(q), energy() is
-  // H(q, p) and first_order_rhs() Hamilton's equations.
+  // problem has no constant mass (mass() throws; its constructor calls set_dof), p = M(q)v + a(q),
+  // energy() is H(q, p) and first_order_rhs() Hamilton's equations.
   virtual const LagrangianSystem* as_lagrangian() const { return nullptr; }
   // The free rigid body's Lie–Poisson structure (rigid_body, rigid_body_euler).
   virtual const FreeRigidBodyStructure* as_free_rigid_body() const { return nullptr; }
@@ -128,11 +128,19 @@ class Problem {
   // a damped oscillator with ζ = 0 and no drive returns nullptr and conserves H.
   virtual const NonConservativeForce* as_forced() const { return nullptr; }
 
-  int dof() const { return static_cast<int>(mass_.size()); }
+  int dof() const { return dof_; }
   virtual State initial_state() const = 0;
-  // Diagonal of the (lumped) mass matrix M, all entries > 0.
-  const Vec& mass() const { return mass_; }
-  const Vec& inverse_mass() const { return inverse_mass_; }
+  // Diagonal of the (lumped) mass matrix M, all entries > 0. Only the kSeparable kind has one:
+  // on a kLagrangian problem (M(q), use its LagrangianSystem) or a kFirstOrder one (no mass at
+  // all) mass(), inverse_mass() and kinetic() throw std::logic_error naming problem and kind.
+  const Vec& mass() const {
+    if (!has_constant_mass_) no_constant_mass();
+    return mass_;
+  }
+  const Vec& inverse_mass() const {
+    if (!has_constant_mass_) no_constant_mass();
+    return inverse_mass_;
+  }
 
   virtual double potential(const Vec& q) const = 0;
   // g = ∇V(q); g is resized by the callee.
@@ -190,8 +198,10 @@ class Problem {
     (void)q, (void)p, values.clear();
   }
 
-  // Total energy H = ½pᵀM⁻¹p + V(q) (the conserved Hamiltonian when there is no force).
+  // Total energy H = ½pᵀM⁻¹p + V(q) (the conserved Hamiltonian when there is no force); H(q, p)
+  // of the LagrangianSystem on a kLagrangian problem, NaN on a kFirstOrder one.
   double energy(const Vec& q, const Vec& p) const;
+  // ½pᵀM⁻¹p: kSeparable only (throws std::logic_error otherwise, like mass()).
   double kinetic(const Vec& p) const;
 
   // Suggested step and horizon for `geomint run` without --dt/--t-end.
@@ -223,8 +233,10 @@ class Problem {
   virtual State end_reference() const;
 
  protected:
-  // Called once by the factory after construction.
+  // Called once by the constructor: set_mass for a kSeparable problem (it sets dof() as well),
+  // set_dof for a kLagrangian or kFirstOrder one, which has no constant mass.
   void set_mass(const Vec& mass);
+  void set_dof(int dof);
   // Throws std::logic_error for kDerivedCapabilities: a problem declares constraints by
   // as_constrained(), a first-order ODE by as_first_order() and a force by as_forced(), not by a
   // bit.
@@ -238,9 +250,13 @@ class Problem {
   friend std::unique_ptr<Problem> make_problem(const std::string& spec_text);
   // has() of a bit in kDerivedCapabilities: asks the one query it comes from.
   bool has_derived(Capability c) const;
+  // The std::logic_error of mass(), inverse_mass() and kinetic() without a constant mass.
+  [[noreturn]] void no_constant_mass() const;
   std::string name_;
   std::string spec_;
   unsigned capabilities_ = 0;
+  int dof_ = 0;
+  bool has_constant_mass_ = false;  // set_mass was called (the kSeparable kind)
   Vec mass_;
   Vec inverse_mass_;
   double default_dt_ = 0.01;

@@ -1,6 +1,7 @@
 // Registry-driven checks of every problem (docs/DESIGN.md §7): derivatives against finite
 // differences, the exact solution against the equations of motion and an independent RK4 run,
 // invariants along the exact solution, and validation of spec strings.
+#include <fmt/format.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gtest/gtest.h>
@@ -19,6 +20,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "problems/charged_particle.hpp"
@@ -165,7 +167,8 @@ TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
   const State start = problem.initial_state();
   ASSERT_GT(problem.dof(), 0);
   if (problem.kind() == ProblemKind::kLagrangian) {
-    // mass() is a placeholder; the energy is H = ½vᵀM(q)v + V with v solved from p = M v + a.
+    // No constant mass (mass() throws); the energy is H = ½vᵀM(q)v + V with v solved from
+    // p = M v + a.
     const LagrangianSystem& system = *problem.as_lagrangian();
     EXPECT_EQ(start.p.size(), problem.dof());
     DenseMatrix M;
@@ -359,8 +362,8 @@ TEST_P(ProblemTest, InvariantsAreConstantAlongExact) {
   const bool mechanical = !problem.has(kFirstOrderOnly);
   const double energy0 = mechanical ? problem.energy(start.q, start.p) : 0.0;
   // Relative to the sizes of the two energy terms, which cancel for bound orbits (Kepler).
-  // kinetic(p) reads the constant mass, a placeholder on a non-separable problem (whose p = m v +
-  // qA of an electron is 1e-24): there the kinetic energy is H − V.
+  // kinetic(p) reads the constant mass, which a non-separable problem does not have (kinetic()
+  // throws; its p = m v + qA of an electron is 1e-24): there the kinetic energy is H − V.
   const double kinetic0 = !mechanical ? 0.0
                           : problem.kind() == ProblemKind::kLagrangian
                               ? energy0 - problem.potential(start.q)
@@ -510,7 +513,12 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   const NonConservativeForce* forced = problem.as_forced();
   const auto* force_class = dynamic_cast<const NonConservativeForce*>(&problem);
   const State start = problem.initial_state();
-  const Vec v0 = problem.inverse_mass().cwiseProduct(start.p);
+  // The velocity by kind: M⁻¹p, ∂H/∂p of the LagrangianSystem, or none (a first-order problem).
+  const Vec v0 = problem.kind() == ProblemKind::kSeparable
+                     ? Vec(problem.inverse_mass().cwiseProduct(start.p))
+                 : problem.kind() == ProblemKind::kLagrangian
+                     ? problem.as_lagrangian()->velocity(start.q, start.p)
+                     : Vec(Vec::Zero(problem.dof()));
   if (forced != nullptr) {
     EXPECT_EQ(forced, force_class);
     SparseMatrix C;
@@ -539,6 +547,42 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
                                : problem.as_lagrangian() ? ProblemKind::kLagrangian
                                                          : ProblemKind::kSeparable;
   EXPECT_EQ(problem.kind(), expected) << kind_name(problem.kind());
+}
+
+// The error of a call that must throw std::logic_error, or "" when it does not throw.
+std::string logic_error_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const std::logic_error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// A constant mass exists only for the separable kind: on a Lagrangian problem (M(q)) and a
+// first-order one (no mass) mass(), inverse_mass() and kinetic() throw, naming problem and kind,
+// instead of answering with a placeholder of ones; dof() is set all the same.
+TEST_P(ProblemTest, OnlyTheSeparableKindHasAConstantMass) {
+  const Problem& problem = *problem_;
+  const State start = problem.initial_state();
+  ASSERT_GT(problem.dof(), 0);
+  EXPECT_EQ(start.q.size(), problem.dof());
+  if (problem.kind() == ProblemKind::kSeparable) {
+    EXPECT_EQ(problem.mass().size(), problem.dof());
+    EXPECT_EQ(problem.inverse_mass().size(), problem.dof());
+    EXPECT_NO_THROW(problem.kinetic(start.p));
+    return;
+  }
+  const std::string expected = fmt::format("problem '{}' is of kind {}: it has no constant mass",
+                                           problem.name(), kind_name(problem.kind()));
+  const Vec p = Vec::Ones(problem.dof());
+  for (const auto& [what, call] : std::vector<std::pair<std::string, std::function<void()>>>{
+           {"mass()", [&] { (void)problem.mass(); }},
+           {"inverse_mass()", [&] { (void)problem.inverse_mass(); }},
+           {"kinetic(p)", [&] { (void)problem.kinetic(p); }}}) {
+    EXPECT_NE(logic_error_of(call).find(expected), std::string::npos)
+        << what << " on " << problem.spec() << ": '" << logic_error_of(call) << "'";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, ProblemTest, ::testing::ValuesIn(problem_test_specs()),

@@ -81,7 +81,7 @@ class RodChainJoint final : public Problem, public LagrangianSystem {
       }
     }
     weight_ = gravity * tail_mass.cwiseProduct(length);
-    set_mass(Vec::Ones(n));  // placeholder for dof(): the mass is M(θ) (is_non_separable)
+    set_dof(n);  // no constant mass: the mass is M(θ)
     set_capabilities(kOmegaMax);
     const double time_unit = std::sqrt(length.sum() / gravity);
     set_defaults(0.01 * time_unit, 100.0 * time_unit);

@@ -93,7 +93,7 @@ class SphericalPendulumAngles final : public Problem, public LagrangianSystem {
   const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit SphericalPendulumAngles(const SphericalParameters& parameters)
       : parameters_(parameters), inertia_(parameters.mass * parameters.length * parameters.length) {
-    set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is mL² diag(1, sin²θ)
+    set_dof(2);  // no constant mass: the mass is mL² diag(1, sin²θ)
     unsigned capabilities = kAngularMomentum | kOmegaMax;
     if (parameters.conical) capabilities |= kExact | kPeriod;
     set_capabilities(capabilities);

@@ -22,7 +22,7 @@ class SpringPendulum final : public Problem, public LagrangianSystem {
  public:
   const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit SpringPendulum(const SpringPendulumParameters& parameters) : P_(parameters) {
-    set_mass(Vec::Ones(2));  // placeholder for dof(): the mass is m diag(1, r²)
+    set_dof(2);  // no constant mass: the mass is m diag(1, r²)
     set_capabilities(kOmegaMax);
     // About 125 steps per period of the faster mode, ten periods of the slower.
     const double fastest = omega_max(Vec());

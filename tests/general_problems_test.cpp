@@ -260,8 +260,8 @@ TEST(GeneralRows, RerunningARowsMethodSpecReproducesIt) {
 
 // initial=FILE on the general kind: a q,v file gives the canonical p = M(q)v (written out here
 // for the double pendulum at non-unit masses and lengths), and the problem started from its own
-// start through a file runs exactly as the problem itself — so the wrapper forwards M(q), not
-// the placeholder unit mass.
+// start through a file runs exactly as the problem itself — so the wrapper forwards M(q) (it
+// has no constant mass).
 TEST(GeneralRows, InitialStateFileUsesThePositionDependentMass) {
   const std::filesystem::path dir =
       std::filesystem::path(testing::TempDir()) / "geomint_general_initial";
