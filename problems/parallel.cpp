@@ -193,6 +193,20 @@ namespace {
 // Below this many non-zeros per chunk a thread costs more than it saves (docs/PERF.md).
 constexpr std::size_t kMinNonZerosPerChunk = 1 << 16;
 
+// First (block) column of each chunk when [0, columns) is cut into `chunks` pieces of about equal
+// non-zero counts (outer: the prefix sums of the non-zeros per column).
+std::vector<Eigen::Index> balanced_columns(const int* outer, Eigen::Index columns, int chunks) {
+  const auto nonzeros = static_cast<std::size_t>(outer[columns] - outer[0]);
+  std::vector<Eigen::Index> first(static_cast<std::size_t>(chunks) + 1, columns);
+  first[0] = 0;
+  for (int chunk = 1; chunk < chunks; ++chunk) {
+    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
+    first[static_cast<std::size_t>(chunk)] =
+        std::lower_bound(outer, outer + columns, target) - outer;
+  }
+  return first;
+}
+
 }  // namespace
 
 void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
@@ -220,37 +234,13 @@ void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::Vector
     return;
   }
   // Chunk c covers the columns whose first non-zero lies in the c-th equal share of them.
-  std::vector<Eigen::Index> first_column(static_cast<std::size_t>(chunks) + 1, n);
-  first_column[0] = 0;
-  for (int chunk = 1; chunk < chunks; ++chunk) {
-    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
-    first_column[static_cast<std::size_t>(chunk)] =
-        std::lower_bound(outer, outer + n, target) - outer;
-  }
+  const std::vector<Eigen::Index> first_column = balanced_columns(outer, n, chunks);
   for_each_chunk(chunks, static_cast<std::size_t>(chunks),
                  [&](int chunk, std::size_t, std::size_t) {
                    multiply(first_column[static_cast<std::size_t>(chunk)],
                             first_column[static_cast<std::size_t>(chunk) + 1]);
                  });
 }
-
-namespace {
-
-// First block column of each chunk when [0, columns) is cut into `chunks` pieces of about equal
-// non-zero counts (outer: the prefix sums of the non-zeros per column).
-std::vector<Eigen::Index> balanced_columns(const int* outer, Eigen::Index columns, int chunks) {
-  const auto nonzeros = static_cast<std::size_t>(outer[columns] - outer[0]);
-  std::vector<Eigen::Index> first(static_cast<std::size_t>(chunks) + 1, columns);
-  first[0] = 0;
-  for (int chunk = 1; chunk < chunks; ++chunk) {
-    const int target = outer[0] + static_cast<int>(chunk_begin(nonzeros, chunk, chunks));
-    first[static_cast<std::size_t>(chunk)] =
-        std::lower_bound(outer, outer + columns, target) - outer;
-  }
-  return first;
-}
-
-}  // namespace
 
 bool to_symmetric_blocks(const Eigen::SparseMatrix<double>& A, SymmetricBlockMatrix& blocks) {
   blocks = SymmetricBlockMatrix{};
