@@ -207,6 +207,25 @@ std::vector<Eigen::Index> balanced_columns(const int* outer, Eigen::Index column
   return first;
 }
 
+// multiply(first, last) over [0, columns) in chunks of about equal non-zero counts, on the pool
+// when there is enough work (the column ranges each chunk owns are disjoint: no two threads
+// write one entry).
+template <typename Multiply>
+void multiply_in_balanced_chunks(const int* outer, Eigen::Index columns, std::size_t nonzeros,
+                                 const Multiply& multiply) {
+  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
+  if (chunks == 1) {
+    multiply(Eigen::Index{0}, columns);
+    return;
+  }
+  const std::vector<Eigen::Index> first = balanced_columns(outer, columns, chunks);
+  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
+                 [&](int chunk, std::size_t, std::size_t) {
+                   multiply(first[static_cast<std::size_t>(chunk)],
+                            first[static_cast<std::size_t>(chunk) + 1]);
+                 });
+}
+
 }  // namespace
 
 void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x,
@@ -227,19 +246,8 @@ void symmetric_product(const Eigen::SparseMatrix<double>& A, const Eigen::Vector
       y[column] = sum;
     }
   };
-  const auto nonzeros = static_cast<std::size_t>(outer[n] - outer[0]);
-  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
-  if (chunks == 1) {
-    multiply(0, n);
-    return;
-  }
   // Chunk c covers the columns whose first non-zero lies in the c-th equal share of them.
-  const std::vector<Eigen::Index> first_column = balanced_columns(outer, n, chunks);
-  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
-                 [&](int chunk, std::size_t, std::size_t) {
-                   multiply(first_column[static_cast<std::size_t>(chunk)],
-                            first_column[static_cast<std::size_t>(chunk) + 1]);
-                 });
+  multiply_in_balanced_chunks(outer, n, static_cast<std::size_t>(outer[n] - outer[0]), multiply);
 }
 
 bool to_symmetric_blocks(const Eigen::SparseMatrix<double>& A, SymmetricBlockMatrix& blocks) {
@@ -334,18 +342,9 @@ void symmetric_product(const SymmetricBlockMatrix& A, const Eigen::VectorXd& x,
       out[3 * I + 2] = s2;
     }
   };
-  const auto nonzeros = 9 * static_cast<std::size_t>(outer[block_columns] - outer[0]);
-  const int chunks = chunk_count(nonzeros, kMinNonZerosPerChunk);
-  if (chunks == 1) {
-    multiply(0, block_columns);
-    return;
-  }
-  const std::vector<Eigen::Index> first = balanced_columns(outer, block_columns, chunks);
-  for_each_chunk(chunks, static_cast<std::size_t>(chunks),
-                 [&](int chunk, std::size_t, std::size_t) {
-                   multiply(first[static_cast<std::size_t>(chunk)],
-                            first[static_cast<std::size_t>(chunk) + 1]);
-                 });
+  multiply_in_balanced_chunks(outer, block_columns,
+                              9 * static_cast<std::size_t>(outer[block_columns] - outer[0]),
+                              multiply);
 }
 
 }  // namespace geomint
