@@ -7,10 +7,12 @@
 
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "integrators/integrator.hpp"
@@ -126,13 +128,14 @@ void BM_HpMidpointStep(benchmark::State& state) {
 // Threads (issue 30 item 2, docs/PERF.md "Threads"): the energy, gradient and Hessian of the
 // neo-Hookean bar and the product H x, at size index range(0) and range(1) threads (the thread
 // setting is restored afterwards). "eigen_spmv" is Eigen's serial H * x, the reference of
-// geomint::symmetric_product ("spmv"), which gives the same bits.
+// geomint::symmetric_product on the scalar matrix ("spmv") and on its 3×3-block copy, the one CG
+// uses ("block_spmv"), which give the same bits.
 // The fastest repetition: the least disturbed by other processes on a shared machine.
 double fastest(const std::vector<double>& times) {
   return *std::min_element(times.begin(), times.end());
 }
 
-enum class Kernel { kEnergy, kGradient, kHessian, kSpmv, kEigenSpmv };
+enum class Kernel { kEnergy, kGradient, kHessian, kSpmv, kBlockSpmv, kEigenSpmv };
 
 void BM_Threads(benchmark::State& state, Kernel kernel) {
   const int saved_threads = geomint::thread_count();
@@ -141,6 +144,8 @@ void BM_Threads(benchmark::State& state, Kernel kernel) {
   const Vec q = deformed(*problem);
   SparseMatrix H;
   problem->hessian(q, H);
+  geomint::SymmetricBlockMatrix blocks;  // the 3×3-block copy CG multiplies with
+  geomint::to_symmetric_blocks(H, blocks);
   Vec out;
   double energy = 0;
   for (auto _ : state) {
@@ -157,6 +162,9 @@ void BM_Threads(benchmark::State& state, Kernel kernel) {
         break;
       case Kernel::kSpmv:
         geomint::symmetric_product(H, q, out);
+        break;
+      case Kernel::kBlockSpmv:
+        geomint::symmetric_product(blocks, q, out);
         break;
       case Kernel::kEigenSpmv:
         out.noalias() = H * q;
@@ -192,6 +200,11 @@ BENCHMARK_CAPTURE(BM_Threads, spmv, Kernel::kSpmv)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->ComputeStatistics("min", fastest);
+BENCHMARK_CAPTURE(BM_Threads, block_spmv, Kernel::kBlockSpmv)
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->ComputeStatistics("min", fastest);
 BENCHMARK_CAPTURE(BM_Threads, eigen_spmv, Kernel::kEigenSpmv)
     ->ArgsProduct({{1, 2}, {1}})
     ->Unit(benchmark::kMillisecond)
@@ -200,6 +213,25 @@ BENCHMARK_CAPTURE(BM_Threads, eigen_spmv, Kernel::kEigenSpmv)
 
 // One iteration each: at 10⁵ tetrahedra a step is minutes, almost all of it in the simplicial
 // sparse LDLᵀ factorisations of the Newton steps (3 per step measured on 2026-12-01).
+// The pool's cost per threaded loop (docs/PERF.md "Pool wake-up"): an empty loop of two chunks,
+// back to back, so the worker is still polling when the next one starts (kPoolPollBeforeSleep),
+// and after a pause of 1 ms (range(0) = 1), when it has gone to sleep and must be woken.
+void BM_PoolLoop(benchmark::State& state) {
+  const bool after_pause = state.range(0) == 1;
+  const int saved_threads = geomint::thread_count();
+  geomint::set_thread_count(2);
+  for (auto _ : state) {
+    if (after_pause) {
+      state.PauseTiming();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      state.ResumeTiming();
+    }
+    geomint::for_each_chunk(2, 2, [](int, std::size_t, std::size_t) {});
+  }
+  geomint::set_thread_count(saved_threads);
+}
+BENCHMARK(BM_PoolLoop)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
 BENCHMARK(BM_HpMidpointStep)->DenseRange(1, 2)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 BENCHMARK_CAPTURE(BM_Gradient, neohookean, std::string("neohookean"))

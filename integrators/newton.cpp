@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "integrators/boomer_amg.hpp"
+#include "integrators/conjugate_gradient.hpp"
 #include "integrators/newton_profile.hpp"
 #include "problems/parallel.hpp"
 #include "problems/spec.hpp"
@@ -31,52 +32,6 @@ namespace geomint {
 namespace {
 
 using MetisLdlt = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::MetisOrdering<int>>;
-
-// Preconditioned conjugate gradients on A (stored in full, both triangles), from x = 0, until
-// ‖b − Ax‖ ≤ target. Written out rather than Eigen's ConjugateGradient for the curvature test:
-// pᵀAp ≤ 0 proves A is not positive definite, which is what the SPD safeguard needs to know
-// (Nocedal & Wright §5.1 and §7.1, truncated CG). `multiply(p, Ap)` is the threaded
-// geomint::symmetric_product (problems/parallel.hpp) on the scalar or the 3×3-block copy of A,
-// the same bits either way and at any thread count.
-enum class CgOutcome { kConverged, kNegativeCurvature, kNoConvergence };
-
-// ‖r‖₂ as robust_norm gives it, from one pass over r where the sum of squares is far from under-
-// and overflow (a CG residual is tested every iteration; robust_norm takes two passes and a
-// temporary). Squares that underflow below 1e-200 change no bit of a sum above it.
-double residual_norm(const Vec& r) {
-  const double squares = r.squaredNorm();
-  return squares > 1e-200 && squares < 1e300 ? std::sqrt(squares) : robust_norm(r);
-}
-
-template <class Multiply, class Preconditioner>
-CgOutcome preconditioned_cg(const Multiply& multiply, const Preconditioner& preconditioner,
-                            const Vec& b, double target, int max_iterations, Vec& x,
-                            int& iterations, double& final_residual) {
-  iterations = 0;
-  x = Vec::Zero(b.size());
-  Vec r = b;
-  final_residual = residual_norm(r);
-  if (final_residual <= target) return CgOutcome::kConverged;
-  Vec z = preconditioner.solve(r);
-  Vec p = z, Ap;
-  double rz = r.dot(z);
-  for (int k = 0; k < max_iterations; ++k) {
-    ++iterations;
-    multiply(p, Ap);
-    const double curvature = p.dot(Ap);
-    if (!(curvature > 0.0)) return CgOutcome::kNegativeCurvature;
-    const double alpha = rz / curvature;
-    x += alpha * p;
-    r -= alpha * Ap;
-    final_residual = residual_norm(r);
-    if (final_residual <= target) return CgOutcome::kConverged;
-    z = preconditioner.solve(r);
-    const double rz_next = r.dot(z);
-    p = z + (rz_next / rz) * p;
-    rz = rz_next;
-  }
-  return CgOutcome::kNoConvergence;
-}
 
 // Wall-clock seconds of a phase of the solve, added to a NewtonProfile total when it ends.
 class PhaseTimer {
@@ -185,7 +140,7 @@ struct NewtonSolver::Factorisation {
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
   MetisLdlt ldlt_metis;
   Eigen::CholmodSupernodalLLT<SparseMatrix> cholmod;
-  Eigen::DiagonalPreconditioner<double> diagonal;
+  JacobiPreconditioner jacobi;
   Eigen::IncompleteCholesky<double, Eigen::Lower> ichol;
   Eigen::SparseLU<SparseMatrix> lu;
   BoomerAmg amg;
@@ -305,8 +260,8 @@ struct NewtonSolver::Factorisation {
           ok = analyse_and_factorise(cholmod, matrix, analyse);
           break;
         case LinearSolverKind::kCg:
-          diagonal.compute(matrix);
-          ok = diagonal.info() == Eigen::Success;
+          jacobi.compute(matrix);
+          ok = true;
           break;
         case LinearSolverKind::kCgIchol:
           ok = analyse_and_factorise(ichol, matrix, analyse);
@@ -386,7 +341,7 @@ struct NewtonSolver::Factorisation {
     }
     if (outcome != CgOutcome::kConverged) return outcome;
     const double decades =
-        cg_residual > 0.0 ? std::max(1.0, std::log10(residual_norm(rhs) / cg_residual)) : 1.0;
+        cg_residual > 0.0 ? std::max(1.0, std::log10(cg_residual_norm(rhs) / cg_residual)) : 1.0;
     if (amg_baseline_iterations < 0) {
       amg_baseline_iterations = iterations / decades;
     } else if (iterations >
@@ -440,8 +395,8 @@ struct NewtonSolver::Factorisation {
         out = cholmod.solve(rhs);
         break;
       case LinearSolverKind::kCg:
-        outcome = preconditioned_cg(cg_product(), diagonal, rhs, cg_target, max_cg, out, iterations,
-                                    cg_residual);
+        outcome =
+            jacobi_cg(cg_product(), jacobi, rhs, cg_target, max_cg, out, iterations, cg_residual);
         *cg_iterations_counter += iterations;
         break;
       case LinearSolverKind::kCgIchol:

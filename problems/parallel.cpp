@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <mutex>
@@ -100,14 +102,41 @@ namespace {
 
 std::atomic<long> started_threads{0};
 
+// kPoolPollBeforeSleep (problems/parallel.hpp): a CG iteration runs one threaded product every
+// ~0.4 ms with serial vector updates between them, and waking a sleeping thread costs ~25 µs here
+// (a futex round trip in a VM; docs/PERF.md "Pool wake-up"), so a worker that polls a little
+// longer than those gaps starts the next loop at once. Bounded, and yielding the core while it
+// polls, so an idle pool sleeps and a pool sharing its cores with other work costs it little.
+// Polls `ready` until it is true or kPoolPollBeforeSleep has passed; whether it became true.
+template <typename Ready>
+bool poll(const Ready& ready) {
+  const auto start = std::chrono::steady_clock::now();
+  for (int round = 1;; ++round) {
+    if (ready()) return true;
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+    if (round % 64 == 0) {
+      if (std::chrono::steady_clock::now() - start > kPoolPollBeforeSleep) return ready();
+      std::this_thread::yield();
+    }
+  }
+}
+
 // Workers 1, 2, … of run_chunks, each running the chunk of its own index of the current loop. One
 // loop at a time (`in_use`); the caller runs chunk 0 and waits until every other chunk is done.
+// A loop is published as a ticket (its sequence number and chunk count in one atomic word, so a
+// worker never pairs one loop's number with another's count) and a finished chunk by decrementing
+// `pending_`. Both sides poll for these a short while before they sleep (kPoolPollBeforeSleep)
+// when the loop has no more threads than the hardware (with more, a polling thread would hold a
+// core that a working one needs), and every change a sleeper waits for is made or followed under
+// `mutex_` before the notify, so no wake-up is lost.
 class ChunkPool {
  public:
   ~ChunkPool() {
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
+      stop_.store(true, std::memory_order_release);
     }
     wake_.notify_all();
     for (std::thread& worker : workers_) worker.join();
@@ -122,47 +151,68 @@ class ChunkPool {
       workers_.emplace_back([this, index] { work(index); });
       started_threads.fetch_add(1, std::memory_order_relaxed);
     }
+    // Safe to write: every worker of the last loop has finished with job_ (pending_ reached 0).
+    job_ = &run;
+    pending_.store(chunks - 1, std::memory_order_relaxed);
     {
+      // The release publishes job_ and pending_ to the workers that see the new ticket.
       const std::lock_guard<std::mutex> lock(mutex_);
-      job_ = &run;
-      job_chunks_ = chunks;
-      pending_ = chunks - 1;
-      ++generation_;
+      ++loops_;
+      ticket_.store(loops_ << kChunkBits | static_cast<std::uint64_t>(chunks),
+                    std::memory_order_release);
     }
     wake_.notify_all();
     run(0);
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [this] { return pending_ == 0; });
-    job_ = nullptr;
+    const auto all_done = [this] { return pending_.load(std::memory_order_acquire) == 0; };
+    if (!(chunks <= hardware_threads() && poll(all_done))) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      done_.wait(lock, all_done);
+    }
     return true;
   }
 
  private:
+  static constexpr int kChunkBits = 16;
+  static_assert(kMaxThreads < (1 << kChunkBits), "a ticket's chunk count takes kChunkBits");
+
   void work(int index) {
-    unsigned long seen = 0;
-    std::unique_lock<std::mutex> lock(mutex_);
+    std::uint64_t seen = 0;
+    bool may_poll = false;  // whether the last loop left a core per thread
     while (true) {
-      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-      if (stop_) return;
-      seen = generation_;
-      if (index >= job_chunks_) continue;  // this loop has fewer chunks than workers
-      const std::function<void(int)>* job = job_;
-      lock.unlock();
-      (*job)(index);
-      lock.lock();
-      if (--pending_ == 0) done_.notify_one();
+      const auto news = [&] {
+        return stop_.load(std::memory_order_acquire) ||
+               ticket_.load(std::memory_order_acquire) != seen;
+      };
+      if (!(may_poll && poll(news))) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, news);
+      }
+      if (stop_.load(std::memory_order_acquire)) return;
+      seen = ticket_.load(std::memory_order_acquire);
+      const int chunks = static_cast<int>(seen & ((std::uint64_t{1} << kChunkBits) - 1));
+      // A worker outside the loop, or one of more threads than cores, sleeps at once next time.
+      may_poll = index < chunks && chunks <= hardware_threads();
+      if (index >= chunks) continue;  // this loop has fewer chunks than workers
+      (*job_)(index);
+      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+        // The caller may have found pending_ > 0 and be about to sleep: notify under the mutex,
+        // which it holds from that test until it sleeps.
+        const std::lock_guard<std::mutex> lock(mutex_);
+        done_.notify_one();
+      }
     }
   }
 
   std::mutex in_use_;
-  std::mutex mutex_;  // guards everything below
+  std::mutex mutex_;  // held to publish a ticket and to notify; sleepers wait on it
   std::condition_variable wake_, done_;
-  std::vector<std::thread> workers_;
+  std::vector<std::thread> workers_;  // changed only by the loop holding in_use_
+  // Written by the caller before it publishes a ticket; read by the workers of that loop only.
   const std::function<void(int)>* job_ = nullptr;
-  int job_chunks_ = 0;
-  int pending_ = 0;  // chunks ≥ 1 of the current loop not yet finished
-  unsigned long generation_ = 0;
-  bool stop_ = false;
+  std::uint64_t loops_ = 0;               // guarded by mutex_
+  std::atomic<std::uint64_t> ticket_{0};  // loops_ << kChunkBits | chunks of the current loop
+  std::atomic<int> pending_{0};           // chunks ≥ 1 of the current loop not yet finished
+  std::atomic<bool> stop_{false};
 };
 
 ChunkPool& chunk_pool() {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <chrono>
 #include <cstddef>
 #include <exception>
 #include <functional>
@@ -42,9 +43,12 @@ inline std::size_t chunk_begin(std::size_t items, int chunk, int chunks) {
 // Runs run(chunk) for every chunk in [0, chunks): chunk 0 on the calling thread, chunk c ≥ 1 on
 // worker c of a persistent pool (started on first use, kept until the process ends), so a loop
 // costs a wake-up per chunk instead of a thread start (~180 products per implicit step of the
-// elastic bar: docs/PERF.md "Persistent thread pool"). While another loop holds the pool (a sweep's
-// concurrent runs, or a loop inside a chunk) the chunks run on threads of their own instead.
-// Which thread runs a chunk never changes what it computes. `run` must not throw.
+// elastic bar: docs/PERF.md "Persistent thread pool"). After a loop, the workers and the caller
+// waiting for them poll for up to kPoolPollBeforeSleep before they sleep, so loops that follow
+// each other closely skip the wake-up (docs/PERF.md "Pool wake-up"). While another loop holds the
+// pool (a sweep's concurrent runs, or a loop inside a chunk) the chunks run on threads of their
+// own instead. Which thread runs a chunk never changes what it computes. `run` must not throw.
+inline constexpr std::chrono::microseconds kPoolPollBeforeSleep{200};
 void run_chunks(int chunks, const std::function<void(int)>& run);
 // Threads started by run_chunks since the process began (pool workers and fallback threads), for
 // tests and benchmarks: constant while the pool serves every loop.

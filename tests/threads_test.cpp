@@ -5,9 +5,11 @@
 // exceptions on, also for concurrent and nested loops; the pool's workers persist; the setting
 // refuses what it cannot use.
 #include <gtest/gtest.h>
+#include <time.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -233,6 +235,42 @@ TEST(ParallelChunks, LoopsReuseThePoolsWorkers) {
   }
   EXPECT_EQ(threads_started(), started);
   EXPECT_EQ(sum.load(), 1000L * (299 * 300 / 2));
+}
+
+// The pool's two ways to hand over a loop, polling and sleeping (kPoolPollBeforeSleep): loops
+// back to back (workers still polling), loops after a pause far longer than the poll (workers
+// asleep), and loops whose worker chunk outlasts the poll (the caller sleeps until it ends) each
+// cover every item once on the same workers; and an idle pool sleeps rather than polls, so it
+// takes no CPU time of its own while the process waits.
+TEST(ParallelChunks, LoopsRunWhetherThePoolPollsOrSleeps) {
+  for_each_chunk(2, 2, [](int, std::size_t, std::size_t) {});
+  const long started = threads_started();
+  constexpr std::size_t kItems = 64;
+  const auto covered_once = [&](bool slow_worker) {
+    std::vector<std::atomic<int>> hits(kItems);
+    for_each_chunk(2, kItems, [&](int chunk, std::size_t begin, std::size_t end) {
+      if (slow_worker && chunk == 1) std::this_thread::sleep_for(5 * kPoolPollBeforeSleep);
+      for (std::size_t i = begin; i < end; ++i) ++hits[i];
+    });
+    return std::all_of(hits.begin(), hits.end(), [](const std::atomic<int>& h) { return h == 1; });
+  };
+  for (int loop = 0; loop < 200; ++loop)
+    EXPECT_TRUE(covered_once(false)) << "back to back " << loop;
+  for (int loop = 0; loop < 5; ++loop) {
+    std::this_thread::sleep_for(10 * kPoolPollBeforeSleep);
+    EXPECT_TRUE(covered_once(false)) << "after a pause " << loop;
+    EXPECT_TRUE(covered_once(true)) << "slow worker " << loop;
+  }
+  EXPECT_EQ(threads_started(), started);
+  // 200 ms idle: a pool that never stopped polling would take about as much CPU time.
+  const auto process_cpu_seconds = [] {
+    timespec now{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+  };
+  const double cpu_before = process_cpu_seconds();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_LT(process_cpu_seconds() - cpu_before, 0.05);
 }
 
 // Loops from several threads at once (a sweep's concurrent runs) and a loop inside a chunk: the
