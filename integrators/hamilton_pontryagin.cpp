@@ -183,6 +183,7 @@ class HamiltonPontryagin final : public Integrator,
     h_ = h;
     memo_valid_ = false;
     potential_memo_valid_ = false;
+    potential_with_gradient_ = false;
 
     // b = p_k, or p_k − h∇V(q_k) for α = 0, where the potential impulse does not depend on v.
     b_ = state.p;
@@ -305,6 +306,10 @@ class HamiltonPontryagin final : public Integrator,
             potential_memo_ = eval_potential(problem, q0_ + (alpha_ * h_) * x);
             potential_memo_v_ = x;
             potential_memo_valid_ = true;
+            potential_memo_uncounted_ = false;
+          } else if (potential_memo_uncounted_) {
+            ++counters_.energy_evals;
+            potential_memo_uncounted_ = false;
           }
           const double potential = ((1 - alpha_) / alpha_) * potential_memo_;
           energy += potential;
@@ -326,9 +331,10 @@ class HamiltonPontryagin final : public Integrator,
       // E_k at v₀ is near −½p_kᵀM⁻¹p_k + V: its terms can cancel, so |E_k| understates the noise.
       // V(x) itself is computed with an error of about ε(|V| + Σ|x_i||∂_iV|) — its terms, plus the
       // rounding of the argument x (a pendulum after many turns, a net far from the origin).
+      potential_with_gradient_ = coupled;
+      if (coupled) implicit_terms(problem, v);  // memoised: ∇V(q^α(v₀)), and V with it if it can
       terms(v, system.objective_scale);
       if (coupled) {
-        implicit_terms(problem, v);  // memoised: ∇V(q^α(v₀))
         system.objective_scale += ((1 - alpha_) / alpha_) *
                                   (q0_ + (alpha_ * h_) * v).cwiseAbs().dot(gradient_.cwiseAbs());
       }
@@ -406,7 +412,18 @@ class HamiltonPontryagin final : public Integrator,
     if (memo_valid_ && memo_v_ == v) return;
     implicit_term_.setZero(v.size());
     if (alpha_ > 0.0 && alpha_ < 1.0) {
-      eval_gradient(problem, q0_ + (alpha_ * h_) * v, gradient_);
+      const Vec q_alpha = q0_ + (alpha_ * h_) * v;
+      if (potential_with_gradient_) {
+        double potential = 0.0;
+        if (eval_gradient_with_potential(problem, q_alpha, gradient_, potential)) {
+          potential_memo_ = potential;
+          potential_memo_v_ = v;
+          potential_memo_valid_ = true;
+          potential_memo_uncounted_ = true;
+        }
+      } else {
+        eval_gradient(problem, q_alpha, gradient_);
+      }
       implicit_term_ += ((1 - alpha_) * h_) * gradient_;
     }
     if (minus_ > 0.0) {
@@ -446,6 +463,12 @@ class HamiltonPontryagin final : public Integrator,
   bool potential_memo_valid_ = false;
   double potential_memo_ = 0.0;  // V(q^α(potential_memo_v_))
   Vec potential_memo_v_;
+  // The memo was filled by implicit_terms with the gradient and not yet used by the objective,
+  // which counts the energy evaluation when it first uses it.
+  bool potential_memo_uncounted_ = false;
+  // implicit_terms takes V with ∇V where the problem has one pass for both: set while the
+  // minimiser, whose line search takes E_k wherever it takes R, solves.
+  bool potential_with_gradient_ = false;
 
   Vec mass_diagonal_;
   SparseMatrix mass_matrix_, hessian_, damping_;

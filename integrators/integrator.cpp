@@ -379,6 +379,14 @@ void Integrator::eval_gradient(const Problem& problem, const Vec& q, Vec& g) {
   problem.gradient(q, g);
 }
 
+bool Integrator::eval_gradient_with_potential(const Problem& problem, const Vec& q, Vec& g,
+                                              double& V) {
+  ++counters_.force_evals;
+  if (problem.potential_with_gradient(q, g, V)) return true;
+  problem.gradient(q, g);
+  return false;
+}
+
 double Integrator::eval_potential(const Problem& problem, const Vec& q) {
   ++counters_.energy_evals;
   return problem.potential(q);

@@ -249,6 +249,11 @@ class Integrator {
   // Evaluation helpers that keep the counters honest.
   void eval_gradient(const Problem& problem, const Vec& q, Vec& g);
   double eval_potential(const Problem& problem, const Vec& q);
+  // gradient and, where the problem computes it in the same pass
+  // (Problem::potential_with_gradient), the potential: whether V was set. Counts a force evaluation
+  // only; the caller counts the energy evaluation when it uses V (so the counters record what the
+  // method asked for).
+  bool eval_gradient_with_potential(const Problem& problem, const Vec& q, Vec& g, double& V);
   void eval_hessian(const Problem& problem, const Vec& q, SparseMatrix& H);
   void eval_force(const Problem& problem, const Vec& q, const Vec& v, double t, Vec& f);
   // −∇V(q) + F(q, v, t): the total generalized force.

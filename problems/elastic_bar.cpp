@@ -95,6 +95,15 @@ struct Stvk {
     P = (Mat3::Identity() + H) * S;
     return true;
   }
+  // energy(H) and stress(H, P) with E formed once: the same bits as the two.
+  bool energy_and_stress(const Mat3& H, double& W, Mat3& P) const {
+    const Mat3 E = green(H);
+    const double trace = E.trace();
+    W = mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
+    const Mat3 S = 2 * mu * E + lambda * E.trace() * Mat3::Identity();
+    P = (Mat3::Identity() + H) * S;
+    return true;
+  }
   // dP = dF S + F dS, dS = μ(dFᵀF + FᵀdF) + λ tr(FᵀdF) I, hence
   // A(ij, kl) = δ_ik S_lj + μ F_il F_kj + μ (FFᵀ)_ik δ_lj + λ F_ij F_kl.
   bool stress_derivative(const Mat3& H, Mat9& A) const {
@@ -155,6 +164,21 @@ struct NeoHookean {
     if (!ok) return false;
     const Mat3 F = Mat3::Identity() + H;
     const Mat3 Q = F.inverse().transpose();  // F⁻ᵀ
+    P = mu * (F - Q) + lambda * log_j * Q;
+    return true;
+  }
+  // energy(H) and stress(H, P) with ln J computed once: the same bits as the two (W = +∞ and
+  // false for an inverted element).
+  bool energy_and_stress(const Mat3& H, double& W, Mat3& P) const {
+    bool ok = false;
+    const double log_j = log_det(H, ok);
+    if (!ok) {
+      W = kInf;
+      return false;
+    }
+    W = 0.5 * mu * (2 * H.trace() + H.squaredNorm()) - mu * log_j + 0.5 * lambda * log_j * log_j;
+    const Mat3 F = Mat3::Identity() + H;
+    const Mat3 Q = F.inverse().transpose();
     P = mu * (F - Q) + lambda * log_j * Q;
     return true;
   }
@@ -224,28 +248,15 @@ class ElasticBar final : public Problem, public HolonomicConstraints, public Non
   // The element energies are computed in chunks, then summed in element order on one thread:
   // the same sum to the bit at any thread count.
   double potential(const Vec& q) const override {
-    const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
-    double elastic = 0;
-    if (chunks == 1) {
-      for (const Tet& tet : tets_) {
-        const double w = energy_density(displacement_gradient(tet, q));
-        if (!(w < kInf)) return kInf;  // inverted neo-Hookean element: outside the domain of V
-        elastic += tet.volume * w;
-      }
-      return elastic + gravity_potential(q);
-    }
     std::vector<double> element_energy(tets_.size());
+    const int chunks = chunk_count(tets_.size(), kMinElementsPerChunk);
     for_each_chunk(chunks, tets_.size(), [&](int, std::size_t begin, std::size_t end) {
       for (std::size_t e = begin; e < end; ++e) {
         const Tet& tet = tets_[e];
         element_energy[e] = tet.volume * energy_density(displacement_gradient(tet, q));
       }
     });
-    for (const double energy : element_energy) {
-      if (!(energy < kInf)) return kInf;
-      elastic += energy;
-    }
-    return elastic + gravity_potential(q);
+    return total_potential(element_energy, q);
   }
 
   // g = Σ_e vol P G ᵀ (the columns are the forces on the 4 nodes) + the gravity load m_i g e_z.
@@ -260,9 +271,31 @@ class ElasticBar final : public Problem, public HolonomicConstraints, public Non
           }
         },
         g);
-    if (config_.gravity != 0) {
-      for (int i = 2; i < dof(); i += 3) g[i] += config_.gravity * mass()[i];
-    }
+    add_gravity_load(g);
+  }
+
+  // potential(q) and gradient(q, g) in one element loop (H, and ln J or E, formed once per
+  // element), with the bits of the two: the HP minimiser's line search needs E_k wherever it takes
+  // the residual (docs/PERF.md "Energy with the gradient").
+  bool potential_with_gradient(const Vec& q, Vec& g, double& V) const override {
+    std::vector<double> element_energy(tets_.size());
+    const Tet* first_tet = tets_.data();
+    assemble_nodal(
+        [&](const Tet& tet, Mat34& nodal) {
+          Mat3 P;
+          double w = 0;
+          const bool finite = energy_and_stress(displacement_gradient(tet, q), w, P);
+          element_energy[static_cast<std::size_t>(&tet - first_tet)] = tet.volume * w;
+          if (finite) {
+            nodal = tet.volume * P * tet.G.transpose();
+          } else {
+            nodal.setConstant(kNaN);
+          }
+        },
+        g);
+    add_gravity_load(g);
+    V = total_potential(element_energy, q);
+    return true;
   }
 
   void hessian(const Vec& q, SparseMatrix& H) const override {
@@ -455,6 +488,11 @@ class ElasticBar final : public Problem, public HolonomicConstraints, public Non
     return config_.material == Material::kStvk ? Stvk{mu_, lambda_}.stress(H, P)
                                                : NeoHookean{mu_, lambda_}.stress(H, P);
   }
+  bool energy_and_stress(const Mat3& H, double& W, Mat3& P) const {
+    return config_.material == Material::kStvk
+               ? Stvk{mu_, lambda_}.energy_and_stress(H, W, P)
+               : NeoHookean{mu_, lambda_}.energy_and_stress(H, W, P);
+  }
   bool stress_derivative(const Mat3& H, Mat9& A) const {
     return config_.material == Material::kStvk ? Stvk{mu_, lambda_}.stress_derivative(H, A)
                                                : NeoHookean{mu_, lambda_}.stress_derivative(H, A);
@@ -497,6 +535,23 @@ class ElasticBar final : public Problem, public HolonomicConstraints, public Non
     return chunk > 0 && static_cast<std::size_t>(
                             std::max(first_element_[static_cast<std::size_t>(dof_a / 3)],
                                      first_element_[static_cast<std::size_t>(dof_b / 3)])) < begin;
+  }
+
+  // Σ_e of the element energies in element order, +∞ when one is not finite (an inverted
+  // neo-Hookean element: outside the domain of V), plus the gravity potential.
+  double total_potential(const std::vector<double>& element_energy, const Vec& q) const {
+    double elastic = 0;
+    for (const double energy : element_energy) {
+      if (!(energy < kInf)) return kInf;
+      elastic += energy;
+    }
+    return elastic + gravity_potential(q);
+  }
+
+  void add_gravity_load(Vec& g) const {
+    if (config_.gravity != 0) {
+      for (int i = 2; i < dof(); i += 3) g[i] += config_.gravity * mass()[i];
+    }
   }
 
   // Σ_e of the 3×4 nodal vectors `element(tet, nodal)` into `out` (size dof(), zeroed first).

@@ -145,6 +145,13 @@ class Problem {
   virtual double potential(const Vec& q) const = 0;
   // g = ∇V(q); g is resized by the callee.
   virtual void gradient(const Vec& q, Vec& g) const = 0;
+  // V = potential(q) and g = gradient(q, g), bit for bit, from one pass where the problem has one
+  // (an element loop forming each element's strain once): true. False, with g and V untouched,
+  // where it has none; the caller then calls the two. For callers that need V wherever they take
+  // ∇V (the HP minimiser's line search, docs/PERF.md "Energy with the gradient").
+  virtual bool potential_with_gradient(const Vec& /*q*/, Vec& /*g*/, double& /*V*/) const {
+    return false;
+  }
   // The same ∇V as an inlineable functor (problems/fixed_gradient.hpp) for problems with a few
   // dof, so explicit methods can run a statically typed step loop; std::monostate when not
   // offered. Must round exactly as gradient() does (both call the functor).

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -243,6 +244,29 @@ TEST_P(ProblemTest, GradientMatchesFiniteDifferences) {
       const double difference = (8 * (values[0] - values[1]) - (values[2] - values[3])) / (12 * h);
       EXPECT_NEAR(g[j], difference, tolerance) << "component " << j << " at q = " << q.transpose();
     }
+  }
+}
+
+// The one-pass V and ∇V (Problem::potential_with_gradient), where a problem has it, are those of
+// potential() and gradient() bit for bit, so a method may use either; where it has none it says so
+// and leaves its outputs alone.
+TEST_P(ProblemTest, PotentialWithGradientHasTheBitsOfTheTwo) {
+  const Problem& problem = *problem_;
+  if (problem.has(kFirstOrderOnly)) GTEST_SKIP() << "first-order only: no potential";
+  for (const Vec& q : sample_configurations(problem)) {
+    Vec g = Vec::Constant(3, 7.0);
+    double V = 7.0;
+    if (!problem.potential_with_gradient(q, g, V)) {
+      EXPECT_EQ(g, Vec::Constant(3, 7.0));
+      EXPECT_EQ(V, 7.0);
+      continue;
+    }
+    Vec g_alone;
+    problem.gradient(q, g_alone);
+    const double V_alone = problem.potential(q);
+    EXPECT_TRUE(V == V_alone || (std::isnan(V) && std::isnan(V_alone))) << V << " " << V_alone;
+    ASSERT_EQ(g.size(), g_alone.size());
+    EXPECT_EQ(std::memcmp(g.data(), g_alone.data(), sizeof(double) * g.size()), 0);
   }
 }
 

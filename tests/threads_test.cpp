@@ -215,6 +215,35 @@ TEST(ParallelChunks, AnExceptionOfAnyChunkReachesTheCaller) {
   }
 }
 
+// The one-pass energy and gradient (Problem::potential_with_gradient, the HP line search's) have
+// the bits of potential() and gradient() at 1–4 threads, for both materials, and for a state with
+// an inverted element: V = +∞ and the same NaN forces.
+TEST(ElasticBarThreads, PotentialWithGradientHasTheBitsOfTheTwoAtAnyThreadCount) {
+  ThreadCountGuard guard;
+  for (const char* material : {"", ",material=stvk"}) {
+    const auto bar = make_problem(std::string(kBar) + material);
+    const Vec q = bar->initial_state().q + 1e-2 * test::random_vector(bar->dof(), 9);
+    Vec inverted = q;
+    inverted.segment<3>(3 * 500) += Eigen::Vector3d(2.0, -3.0, 1.5);  // through its neighbours
+    for (const Vec* state : {static_cast<const Vec*>(&q), static_cast<const Vec*>(&inverted)}) {
+      for (int threads : {1, 2, 3, 4}) {
+        set_thread_count(threads);
+        Vec g, g_alone;
+        double V = 0;
+        ASSERT_TRUE(bar->potential_with_gradient(*state, g, V));
+        bar->gradient(*state, g_alone);
+        const double V_alone = bar->potential(*state);
+        EXPECT_EQ(std::memcmp(&V, &V_alone, sizeof(double)), 0) << material << threads;
+        EXPECT_TRUE(same_bits(g, g_alone)) << material << " " << threads << " threads";
+        if (state == &inverted && std::string(material).empty()) {
+          EXPECT_EQ(V, std::numeric_limits<double>::infinity());
+          EXPECT_FALSE(g.allFinite());
+        }
+      }
+    }
+  }
+}
+
 // The pool's workers persist: after a first loop has started them, a thousand more loops start no
 // thread, and chunk 1 runs on the same thread every time.
 TEST(ParallelChunks, LoopsReuseThePoolsWorkers) {
