@@ -105,7 +105,7 @@ GEOMINT_STEP(hp_cg, "hp:alpha=0.5,linear_solver=cg", 0, 3);
 GEOMINT_STEP(hp_cg_amg, "hp:alpha=0.5,linear_solver=cg_amg", 0, 3);
 GEOMINT_STEP(hp_cg_modified, "hp:alpha=0.5,linear_solver=cg,modified_newton=true", 0, 3);
 // Hessian reuse with the stronger preconditioners: fewer CG iterations, each dearer (docs/PERF.md
-// "Blocked CG and pool wake-up").
+// "Blocked CG").
 GEOMINT_STEP(hp_cg_ichol_modified, "hp:alpha=0.5,linear_solver=cg_ichol,modified_newton=true", 1,
              2);
 GEOMINT_STEP(hp_cg_amg_modified, "hp:alpha=0.5,linear_solver=cg_amg,modified_newton=true", 1, 2);
