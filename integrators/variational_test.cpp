@@ -12,6 +12,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/newton_profile.hpp"
 #include "tests/test_util.hpp"
 #include "verify/verify.hpp"
 
@@ -577,6 +578,26 @@ TEST(Counters, ExplicitRulesSolveNothingAndReuseTheEndGradient) {
   trajectory("hp:alpha=0", *problem, problem->initial_state(), 0.01, 100, nullptr, &work);
   EXPECT_EQ(work.newton_iters, 0);
   EXPECT_EQ(work.force_evals, 100);
+}
+
+// energy_evals counts each point at which the minimiser used E_k (its first value and every line
+// search trial), whether the problem computed V on its own or with ∇V in one pass
+// (Problem::potential_with_gradient: the elastic bar; the pendulum has none), so the counter and
+// the committed rows do not depend on how V was obtained.
+TEST(Counters, MinimiserCountsEveryEnergyItUsesHoweverItWasComputed) {
+  for (const char* spec : {"elastic_bar:nx=3,ny=1,nz=1", "pendulum:theta0=1.5"}) {
+    const auto problem = make_problem(spec);
+    Vec g;
+    double V = 0;
+    const bool one_pass = problem->potential_with_gradient(problem->initial_state().q, g, V);
+    EXPECT_EQ(one_pass, std::string(spec).starts_with("elastic_bar")) << spec;
+    const NewtonProfile before = newton_profile();
+    Counters work;
+    trajectory("hp", *problem, problem->initial_state(), 0.01, 20, nullptr, &work);
+    const NewtonProfile after = newton_profile();
+    EXPECT_GT(work.energy_evals, 20) << spec;
+    EXPECT_EQ(work.energy_evals, after.objectives - before.objectives) << spec;
+  }
 }
 
 TEST(Counters, MinimiserCountsLineSearchEnergiesAndPlainNewtonNone) {
