@@ -84,25 +84,25 @@ struct Stvk {
 
   static Mat3 green(const Mat3& H) { return 0.5 * (H + H.transpose() + H.transpose() * H); }
 
-  double energy(const Mat3& H) const {
-    const Mat3 E = green(H);
-    const double trace = E.trace();
-    return mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
-  }
+  double energy(const Mat3& H) const { return energy_of_strain(green(H)); }
   bool stress(const Mat3& H, Mat3& P) const {
-    const Mat3 E = green(H);
-    const Mat3 S = 2 * mu * E + lambda * E.trace() * Mat3::Identity();
-    P = (Mat3::Identity() + H) * S;
+    stress_of_strain(H, green(H), P);
     return true;
   }
   // energy(H) and stress(H, P) with E formed once: the same bits as the two.
   bool energy_and_stress(const Mat3& H, double& W, Mat3& P) const {
     const Mat3 E = green(H);
+    W = energy_of_strain(E);
+    stress_of_strain(H, E, P);
+    return true;
+  }
+  double energy_of_strain(const Mat3& E) const {
     const double trace = E.trace();
-    W = mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
+    return mu * E.squaredNorm() + 0.5 * lambda * trace * trace;
+  }
+  void stress_of_strain(const Mat3& H, const Mat3& E, Mat3& P) const {
     const Mat3 S = 2 * mu * E + lambda * E.trace() * Mat3::Identity();
     P = (Mat3::Identity() + H) * S;
-    return true;
   }
   // dP = dF S + F dS, dS = μ(dFᵀF + FᵀdF) + λ tr(FᵀdF) I, hence
   // A(ij, kl) = δ_ik S_lj + μ F_il F_kj + μ (FFᵀ)_ik δ_lj + λ F_ij F_kl.
@@ -154,33 +154,31 @@ struct NeoHookean {
   double energy(const Mat3& H) const {
     bool ok = false;
     const double log_j = log_det(H, ok);
-    if (!ok) return kInf;
-    // tr FᵀF − 3 = 2 tr H + ‖H‖²
-    return 0.5 * mu * (2 * H.trace() + H.squaredNorm()) - mu * log_j + 0.5 * lambda * log_j * log_j;
+    return ok ? energy_of(H, log_j) : kInf;
   }
   bool stress(const Mat3& H, Mat3& P) const {
     bool ok = false;
     const double log_j = log_det(H, ok);
-    if (!ok) return false;
-    const Mat3 F = Mat3::Identity() + H;
-    const Mat3 Q = F.inverse().transpose();  // F⁻ᵀ
-    P = mu * (F - Q) + lambda * log_j * Q;
-    return true;
+    if (ok) stress_of(H, log_j, P);
+    return ok;
   }
   // energy(H) and stress(H, P) with ln J computed once: the same bits as the two (W = +∞ and
   // false for an inverted element).
   bool energy_and_stress(const Mat3& H, double& W, Mat3& P) const {
     bool ok = false;
     const double log_j = log_det(H, ok);
-    if (!ok) {
-      W = kInf;
-      return false;
-    }
-    W = 0.5 * mu * (2 * H.trace() + H.squaredNorm()) - mu * log_j + 0.5 * lambda * log_j * log_j;
+    W = ok ? energy_of(H, log_j) : kInf;
+    if (ok) stress_of(H, log_j, P);
+    return ok;
+  }
+  // tr FᵀF − 3 = 2 tr H + ‖H‖²
+  double energy_of(const Mat3& H, double log_j) const {
+    return 0.5 * mu * (2 * H.trace() + H.squaredNorm()) - mu * log_j + 0.5 * lambda * log_j * log_j;
+  }
+  void stress_of(const Mat3& H, double log_j, Mat3& P) const {
     const Mat3 F = Mat3::Identity() + H;
-    const Mat3 Q = F.inverse().transpose();
+    const Mat3 Q = F.inverse().transpose();  // F⁻ᵀ
     P = mu * (F - Q) + lambda * log_j * Q;
-    return true;
   }
   // With Q = F⁻ᵀ, dQ = −Q dFᵀ Q and d ln J = Q : dF:
   // A(ij, kl) = μ δ_ik δ_jl + (μ − λ ln J) Q_il Q_kj + λ Q_ij Q_kl.
