@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "problems/parallel.hpp"
+#include "tests/test_util.hpp"
 
 namespace geomint {
 namespace {
@@ -47,15 +48,6 @@ bool same_bits(const Vec& a, const Vec& b) {
   return a.size() == b.size() &&
          std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
 }
-
-class ThreadCountGuard {
- public:
-  ThreadCountGuard() : saved_(thread_count()) {}
-  ~ThreadCountGuard() { set_thread_count(saved_); }
-
- private:
-  int saved_;
-};
 
 struct Solve {
   CgOutcome outcome = CgOutcome::kNoConvergence;
@@ -116,7 +108,7 @@ TEST(ConjugateGradient, BelowTheBlockedSizeJacobiCgIsTheSerialLoop) {
 
 // n is not a multiple of kCgBlock (a short last block) and spans enough blocks for 4 threads.
 TEST(ConjugateGradient, BlockedLoopSolvesWithTheSameBitsAtAnyThreadCount) {
-  ThreadCountGuard guard;
+  test::ThreadCountGuard guard;
   const Eigen::Index n = 5 * kCgBlock + 1234;
   for (double scale : {1e-150, 1.0, 1e+150}) {
     SCOPED_TRACE(scale);

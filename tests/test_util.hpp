@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "problems/parallel.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
 
@@ -66,5 +67,17 @@ inline Vec random_vector(int n, unsigned seed) {
   for (int k = 0; k < n; ++k) v[k] = uniform(generator);
   return v;
 }
+
+// Restores the thread count (problems/parallel.hpp) the process had when a test ends.
+class ThreadCountGuard {
+ public:
+  ThreadCountGuard() : saved_(thread_count()) {}
+  ~ThreadCountGuard() { set_thread_count(saved_); }
+  ThreadCountGuard(const ThreadCountGuard&) = delete;
+  ThreadCountGuard& operator=(const ThreadCountGuard&) = delete;
+
+ private:
+  int saved_;
+};
 
 }  // namespace geomint::test

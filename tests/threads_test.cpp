@@ -33,16 +33,6 @@ const char* const kBar =
     "elastic_bar:nx=24,ny=8,nz=8,length=2.5,width=0.4,height=0.3,young=3e6,density=700,"
     "damping=0.02";
 
-// Restores the thread count the process had when a test ends.
-class ThreadCountGuard {
- public:
-  ThreadCountGuard() : saved_(thread_count()) {}
-  ~ThreadCountGuard() { set_thread_count(saved_); }
-
- private:
-  int saved_;
-};
-
 bool same_bits(const Vec& a, const Vec& b) {
   return a.size() == b.size() &&
          std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
@@ -72,7 +62,7 @@ Evaluations evaluate(const Problem& bar, const Vec& q, const Vec& v) {
 }
 
 TEST(ElasticBarThreads, EvaluationsAreBitIdenticalAtAnyThreadCount) {
-  ThreadCountGuard guard;
+  test::ThreadCountGuard guard;
   const auto bar = make_problem(kBar);
   ASSERT_EQ(bar->dof(), 3 * 24 * 9 * 9);  // the face x = 0 is clamped
   // A deformed state of 1e-2 relative size, and a velocity: every element matrix differs.
@@ -157,7 +147,7 @@ TEST(ParallelChunks, BlockCopyRefusesPatternsNotMadeOf3x3Blocks) {
 // One step of the HP integrator (Newton with CG on the threaded Hessian and gradient) from a
 // twisted bar: twice at 2 threads and once at 1, the same bytes.
 TEST(ElasticBarThreads, ImplicitStepsAreBitIdenticalAtOneAndTwoThreads) {
-  ThreadCountGuard guard;
+  test::ThreadCountGuard guard;
   // 12·8·8 cells = 4608 tets: 2 chunks at 2 threads.
   const auto bar = make_problem(
       "elastic_bar:nx=12,ny=8,nz=8,length=1.5,width=0.4,height=0.3,young=3e6,density=700,"
@@ -219,7 +209,7 @@ TEST(ParallelChunks, AnExceptionOfAnyChunkReachesTheCaller) {
 // the bits of potential() and gradient() at 1–4 threads, for both materials, and for a state with
 // an inverted element: V = +∞ and the same NaN forces.
 TEST(ElasticBarThreads, PotentialWithGradientHasTheBitsOfTheTwoAtAnyThreadCount) {
-  ThreadCountGuard guard;
+  test::ThreadCountGuard guard;
   for (const char* material : {"", ",material=stvk"}) {
     const auto bar = make_problem(std::string(kBar) + material);
     const Vec q = bar->initial_state().q + 1e-2 * test::random_vector(bar->dof(), 9);
@@ -333,7 +323,7 @@ TEST(ParallelChunks, ConcurrentAndNestedLoopsCoverEveryItemOnce) {
 }
 
 TEST(ThreadSetting, RefusesCountsOutsideItsRangeAndLimitsChunks) {
-  ThreadCountGuard guard;
+  test::ThreadCountGuard guard;
   const auto set_text = [](const std::string& text) { set_thread_count(std::stoi(text)); };
   EXPECT_TRUE(test::input_error_names(set_text, "0",
                                       std::vector<std::string>{"thread count 0", "[1, 256]"}));
