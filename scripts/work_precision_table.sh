@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Post-processing for results/work_precision and work_precision_full (issues 5, 29), run by
+# Post-processing for results/work_precision and work_precision_full, run by
 # scripts/work_precision.gp inside the scene folder: reads summary.csv and writes
 #   wp/<group>/<curve>.dat  one line per ok run of a method curve (a fixed-step method over dt, an
 #                           adaptive one over tolerance), columns:
@@ -23,7 +23,7 @@
 #                           a curve with timed-out runs that
 #                           reaches a level in no run shows "timeout" there (did not reach,
 #                           explicitly); each group lists its timed-out runs; the fastest curve
-#                           per level; and the goal of issue 29 item 5 (best
+#                           per level; and the goal (best
 #                           geomint method against best library solver at 1e-8 on Kepler 10^2,
 #                           10^4 and 10^5 and on the outer solar system).
 # A group is a label without its last _<part> (kepler_1e2_explicit -> kepler_1e2).
@@ -169,7 +169,7 @@ END {
   # Range: the extreme ratios the two runs' spreads allow, from (fastest geomint repeat) /
   # (median + IQR of the library run) to (median + IQR of the geomint run) / (fastest library
   # repeat).
-  print "## Goal (issue 29, item 5): time to error_final <= 1e-8, geomint / library\n"
+  print "## Goal (geomint <= 0.5x the best library): time to error_final <= 1e-8, geomint / library\n"
   for (g = 1; g <= ngroups; g++) {
     group = groups[g]
     # Kepler at every horizon the scenes run (10^2 is the goal's; the longer ones say where it

@@ -6,7 +6,15 @@
   docs_check.py citations SOURCE_DIR  every section a source file cites, `docs/USAGE.md "Exit codes"`
                                       or `docs/DESIGN.md §3`, exists in the cited file
   docs_check.py version SOURCE_DIR    CITATION.cff's `version` is CMakeLists.txt's project(VERSION)
-  docs_check.py readme SOURCE_DIR     README.md stays a five-minute read: at most 250 lines
+  docs_check.py readme SOURCE_DIR     README.md stays a five-minute read: at most 250 lines, and
+                                      every cell of its headline table at most 400 characters
+                                      (the claim and the current number; history goes to docs/)
+  docs_check.py csv SOURCE_DIR        every CSV under results/ reads with pandas' comment="#" (as
+                                      docs/USAGE.md "Reading the CSV files" shows): `# ` lines
+                                      only before the header, no `#` in a header or data row
+  docs_check.py tracker SOURCE_DIR    user documentation (README.md, docs/, results/) cites no
+                                      internal tracker numbers ("issue 29 item 5"), which readers
+                                      cannot see
   docs_check.py selftest SCRATCH_DIR  each check above fails on a seeded error in a scratch tree
 
 Exit 0 when everything resolves, 1 with one line per broken link or citation. Python 3 standard
@@ -146,14 +154,78 @@ def check_version(root: str) -> list[str]:
 
 
 README_MAX_LINES = 250
+HEADLINE_CELL_MAX_CHARS = 400
+
+
+def headline_rows(text: str) -> list[tuple[int, list[str]]]:
+    """The body rows of README.md's "Headline results" table: (line number, cells)."""
+    section = re.search(r"^## Headline results\n(.*?)(?=^## )", text, flags=re.M | re.S)
+    if section is None:
+        return []
+    first_line = text.count("\n", 0, section.start(1)) + 1
+    rows = []
+    for offset, line in enumerate(section.group(1).split("\n")):
+        if not line.startswith("|") or re.match(r"^\|[-| :]+\|$", line):
+            continue
+        cells = [cell.strip() for cell in re.split(r"(?<!\\)\|", line.strip())[1:-1]]
+        rows.append((first_line + offset, cells))
+    return rows[1:]  # the header row
 
 
 def check_readme(root: str) -> list[str]:
     with open(os.path.join(root, "README.md"), encoding="utf-8") as file:
-        lines = file.read().count("\n")
+        text = file.read()
+    problems = []
+    lines = text.count("\n")
     if lines > README_MAX_LINES:
-        return [f"README.md: {lines} lines, more than {README_MAX_LINES}: move detail to docs/"]
-    return []
+        problems.append(f"README.md: {lines} lines, more than {README_MAX_LINES}: move detail to docs/")
+    rows = headline_rows(text)
+    if not rows:
+        problems.append("README.md: no '## Headline results' table")
+    for line, cells in rows:
+        for cell in cells:
+            if len(cell) > HEADLINE_CELL_MAX_CHARS:
+                problems.append(f"README.md:{line}: headline cell of {len(cell)} characters, more "
+                                f"than {HEADLINE_CELL_MAX_CHARS}: give the claim and the current "
+                                f"number, move the history to docs/PERF.md or the scene README")
+    return problems
+
+
+def check_csv(root: str) -> list[str]:
+    problems = []
+    for relative in walk(root, lambda p: p.startswith("results/") and p.endswith(".csv")):
+        with open(os.path.join(root, relative), encoding="utf-8", errors="replace") as file:
+            in_provenance = True
+            for number, line in enumerate(file, start=1):
+                if in_provenance and line.startswith("# "):
+                    continue
+                in_provenance = False
+                if "#" in line:
+                    problems.append(f"{relative}:{number}: '#' in a header or data row: pandas' "
+                                    f"comment=\"#\" would cut the row there")
+                    break
+    return problems
+
+
+# "issue 29", "issues 5, 29", "Issue 30's": numbers of a tracker the readers of these files cannot see.
+TRACKER_REFERENCE = re.compile(r"\bissues? #?\d+", flags=re.I)
+
+
+def user_docs(root: str) -> list[str]:
+    return walk(root, lambda p: p.endswith(".md") and (
+        p == "README.md" or p.startswith("docs/") or p.startswith("results/")
+        or p.startswith("examples/")))
+
+
+def check_tracker(root: str) -> list[str]:
+    problems = []
+    for relative in user_docs(root):
+        with open(os.path.join(root, relative), encoding="utf-8") as file:
+            for number, line in enumerate(file, start=1):
+                for match in TRACKER_REFERENCE.finditer(line):
+                    problems.append(f"{relative}:{number}: cites the internal tracker "
+                                    f"('{match.group(0)}'): say what is measured and why instead")
+    return problems
 
 
 def write(root: str, relative: str, text: str) -> None:
@@ -170,11 +242,14 @@ def selftest(scratch: str) -> list[str]:
     shutil.rmtree(root, ignore_errors=True)
     write(root, "CMakeLists.txt", "project(geomint VERSION 1.2.3 LANGUAGES CXX)\n")
     write(root, "CITATION.cff", 'cff-version: 1.2.0\nversion: "1.2.3"\n')
-    write(root, "README.md", "# t\n\nSee [usage](docs/USAGE.md#exit-codes-and-rows).\n")
+    write(root, "README.md", "# t\n\nSee [usage](docs/USAGE.md#exit-codes-and-rows).\n\n"
+                             "## Headline results\n\n| claim | measured |\n|---|---|\n| a | 1.0 |\n\n"
+                             "## End\n")
     write(root, "docs/USAGE.md", "# Usage\n\n## Exit codes and rows\n\n* **Step budgets.** x\n")
+    write(root, "results/s/summary.csv", "# version: 1\nproblem,status\nx,ok\n")
     write(root, "a.cpp", '// docs/USAGE.md "Exit codes"; docs/USAGE.md\n// "Step budgets"\n')
     checks = {"links": check_links, "citations": check_citations, "version": check_version,
-              "readme": check_readme}
+              "readme": check_readme, "tracker": check_tracker, "csv": check_csv}
     problems = [f"selftest: {name} fails on the clean tree: {found}"
                 for name, check in checks.items() if (found := check(root))]
     seeded = {
@@ -182,6 +257,8 @@ def selftest(scratch: str) -> list[str]:
         "citations": ("a.cpp", '// docs/USAGE.md "Exit status"\n'),
         "version": ("CITATION.cff", 'cff-version: 1.2.0\nversion: "1.2.4"\n'),
         "readme": ("README.md", "line\n" * (README_MAX_LINES + 1)),
+        "tracker": ("docs/USAGE.md", "# Usage\n\nAs issue 29 item 5 asked.\n"),
+        "csv": ("results/s/summary.csv", "# version: 1\nproblem,status\nx#1,ok\n"),
     }
     for name, (relative, text) in seeded.items():
         with open(os.path.join(root, relative), encoding="utf-8") as file:
@@ -190,6 +267,15 @@ def selftest(scratch: str) -> list[str]:
         if not checks[name](root):
             problems.append(f"selftest: {name} passes a seeded error in {relative}")
         write(root, relative, clean)
+    with open(os.path.join(root, "README.md"), encoding="utf-8") as file:
+        clean = file.read()
+    write(root, "README.md", clean.replace("| a | 1.0 |", f"| a | {'9' * 401} |"))
+    if not check_readme(root):
+        problems.append("selftest: readme passes a 401-character headline cell")
+    write(root, "README.md", clean.replace("## Headline results", "## Results"))
+    if not check_readme(root):
+        problems.append("selftest: readme passes a README without its headline table")
+    write(root, "README.md", clean)
     write(root, "docs/GONE.md", "[x](missing.md)\n")
     if not check_links(root):
         problems.append("selftest: links passes a link to a missing file")
@@ -199,7 +285,8 @@ def selftest(scratch: str) -> list[str]:
 
 def main() -> None:
     checks = {"links": check_links, "citations": check_citations, "version": check_version,
-              "readme": check_readme, "selftest": selftest}
+              "readme": check_readme, "tracker": check_tracker, "csv": check_csv,
+              "selftest": selftest}
     if len(sys.argv) != 3 or sys.argv[1] not in checks:
         sys.exit(__doc__)
     root = os.path.abspath(sys.argv[2])
