@@ -11,7 +11,7 @@ FIGURE_SCENES = $(filter-out $(LONG_SCENES),$(SCENES))
 
 .PHONY: all deps configure build test test-all reproduce-figures reproduce-all reproduce-quick gates gate-quick bench \
         format clean mutation mutation-check sanitize-build fuzz-build test-sanitize fuzz readme-tables \
-        report report-quick \
+        report report-quick citation \
         test-cluster test-external perf
 
 all: build
@@ -124,6 +124,11 @@ report: build
 
 report-quick: build
 	@$(BUILD_DIR)/geomint report --quick --results results --gates $(GATES) --out $(SITE)
+
+# CITATION.cff rewritten from cmake/citation.cmake (authors, title, version, and the repository URL
+# when configured: cmake -B build -DGEOMINT_REPOSITORY_URL=https://...); commit the result.
+citation: configure
+	@cmake --build $(BUILD_DIR) --target citation
 
 # CI-sized variant: quick_* settings, output under results/<scene>/quick/ (not committed).
 reproduce-quick: build

@@ -7,14 +7,19 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 
+#include "citation_info.hpp"  // generated from cmake/citation.cmake (harness/CMakeLists.txt)
 #include "harness/gate.hpp"
+#include "harness/paths.hpp"
 #include "harness/shard.hpp"
 #include "harness/sweep.hpp"
 #include "harness/toml_reader.hpp"
@@ -32,6 +37,8 @@ namespace {
 
 // The site's marker: --out is replaced whole, so only a folder holding it may be replaced.
 constexpr const char* kMarker = ".geomint-report";
+// The files at the site's top level: a scene folder of one of these names would overwrite one.
+constexpr std::array<const char*, 3> kSiteFiles = {"index.html", "style.css", kMarker};
 
 constexpr const char* kStyle =
     R"(body { font-family: sans-serif; margin: 1.5em auto; max-width: 75em;
@@ -64,6 +71,45 @@ std::string read_text(const fs::path& path) {
 
 bool starts_with(const std::string& text, const std::string& prefix) {
   return text.compare(0, prefix.size(), prefix) == 0;
+}
+
+// The path a URL names: %XX escapes decoded (a README writes `a%20b.md` for `a b.md`); a `%` not
+// followed by two hex digits stays itself.
+std::string url_decoded(const std::string& url) {
+  std::string out;
+  for (size_t k = 0; k < url.size(); ++k) {
+    if (url[k] == '%' && k + 2 < url.size() &&
+        std::isxdigit(static_cast<unsigned char>(url[k + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(url[k + 2]))) {
+      out += static_cast<char>(std::stoi(url.substr(k + 1, 2), nullptr, 16));
+      k += 2;
+    } else {
+      out += url[k];
+    }
+  }
+  return out;
+}
+
+// A BibTeX field value: LaTeX's special characters escaped, braces (which BibTeX counts even
+// escaped) turned into parentheses, so any scene title keeps the entry parseable.
+std::string bibtex_text(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '{') {
+      out += '(';
+    } else if (c == '}') {
+      out += ')';
+    } else if (c == '\\') {
+      out += "/";
+    } else if (std::strchr("&%$#_", c) != nullptr && c != '\0') {
+      out += std::string("\\") + c;
+    } else if (c == '~' || c == '^') {
+      out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  return out;
 }
 
 // As table.md shortens numbers (harness/table.cpp), with more digits: the CSV is one click away.
@@ -146,6 +192,7 @@ struct ScenePage {
   // when table.md's recorded scene hash differs from the file's (published variant only; the
   // quick tables are rewritten by every `make gate-quick`).
   std::string stale;
+  std::vector<std::string> notes;  // files left out (symbolic links), printed by the verb
 };
 
 // summary, order and stability first (what table.md shows), then the others by name.
@@ -202,19 +249,9 @@ std::string provenance_block(const CsvTable& table) {
   return html + "</dl>\n";
 }
 
-std::string cite_block(const ScenePage& page, const CsvTable& table, const std::string& stem) {
-  const auto [version, sha] = version_and_sha(table.value("geomint", "unknown"));
-  const std::string date = table.value("date", "undated");
-  const std::string year = date.size() >= 4 ? date.substr(0, 4) : date;
-  const std::string text = fmt::format(
-      "geomint {} (commit {}), scene {}, table {}.csv ({} variant), {}.\n\n"
-      "@misc{{geomint_{}_{},\n  title  = {{geomint: {} ({}.csv)}},\n"
-      "  note   = {{geomint version {}, commit {}, scene {}, table {}.csv}},\n"
-      "  year   = {{{}}}\n}}\n",
-      version, sha.empty() ? "unknown" : sha, page.name, stem, table.value("variant", "full"), date,
-      page.name, stem, page.title, stem, version, sha.empty() ? "unknown" : sha, page.name, stem,
-      year);
-  return "<details><summary>Cite this table</summary><pre>" + html_escape(text) +
+std::string cite_block(const ScenePage& page, const CsvTable& table) {
+  return "<details><summary>Cite this table</summary><pre>" +
+         html_escape(table_citation(table, page.name, page.title, citation::kRepositoryUrl)) +
          "</pre></details>\n";
 }
 
@@ -240,9 +277,9 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
     html += "<h2>Figures</h2>\n";
     for (const auto& image : page.images) {
       html += fmt::format(
-          "<figure><img src=\"{0}\" alt=\"{0}\"><figcaption>{0}</figcaption>"
+          "<figure><img src=\"{1}\" alt=\"{0}\"><figcaption>{0}</figcaption>"
           "</figure>\n",
-          html_escape(image));
+          html_escape(image), html_escape(url_path(image)));
     }
   }
   if (page.tables.empty()) {
@@ -260,9 +297,10 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
     }
     html += gate_list(checks);
     html += csv_table_html(table, file_name);
-    html += fmt::format("<p>{} rows; full precision in <a href=\"{}\">{}</a>.</p>\n",
-                        table.rows.size(), html_escape(file_name), html_escape(file_name));
-    html += cite_block(page, table, stem) + "</section>\n";
+    html +=
+        fmt::format("<p>{} rows; full precision in <a href=\"{}\">{}</a>.</p>\n", table.rows.size(),
+                    html_escape(url_path(file_name)), html_escape(file_name));
+    html += cite_block(page, table) + "</section>\n";
   }
   std::vector<const GateOutcome*> other;  // gates over every table of the scene
   for (const auto& outcome : page.outcomes) {
@@ -314,11 +352,11 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
     }
     if (!page.stale.empty()) gates += " <span class=\"fail\">STALE</span>";
     html += fmt::format(
-        "<tr><td><a href=\"{0}/index.html\">{0}</a></td><td "
+        "<tr><td><a href=\"{5}/index.html\">{0}</a></td><td "
         "class=\"claim\"><strong>{1}</strong><br>{2}</td>"
         "<td>{3}</td><td>{4}</td></tr>\n",
         html_escape(page.name), html_escape(page.title), html_escape(page.headline), gates,
-        page.tables.size());
+        page.tables.size(), html_escape(url_path(page.name)));
   }
   html += "</tbody>\n</table></div>\n";
   html +=
@@ -342,8 +380,11 @@ std::string rewrite_link(const std::string& target, const fs::path& scene_dir,
   if (file.find('/') == std::string::npos && (ext == ".csv" || ext == ".png" || ext == ".svg")) {
     return target;
   }
-  const fs::path absolute = fs::weakly_canonical(fs::absolute(scene_dir / file));
-  return fs::relative(absolute, fs::weakly_canonical(fs::absolute(page_dir))).generic_string() +
+  // The target is a URL (`a%20b.md`): decoded to the file it names, and the new relative path
+  // encoded again, so folders named with `#`, `?` or `%` stay part of the path.
+  const fs::path absolute = fs::weakly_canonical(fs::absolute(scene_dir / url_decoded(file)));
+  return url_path(fs::relative(absolute, fs::weakly_canonical(fs::absolute(page_dir)))
+                      .generic_string()) +
          target.substr(file.size());
 }
 
@@ -359,10 +400,20 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
   description = scene["description"].value_or(std::string());
   page.headline = first_sentence(description);
   page.source = options.quick ? folder / "quick" : folder;
-  if (fs::is_directory(page.source)) {
-    std::vector<fs::path> csvs;
+  // A symbolic link would publish whatever it points to (any file of the machine) as a result
+  // of the scene: links are left out, with a note.
+  const auto skip_link = [&page](const fs::path& path) {
+    if (!fs::is_symlink(path)) return false;
+    page.notes.push_back(fmt::format(
+        "report: left out '{}': a symbolic link (the site publishes only the scene's own files)",
+        path.string()));
+    return true;
+  };
+  std::vector<fs::path> csvs;
+  if (!skip_link(page.source) && fs::is_directory(page.source)) {
     for (const auto& entry : fs::directory_iterator(page.source)) {
       const std::string ext = entry.path().extension().string();
+      if ((ext == ".csv" || ext == ".png" || ext == ".svg") && skip_link(entry.path())) continue;
       if (!entry.is_regular_file()) continue;
       if (ext == ".csv") csvs.push_back(entry.path());
       if (ext == ".png" || ext == ".svg") page.images.push_back(entry.path().filename().string());
@@ -387,7 +438,11 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
     for (const auto& csv : csvs) page.tables.push_back(read_csv_file(csv.string()));
   }
   if (!page.tables.empty() && !gates.empty()) {
-    std::vector<ResultFile> files = load_result_files({page.source.string()});
+    // The tables on the page, not the folder's: a left-out link is not checked either.
+    std::vector<std::string> table_paths;
+    for (const auto& csv : csvs) table_paths.push_back(csv.string());
+    std::sort(table_paths.begin(), table_paths.end());
+    std::vector<ResultFile> files = load_result_files(table_paths);
     // Tables of another scene (a copied folder) are checked under the folder's name: the page
     // shows this folder's verdicts.
     // Paths in the verdicts' lines are those of the copies next to the page.
@@ -416,7 +471,7 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
   }
   const fs::path readme = folder / "README.md";
   const fs::path page_dir = final_out / page.name;
-  if (fs::exists(readme)) {
+  if (fs::exists(readme) && !skip_link(readme)) {
     page.narrative_html = markdown_to_html(read_text(readme), [&](const std::string& target) {
       return rewrite_link(target, folder, page_dir);
     });
@@ -424,6 +479,73 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
     page.narrative_html = markdown_to_html(description);
   }
   return page;
+}
+
+// --out as an absolute folder path without a trailing separator: `site/` and `site/.` name the
+// folder `site`, whose parent receives the temporary copy (a trailing `/` once put the copy inside
+// the folder it then deleted).
+fs::path site_folder(const std::string& out_dir) {
+  fs::path out = fs::absolute(out_dir).lexically_normal();
+  if (!out.has_filename() && out.has_relative_path()) out = out.parent_path();
+  return out;
+}
+
+// True when `ancestor` is `path` or a folder above it (both absolute, with `..` and links
+// resolved).
+bool is_same_or_ancestor(const fs::path& ancestor, const fs::path& path) {
+  auto at = path.begin();
+  for (const auto& component : ancestor) {
+    if (component.empty()) continue;  // a trailing separator
+    if (at == path.end() || *at != component) return false;
+    ++at;
+  }
+  return true;
+}
+
+// Everything that can make --out unsafe or unwritable, checked before anything is written: the
+// site replaces --out whole, so it must not hold the working folder, the input or someone's
+// files, and both it and its parent (where the new site is built) must take files.
+void check_site_folder(const ReportOptions& options, const fs::path& out) {
+  std::error_code error;
+  const fs::path resolved = fs::weakly_canonical(out, error);
+  const auto refuse_if_above = [&](const fs::path& other, const std::string& what) {
+    const fs::path other_resolved = fs::weakly_canonical(fs::absolute(other), error);
+    if (!error && is_same_or_ancestor(resolved, other_resolved)) {
+      throw InputError(fmt::format(
+          "report: --out '{}' is {} or a folder above it ('{}'); the site replaces --out whole, "
+          "so give a folder of its own, e.g. site",
+          options.out_dir, what, other_resolved.string()));
+    }
+  };
+  if (!out.has_relative_path()) {
+    throw InputError(
+        fmt::format("report: --out '{}' is the root folder; give a folder of its own, e.g. site",
+                    options.out_dir));
+  }
+  refuse_if_above(fs::current_path(), "the current folder");
+  refuse_if_above(options.results_dir, "the results folder");
+  if (fs::exists(options.gates_path, error)) refuse_if_above(options.gates_path, "the gates file");
+  if (fs::exists(out)) {
+    if (!fs::is_directory(out)) {
+      throw InputError(
+          fmt::format("report: --out '{}' is a file; give a folder for the site", options.out_dir));
+    }
+    if (!fs::is_empty(out) && !fs::exists(out / kMarker)) {
+      throw InputError(fmt::format(
+          "report: --out '{}' holds files and is not a site geomint report wrote (no {} in it); "
+          "give a new or empty folder",
+          options.out_dir, kMarker));
+    }
+  }
+  // /proc, a read-only folder, a file where a folder is needed: refused here, not after the
+  // pages are built (as an I/O failure).
+  try {
+    check_output_dir(out.parent_path().string(), "the folder that receives it");
+    if (fs::exists(out)) check_output_dir(out.string(), "the site folder");
+  } catch (const InputError& cannot) {
+    throw InputError(
+        fmt::format("report: --out '{}' cannot be written: {}", options.out_dir, cannot.what()));
+  }
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -459,6 +581,54 @@ std::string html_escape(const std::string& text) {
     }
   }
   return out;
+}
+
+std::string url_path(const std::string& path) {
+  std::string out;
+  for (char c : path) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (std::isalnum(byte) || std::strchr("-._~/", c) != nullptr) {
+      out += c;
+    } else {
+      out += fmt::format("%{:02X}", byte);
+    }
+  }
+  return out;
+}
+
+std::string table_citation(const CsvTable& table, const std::string& scene,
+                           const std::string& scene_title, const std::string& repository_url) {
+  const auto [version, sha] = version_and_sha(table.value("geomint", "unknown"));
+  const std::string commit = sha.empty() ? "unknown" : sha;
+  const std::string date = table.value("date", "undated");
+  const std::string year = date.size() >= 4 ? date.substr(0, 4) : date;
+  const std::string file = fs::path(table.path).filename().string();
+  const std::string variant = table.value("variant", "full");
+  std::string authors, bibtex_authors;
+  for (const char* author : citation::kAuthors) {
+    authors += (authors.empty() ? "" : "; ") + std::string(author);
+    // An organisation in double braces: BibTeX would read "The geomint maintainers" as a person
+    // named Maintainers.
+    const bool person = std::strstr(author, ", ") != nullptr;
+    bibtex_authors += (bibtex_authors.empty() ? "" : " and ") +
+                      (person ? bibtex_text(author) : "{" + bibtex_text(author) + "}");
+  }
+  std::string text =
+      fmt::format("{}. geomint {} (commit {}), scene {}, table {} ({} variant), {}.{}\n\n", authors,
+                  version, commit, scene, file, variant, date,
+                  repository_url.empty() ? "" : fmt::format(" {}", repository_url));
+  text += fmt::format("@software{{geomint_{}_{},\n", sanitize_for_path(scene),
+                      sanitize_for_path(fs::path(file).stem().string()));
+  text += fmt::format("  author  = {{{}}},\n", bibtex_authors);
+  text += fmt::format("  title   = {{{} --- {} ({})}},\n", bibtex_text(citation::kTitle),
+                      bibtex_text(scene_title), bibtex_text(file));
+  text += fmt::format("  version = {{{}}},\n", bibtex_text(version));
+  text +=
+      fmt::format("  note    = {{commit {}; scene {}, table {}, {} variant}},\n",
+                  bibtex_text(commit), bibtex_text(scene), bibtex_text(file), bibtex_text(variant));
+  if (!repository_url.empty()) text += fmt::format("  url     = {{{}}},\n", repository_url);
+  text += fmt::format("  year    = {{{}}}\n}}\n", bibtex_text(year));
+  return text;
 }
 
 std::string markdown_to_html(const std::string& markdown,
@@ -564,24 +734,27 @@ ReportSummary write_report(const ReportOptions& given) {
       fs::exists(options.gates_path) || options.gates_path != (results / "gates.toml").string()
           ? load_gates(options.gates_path)
           : std::vector<Gate>{};
-  const fs::path out = fs::absolute(options.out_dir).lexically_normal();
-  if (fs::exists(out)) {
-    if (!fs::is_directory(out)) {
-      throw InputError(
-          fmt::format("report: --out '{}' is a file; give a folder for the site", options.out_dir));
-    }
-    if (!fs::is_empty(out) && !fs::exists(out / kMarker)) {
-      throw InputError(fmt::format(
-          "report: --out '{}' holds files and is not a site geomint report wrote (no {} in it); "
-          "give a new or empty folder",
-          options.out_dir, kMarker));
-    }
-  }
+  const fs::path out = site_folder(options.out_dir);
+  check_site_folder(options, out);
   std::vector<fs::path> folders;
+  std::vector<std::string> notes;
   for (const auto& entry : fs::directory_iterator(results)) {
-    if (entry.is_directory() && fs::exists(entry.path() / "scene.toml")) {
-      folders.push_back(entry.path());
+    if (!entry.is_directory() || !fs::exists(entry.path() / "scene.toml")) continue;
+    const std::string name = entry.path().filename().string();
+    if (entry.is_symlink()) {
+      notes.push_back(fmt::format(
+          "report: left out scene '{}': a symbolic link (the site publishes only the results "
+          "folder's own scenes)",
+          entry.path().string()));
+      continue;
     }
+    if (std::find(kSiteFiles.begin(), kSiteFiles.end(), name) != kSiteFiles.end()) {
+      throw InputError(fmt::format(
+          "report: scene folder '{}' has the name of a file of the site (index.html, style.css, "
+          "{}): its page would replace that file; rename the folder",
+          entry.path().string(), kMarker));
+    }
+    folders.push_back(entry.path());
   }
   std::sort(folders.begin(), folders.end());
   if (folders.empty()) {
@@ -591,6 +764,13 @@ ReportSummary write_report(const ReportOptions& given) {
   }
   std::vector<ScenePage> pages;
   for (const auto& folder : folders) pages.push_back(load_scene_page(folder, options, gates, out));
+  if (options.quick && std::all_of(pages.begin(), pages.end(),
+                                   [](const ScenePage& page) { return page.tables.empty(); })) {
+    throw InputError(fmt::format(
+        "report: --quick: no scene of '{}' has quick tables (<scene>/quick/*.csv); make them with "
+        "`make gate-quick`, or leave out --quick for the published tables",
+        options.results_dir));
+  }
 
   const std::string generator =
       options.generator.empty() ? fmt::format("geomint {} ({})", build_version(), build_git_sha())
@@ -618,6 +798,7 @@ ReportSummary write_report(const ReportOptions& given) {
       summary.gates_passed += page.passed;
       summary.gates_failed += page.failed;
       if (!page.stale.empty()) ++summary.stale_scenes;
+      notes.insert(notes.end(), page.notes.begin(), page.notes.end());
     }
     fs::remove_all(out);
     fs::rename(partial, out);
@@ -626,6 +807,7 @@ ReportSummary write_report(const ReportOptions& given) {
     fs::remove_all(partial, ignored);
     throw;
   }
+  summary.notes = std::move(notes);
   return summary;
 }
 

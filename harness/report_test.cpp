@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -140,6 +141,100 @@ TEST_F(ReportTest, RefusesToReplaceAFolderItDidNotWrite) {
   write_fixture_site();  // its own site, replaced
   EXPECT_TRUE(fs::exists(dir_ / "site" / "tiny" / "index.html"));
   EXPECT_FALSE(fs::exists(dir_ / "site" / "notes.txt"));
+}
+
+// The "Cite this table" blocks: each holds one BibTeX @software entry whose braces balance and
+// which has the fields a citation needs, authors first; no url field without a configured URL.
+TEST_F(ReportTest, CiteBlocksHoldParseableBibtex) {
+  write_fixture_site();
+  const std::string page = read_text(dir_ / "site" / "tiny" / "index.html");
+  int entries = 0;
+  for (size_t at = page.find("@software{"); at != std::string::npos;
+       at = page.find("@software{", at + 1)) {
+    ++entries;
+    const std::string entry =
+        replace_all(page.substr(at, page.find("</pre>", at) - at), "&#39;", "'");
+    int depth = 0;
+    size_t end = 0;
+    for (size_t k = 0; k < entry.size() && end == 0; ++k) {
+      depth += entry[k] == '{' ? 1 : entry[k] == '}' ? -1 : 0;
+      ASSERT_GE(depth, 0) << entry;
+      if (depth == 0 && entry[k] == '}') end = k;
+    }
+    ASSERT_NE(end, 0u) << "unbalanced braces: " << entry;
+    EXPECT_EQ(entry.substr(end + 1), "\n") << entry;
+    for (const char* field :
+         {"author  = {{The geomint maintainers}}", "title   = {geomint: ", "version = {0.1.0}",
+          "note    = {commit 0123456789ab; scene tiny, table ", "year    = {2026}"}) {
+      EXPECT_NE(entry.find(field), std::string::npos) << field << " missing in\n" << entry;
+    }
+    EXPECT_EQ(entry.find("url"), std::string::npos) << entry;
+  }
+  EXPECT_EQ(entries, 2);  // summary.csv and order.csv
+}
+
+// With a repository URL (GEOMINT_REPOSITORY_URL) the citation names it; a title with BibTeX's
+// special characters keeps the braces balanced.
+TEST(ReportCitation, NamesTheRepositoryWhenConfigured) {
+  CsvTable table = parse_csv_table("# geomint: 0.2.0 (abcdef012345)\n# date: 2027-01-02\na\n1\n",
+                                   "/x/summary.csv");
+  const std::string text =
+      table_citation(table, "tiny", "A {curly} 50% title", "https://example.org/geomint");
+  EXPECT_NE(text.find("  url     = {https://example.org/geomint},\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("version = {0.2.0}"), std::string::npos) << text;
+  EXPECT_NE(text.find("commit abcdef012345"), std::string::npos) << text;
+  EXPECT_NE(text.find("A (curly) 50\\% title"), std::string::npos) << text;
+  const std::string entry = text.substr(text.find('@'));
+  EXPECT_EQ(std::count(entry.begin(), entry.end(), '{'),
+            std::count(entry.begin(), entry.end(), '}'));
+  EXPECT_EQ(table_citation(table, "tiny", "t", "").find("url"), std::string::npos);
+}
+
+// Every path in href and src is percent-encoded: a scene folder or file named with `#`, `?` or `%`
+// is linked as itself, not as a fragment, a query or an escape.
+TEST_F(ReportTest, EncodesPathsInLinks) {
+  EXPECT_EQ(url_path("a b#c?d%e/f.csv"), "a%20b%23c%3Fd%25e/f.csv");
+  EXPECT_EQ(url_path("plain-name_1.2~/x"), "plain-name_1.2~/x");
+  const fs::path results = dir_ / "results";
+  fs::create_directories(results / "a#b%c?d");
+  fs::copy_file(kFixture / "results" / "tiny" / "scene.toml", results / "a#b%c?d" / "scene.toml");
+  fs::copy_file(kFixture / "results" / "tiny" / "summary.csv", results / "a#b%c?d" / "s#1.csv");
+  fs::copy_file(kFixture / "results" / "tiny" / "energy.png", results / "a#b%c?d" / "e%1.png");
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site").string();
+  write_report(options);
+  EXPECT_NE(read_text(dir_ / "site" / "index.html").find("href=\"a%23b%25c%3Fd/index.html\""),
+            std::string::npos);
+  const std::string page = read_text(dir_ / "site" / "a#b%c?d" / "index.html");
+  EXPECT_NE(page.find("href=\"s%231.csv\""), std::string::npos);
+  EXPECT_NE(page.find("src=\"e%251.png\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "site" / "a#b%c?d" / "s#1.csv"));
+}
+
+// A symbolic link in a scene folder would publish its target (any file of the machine): links
+// are left out of the site and the gates, with a note naming them.
+TEST_F(ReportTest, LeavesOutSymbolicLinks) {
+  const fs::path results = dir_ / "results";
+  fs::copy(kFixture / "results", results, fs::copy_options::recursive);
+  std::ofstream(dir_ / "secret.csv") << "label,x\nsecret,1\n";
+  fs::create_symlink(dir_ / "secret.csv", results / "tiny" / "leak.csv");
+  fs::create_symlink(dir_ / "secret.csv", results / "tiny" / "leak.png");
+  fs::create_directory_symlink(results / "tiny", results / "linked_scene");
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site").string();
+  const ReportSummary summary = write_report(options);
+  EXPECT_FALSE(fs::exists(dir_ / "site" / "tiny" / "leak.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "site" / "tiny" / "leak.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "site" / "linked_scene"));
+  EXPECT_EQ(read_text(dir_ / "site" / "tiny" / "index.html").find("leak"), std::string::npos);
+  EXPECT_EQ(summary.scenes, 2);
+  EXPECT_EQ(summary.tables, 2);
+  ASSERT_EQ(summary.notes.size(), 3u);
+  for (const auto& note : summary.notes) {
+    EXPECT_NE(note.find("a symbolic link"), std::string::npos) << note;
+  }
 }
 
 // A scene whose table.md records another scene hash than its scene.toml's (the scene was edited

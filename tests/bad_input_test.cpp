@@ -322,6 +322,93 @@ const std::vector<Case>& cases() {
         {"r/s/scene.toml", "title = 'x'\n"},
         {"r/s/summary.csv", "label,x\na,1,2\n"}},
        {"r", "r/s", "r/s/scene.toml", "r/s/summary.csv"}},
+      // --out is replaced whole: refused, before anything is written, when that would delete the
+      // working folder or the input, or when no file can be created there.
+      {"ReportOutWithTrailingSlash",  // `make report SITE=site/`: the previous site is replaced
+       "report --results {dir}/r --out {dir}/site/",
+       0,
+       "open",
+       {{"r/", ""},
+        {"r/s/", ""},
+        {"r/s/scene.toml", "title = 'x'\n"},
+        {"site/", ""},
+        {"site/.geomint-report", ""},
+        {"site/index.html", "old"}},
+       {"r", "r/s", "r/s/scene.toml", "site", "site/.geomint-report", "site/index.html",
+        "site/style.css", "site/s", "site/s/index.html"}},
+      {"ReportOutIsTheCurrentFolder",  // run inside a previous site: `--out .` deleted it
+       "report --results {dir}/r --out .",
+       2,
+       "the current folder",
+       {{".geomint-report", ""}, {"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}},
+       {".geomint-report", "r", "r/s", "r/s/scene.toml"}},
+      {"ReportOutAboveTheCurrentFolder",
+       "report --results {dir}/r --out ..",
+       2,
+       "the current folder",
+       {{"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}},
+       {"r", "r/s", "r/s/scene.toml"}},
+      {"ReportOutHoldsTheResults",  // results kept inside a previous site
+       "report --results {dir}/site/r --out {dir}/site",
+       2,
+       "the results folder",
+       {{"site/", ""},
+        {"site/.geomint-report", ""},
+        {"site/r/", ""},
+        {"site/r/s/", ""},
+        {"site/r/s/scene.toml", "title = 'x'\n"}},
+       {"site", "site/.geomint-report", "site/r", "site/r/s", "site/r/s/scene.toml"}},
+      {"ReportOutHoldsTheGates",
+       "report --results {dir}/r --gates {dir}/site/g.toml --out {dir}/site",
+       2,
+       "the gates file",
+       {{"r/", ""},
+        {"r/s/", ""},
+        {"r/s/scene.toml", "title = 'x'\n"},
+        {"site/", ""},
+        {"site/.geomint-report", ""},
+        {"site/g.toml", "[[gate]]\nname = 'a'\ncolumn = 'x'\nmin = 0\n"}},
+       {"r", "r/s", "r/s/scene.toml", "site", "site/.geomint-report", "site/g.toml"}},
+      {"ReportOutInProc",
+       "report --results {dir}/r --out /proc/geomint-site",
+       2,
+       "no file can be created in folder '/proc'",
+       {{"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}},
+       {"r", "r/s", "r/s/scene.toml"}},
+      {"ReportOutUnderAFile",
+       "report --results {dir}/r --out {dir}/file/site",
+       2,
+       "is not a directory",
+       {{"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}, {"file", "x"}},
+       {"r", "r/s", "r/s/scene.toml", "file"}},
+      // A scene folder named like a file of the site would overwrite it (or fail half-way).
+      {"ReportSceneNamedIndexHtml",
+       "report --results {dir}/r --out {dir}/site",
+       2,
+       "r/index.html' has the name of a file of the site",
+       {{"r/", ""}, {"r/index.html/", ""}, {"r/index.html/scene.toml", "title = 'x'\n"}},
+       {"r", "r/index.html", "r/index.html/scene.toml"}},
+      {"ReportSceneNamedStyleCss",
+       "report --results {dir}/r --out {dir}/site",
+       2,
+       "r/style.css' has the name of a file of the site",
+       {{"r/", ""}, {"r/style.css/", ""}, {"r/style.css/scene.toml", "title = 'x'\n"}},
+       {"r", "r/style.css", "r/style.css/scene.toml"}},
+      {"ReportSceneNamedLikeTheMarker",
+       "report --results {dir}/r --out {dir}/site",
+       2,
+       "r/.geomint-report' has the name of a file of the site",
+       {{"r/", ""}, {"r/.geomint-report/", ""}, {"r/.geomint-report/scene.toml", "title = 'x'\n"}},
+       {"r", "r/.geomint-report", "r/.geomint-report/scene.toml"}},
+      {"ReportQuickWithoutQuickTables",
+       "report --quick --results {dir}/r --out {dir}/site",
+       2,
+       "make gate-quick",
+       {{"r/", ""},
+        {"r/s/", ""},
+        {"r/s/scene.toml", "title = 'x'\n"},
+        {"r/s/summary.csv", "label,x\na,1\n"}},
+       {"r", "r/s", "r/s/scene.toml", "r/s/summary.csv"}},
       // --- a tolerance far below round-off means "to round-off", not a failure ---
       {"ImplicitToleranceBelowRoundOff",
        "run --problem kepler --method implicit_midpoint:tol=1e-300 --dt 0.01 --t-end 1 "
@@ -1295,6 +1382,44 @@ TEST(BadInputRegistry, NamesAreUniqueAndEveryCaseHasAWord) {
     EXPECT_FALSE(c.word.empty()) << c.name;
     EXPECT_TRUE(c.exit_code == 0 || c.exit_code == 1 || c.exit_code == 2) << c.name;
   }
+}
+
+// `report --out` below a folder the user cannot write is bad input (exit 2, nothing written),
+// found by the probe before any page is built. Root writes anywhere: as root the command runs as
+// `nobody` through setpriv(1); without setpriv the case cannot be made and is skipped.
+TEST(BadInputReport, OutInAReadOnlyFolder) {
+  // Not below the test's private (0700) temporary folder: `nobody` must reach the scenes.
+  const fs::path dir =
+      fs::path("/tmp") / ("geomint_bad_input_read_only." + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "r" / "s");
+  fs::create_directories(dir / "locked");
+  std::ofstream(dir / "r" / "s" / "scene.toml") << "title = 'x'\n";
+  std::string as_user;
+  if (::geteuid() == 0) {
+    if (std::system("command -v setpriv > /dev/null 2>&1") != 0) {
+      GTEST_SKIP() << "root without setpriv: no user for whom a folder is read-only";
+    }
+    // nobody reads the scenes and runs the build, but cannot write into locked/ (root's, 0755).
+    as_user = "setpriv --reuid=65534 --regid=65534 --clear-groups ";
+  } else {
+    fs::permissions(dir / "locked", fs::perms::owner_write, fs::perm_options::remove);
+  }
+  const std::string command = "cd " + dir.string() + " && " + as_user + "timeout -k 5 30 " +
+                              fs::absolute(binary()).string() + " report --results " +
+                              (dir / "r").string() + " --out " +
+                              (dir / "locked" / "site").string() + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << command << "\n" << output;
+  EXPECT_NE(output.find("no file can be created in folder"), std::string::npos) << output;
+  EXPECT_TRUE(fs::is_empty(dir / "locked")) << output;
+  fs::permissions(dir / "locked", fs::perms::owner_write, fs::perm_options::add);
+  fs::remove_all(dir);
 }
 
 // SIGTERM (what Slurm sends at a time limit) and SIGINT (Ctrl-C) end a sweep as the signal

@@ -25,6 +25,7 @@ Verb add_report(CLI::App& app) {
   return {"report", command, [options](const Context& context) {
             options->command_line = context.command_line;
             const ReportSummary summary = write_report(*options);
+            for (const auto& note : summary.notes) inform(context, note);
             // 0 once written: the gate verdicts are in the pages (`geomint gate` is what fails).
             inform(context,
                    fmt::format(
