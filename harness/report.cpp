@@ -485,6 +485,8 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
 // folder `site`, whose parent receives the temporary copy (a trailing `/` once put the copy inside
 // the folder it then deleted).
 fs::path site_folder(const std::string& out_dir) {
+  if (out_dir.empty())
+    throw InputError("report: --out is empty; give a folder for the site, e.g. site");
   fs::path out = fs::absolute(out_dir).lexically_normal();
   if (!out.has_filename() && out.has_relative_path()) out = out.parent_path();
   return out;

@@ -336,6 +336,12 @@ const std::vector<Case>& cases() {
         {"site/index.html", "old"}},
        {"r", "r/s", "r/s/scene.toml", "site", "site/.geomint-report", "site/index.html",
         "site/style.css", "site/s", "site/s/index.html"}},
+      {"ReportOutEmpty",
+       "report --results {dir}/r --out ''",
+       2,
+       "--out is empty",
+       {{"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}},
+       {"r", "r/s", "r/s/scene.toml"}},
       {"ReportOutIsTheCurrentFolder",  // run inside a previous site: `--out .` deleted it
        "report --results {dir}/r --out .",
        2,
