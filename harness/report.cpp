@@ -509,7 +509,8 @@ bool is_same_or_ancestor(const fs::path& ancestor, const fs::path& path) {
 // files, and both it and its parent (where the new site is built) must take files.
 void check_site_folder(const ReportOptions& options, const fs::path& out) {
   std::error_code error;
-  const fs::path resolved = fs::weakly_canonical(out, error);
+  fs::path resolved = fs::weakly_canonical(out, error);
+  if (error) resolved = out;  // compared as spelled (absolute, normal) when it cannot be resolved
   const auto refuse_if_above = [&](const fs::path& other, const std::string& what) {
     const fs::path other_resolved = fs::weakly_canonical(fs::absolute(other), error);
     if (!error && is_same_or_ancestor(resolved, other_resolved)) {

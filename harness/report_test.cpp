@@ -200,6 +200,9 @@ TEST_F(ReportTest, EncodesPathsInLinks) {
   fs::copy_file(kFixture / "results" / "tiny" / "scene.toml", results / "a#b%c?d" / "scene.toml");
   fs::copy_file(kFixture / "results" / "tiny" / "summary.csv", results / "a#b%c?d" / "s#1.csv");
   fs::copy_file(kFixture / "results" / "tiny" / "energy.png", results / "a#b%c?d" / "e%1.png");
+  // README links leave the scene as URLs: `%20` is a space, and the rewritten path is encoded.
+  std::ofstream(results / "a#b%c?d" / "README.md")
+      << "[scene](scene.toml) and [other](../other%20dir/n.md)\n";
   ReportOptions options;
   options.results_dir = results.string();
   options.out_dir = (dir_ / "site").string();
@@ -210,6 +213,9 @@ TEST_F(ReportTest, EncodesPathsInLinks) {
   EXPECT_NE(page.find("href=\"s%231.csv\""), std::string::npos);
   EXPECT_NE(page.find("src=\"e%251.png\""), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "site" / "a#b%c?d" / "s#1.csv"));
+  EXPECT_NE(page.find("href=\"../../results/a%23b%25c%3Fd/scene.toml\""), std::string::npos)
+      << page;
+  EXPECT_NE(page.find("href=\"../../results/other%20dir/n.md\""), std::string::npos) << page;
 }
 
 // A symbolic link in a scene folder would publish its target (any file of the machine): links
