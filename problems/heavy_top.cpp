@@ -54,7 +54,8 @@ class HeavyTop final : public AttitudeProblem {
 }  // namespace
 
 std::unique_ptr<Problem> make_heavy_top(Params& params) {
-  const RigidBodyParameters P = read_rigid_body_parameters(params, "heavy_top");
+  const RigidBodyParameters P = read_rigid_body_parameters(params);
+  check_attitude_masses(P, "heavy_top");
   const Eigen::Matrix3d attitude = read_initial_attitude(params, "heavy_top");
   const auto positive = [](double x) { return x > 0; };
   const double mass = params.real("m", 1.0, "mass of the body", positive, "> 0");

@@ -214,7 +214,7 @@ Eigen::Matrix3d read_initial_attitude(Params& params, const std::string& problem
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
 }
 
-RigidBodyParameters read_rigid_body_parameters(Params& params, const std::string& problem) {
+RigidBodyParameters read_rigid_body_parameters(Params& params) {
   const auto positive = [](double x) { return x > 0; };
   RigidBodyParameters P;
   P.moments[0] =
@@ -226,17 +226,31 @@ RigidBodyParameters read_rigid_body_parameters(Params& params, const std::string
   P.omega[0] = params.real("omega1", 0.8, "initial body angular velocity about axis 1");
   P.omega[1] = params.real("omega2", 0.3, "initial body angular velocity about axis 2");
   P.omega[2] = params.real("omega3", -0.6, "initial body angular velocity about axis 3");
+  return P;
+}
+
+void check_attitude_masses(const RigidBodyParameters& parameters, const std::string& problem) {
+  const Eigen::Vector3d& I = parameters.moments;
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;
-    const double others = P.moments[i] + P.moments[j];
-    if (!(P.moments[k] < others)) {
+    const double others = I[i] + I[j];
+    if (I[k] == others) {
+      throw InputError(fmt::format(
+          "problem '{}': I{} = {} equals I{} + I{} (a flat body, a lamina): its mass d{} = "
+          "(I1+I2+I3)/2 - I{} is 0, so the mass tensor of the 9-coordinate form is singular (the "
+          "kinetic energy needs its inverse); allowed: I{} < I{} + I{}. Euler's equations "
+          "(rigid_body_euler) take any positive moments",
+          problem, k + 1, I[k], i + 1, j + 1, k + 1, k + 1, k + 1, i + 1, j + 1));
+    }
+    if (!(I[k] < others)) {
       throw InputError(fmt::format(
           "problem '{}': I{} = {} must be < I{} + I{} = {} (triangle inequality of the principal "
-          "moments; the mass d{} = (I1+I2+I3)/2 - I{} must be > 0)",
-          problem, k + 1, P.moments[k], i + 1, j + 1, others, k + 1, k + 1));
+          "moments: the mass d{} = (I1+I2+I3)/2 - I{} of the 9-coordinate form must be > 0, and no "
+          "mass distribution has these moments). Euler's equations (rigid_body_euler) take any "
+          "positive moments",
+          problem, k + 1, I[k], i + 1, j + 1, others, k + 1, k + 1));
     }
   }
-  return P;
 }
 
 FreeBodyMotion::FreeBodyMotion(const Eigen::Vector3d& moments, const Eigen::Vector3d& pi0)
@@ -322,7 +336,8 @@ Eigen::Vector3d rigid_body_body_momentum(const Vec& q, const Vec& p) {
 }
 
 std::unique_ptr<Problem> make_rigid_body(Params& params) {
-  const RigidBodyParameters P = read_rigid_body_parameters(params, "rigid_body");
+  const RigidBodyParameters P = read_rigid_body_parameters(params);
+  check_attitude_masses(P, "rigid_body");
   return std::make_unique<RigidBody>(P, read_initial_attitude(params, "rigid_body"));
 }
 

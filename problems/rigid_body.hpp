@@ -11,13 +11,18 @@
 namespace geomint {
 
 // Principal moments (I1, I2, I3) and the initial body angular velocity Ω, read and validated the
-// same way by both problems: every I_k > 0 and the strict triangle inequality I_k < I_i + I_j
-// (the masses d_k = ½(I1 + I2 + I3) − I_k of the 9-coordinate form must be positive).
+// same way by every rigid-body problem: every I_k > 0, all Euler's equations need (so GNI §IV.1's
+// body I = (2, 1, 2/3), which no mass distribution has, and a lamina I3 = I1 + I2 run there).
 struct RigidBodyParameters {
   Eigen::Vector3d moments;
   Eigen::Vector3d omega;
 };
-RigidBodyParameters read_rigid_body_parameters(Params& params, const std::string& problem);
+RigidBodyParameters read_rigid_body_parameters(Params& params);
+
+// The 9-coordinate form (rigid_body, heavy_top) needs the masses d_k = ½(I1 + I2 + I3) − I_k > 0,
+// the strict triangle inequality I_k < I_i + I_j: a negative d_k has no mass distribution, and a
+// flat body (d_k = 0) makes the mass tensor singular. Throws an InputError naming the case.
+void check_attitude_masses(const RigidBodyParameters& parameters, const std::string& problem);
 
 // Π(t) of the torque-free body from Π(0) (LL §37). With the moments sorted I_a < I_b < I_c, the
 // orbit circulates about the extreme axis z (c when |Π|² > 2E I_b, else a), and with x the other

@@ -76,7 +76,7 @@ class RigidBodyEuler final : public FirstOrderProblem, public FreeRigidBodyStruc
 }  // namespace
 
 std::unique_ptr<Problem> make_rigid_body_euler(Params& params) {
-  const RigidBodyParameters P = read_rigid_body_parameters(params, "rigid_body_euler");
+  const RigidBodyParameters P = read_rigid_body_parameters(params);
   const Eigen::Vector3d pi0 = P.moments.cwiseProduct(P.omega);
   return std::make_unique<RigidBodyEuler>(P, pi0, FreeBodyMotion(P.moments, pi0));
 }

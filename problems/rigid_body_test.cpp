@@ -29,14 +29,38 @@ std::string message_of(const std::string& spec) {
   return "(no error)";
 }
 
-TEST(RigidBody, TriangleInequalityIsAnInputErrorNamingIt) {
+// The 9-coordinate form needs the masses d_k = ½(I1+I2+I3) − I_k > 0: a violated triangle
+// inequality is refused naming it, and a flat body (d_k = 0) naming the singular mass tensor.
+TEST(RigidBody, TriangleInequalityIsAnInputErrorOfTheNineCoordinateForm) {
   const std::string message = message_of("rigid_body:I1=1,I2=1.2,I3=2.5");
   EXPECT_NE(message.find("I3 = 2.5 must be < I1 + I2 = 2.2"), std::string::npos) << message;
   EXPECT_NE(message.find("triangle inequality"), std::string::npos) << message;
-  // Equality is a flat body with a zero mass d_k: refused as well.
-  EXPECT_NE(message_of("rigid_body:I1=3,I2=1,I3=2").find("I1 = 3 must be < I2 + I3"),
+  EXPECT_NE(message.find("rigid_body_euler"), std::string::npos) << message;
+  const std::string flat = message_of("rigid_body:I1=3,I2=1,I3=2");
+  EXPECT_NE(flat.find("I1 = 3 equals I2 + I3 (a flat body, a lamina)"), std::string::npos) << flat;
+  EXPECT_NE(flat.find("mass tensor of the 9-coordinate form is singular"), std::string::npos)
+      << flat;
+  EXPECT_NE(message_of("heavy_top:I1=1,I2=5,I3=3").find("I2 = 5 must be < I3 + I1 = 4"),
             std::string::npos);
-  EXPECT_NE(message_of("rigid_body_euler:I1=1,I2=5,I3=3").find("I2 = 5 must be < I3 + I1 = 4"),
+}
+
+// Euler's equations need positive moments only: GNI §IV.1's body I = (2, 1, 2/3) (outside the
+// triangle inequality: no mass distribution has it), a lamina I3 = I1 + I2 and I2 > I1 + I3 run,
+// with the elliptic solution; a moment ≤ 0 or NaN is still refused naming the range.
+TEST(RigidBodyEuler, TakesAnyPositiveMoments) {
+  for (const std::string parameters :
+       {"I1=2,I2=1,I3=0.6666666666666666", "I1=1,I2=2,I3=3", "I1=1,I2=5,I3=3"}) {
+    SCOPED_TRACE(parameters);
+    EXPECT_EQ(message_of("rigid_body_euler:" + parameters), "(no error)");
+    const auto problem = make_problem("rigid_body_euler:" + parameters);
+    EXPECT_TRUE(problem->has(kExact) && problem->has(kPeriod));
+    EXPECT_GT(problem->period(), 0);
+  }
+  EXPECT_NE(message_of("rigid_body_euler:I3=0").find("I3=0 is out of range (allowed: > 0)"),
+            std::string::npos);
+  EXPECT_NE(message_of("rigid_body_euler:I1=-1").find("I1=-1 is out of range (allowed: > 0)"),
+            std::string::npos);
+  EXPECT_NE(message_of("rigid_body_euler:I2=nan").find("I2='nan' is not a finite number"),
             std::string::npos);
 }
 
@@ -107,13 +131,19 @@ struct Case {
 };
 
 // About the largest axis, about the smallest, with the moments in another order (an odd
-// relabelling reverses time), and 1e-4 from the separatrix on both sides (I = (1, 2, 3), Π near
-// the intermediate axis: the tennis racket).
+// relabelling reverses time), 1e-4 from the separatrix on both sides (I = (1, 2, 3), a lamina,
+// Π near the intermediate axis: the tennis racket), and GNI's body outside the triangle
+// inequality.
 std::vector<Case> cases() {
-  return {{{2, 3, 4.5}, {0.8, 0.3, -0.6}},   {{2, 3, 4.5}, {1.5, 0.2, 0.1}},
-          {{3, 1.5, 2.2}, {0.2, 1.1, 0.4}},  {{1.5, 3, 2.2}, {-0.3, 0.2, 0.9}},
-          {{1, 2, 3}, {0.01, 1, 0.0101}},    {{1, 2, 3}, {0.0101, 1, 0.01}},
-          {{4, 2.5, 3.1}, {0.05, -0.4, 0.7}}};
+  return {{{2, 3, 4.5}, {0.8, 0.3, -0.6}},
+          {{2, 3, 4.5}, {1.5, 0.2, 0.1}},
+          {{3, 1.5, 2.2}, {0.2, 1.1, 0.4}},
+          {{1.5, 3, 2.2}, {-0.3, 0.2, 0.9}},
+          {{1, 2, 3}, {0.01, 1, 0.0101}},
+          {{1, 2, 3}, {0.0101, 1, 0.01}},
+          {{4, 2.5, 3.1}, {0.05, -0.4, 0.7}},
+          // GNI §IV.1's free body, Π(0) = (cos 1.1, 0, sin 1.1).
+          {{2, 1, 2.0 / 3}, {std::cos(1.1) / 2, 0, 1.5 * std::sin(1.1)}}};
 }
 
 TEST(FreeBodyMotion, EllipticSolutionMatchesATightIntegrationOfEulersEquations) {

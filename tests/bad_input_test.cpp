@@ -102,6 +102,25 @@ const std::vector<Case>& cases() {
       {"RigidBodyTriangleInequality",
        "run --problem rigid_body:I1=1,I2=1.2,I3=2.5 --method rattle --dt 0.1 --t-end 1", 2,
        "I3 = 2.5 must be < I1 + I2 = 2.2 (triangle inequality"},
+      // A flat body runs as Euler's equations; the 9-coordinate form says why it cannot.
+      {"RigidBodyFlatBodyHasASingularMassTensor",
+       "run --problem rigid_body:I1=1,I2=2,I3=3 --method rattle --dt 0.1 --t-end 1", 2,
+       "I3 = 3 equals I1 + I2 (a flat body, a lamina): its mass d3 = (I1+I2+I3)/2 - I3 is 0, so "
+       "the mass tensor of the 9-coordinate form is singular"},
+      {"HeavyTopOutsideTheTriangleInequality",
+       "run --problem heavy_top:I1=2,I2=1,I3=0.6666666666666666 --method rattle --dt 0.1 "
+       "--t-end 1",
+       2, "I1 = 2 must be < I2 + I3"},
+      // Euler's equations need positive moments only: zero, negative and NaN still refused.
+      {"RigidBodyEulerZeroMoment",
+       "run --problem rigid_body_euler:I1=2,I2=1,I3=0 --method rk4 --dt 0.1 --t-end 1", 2,
+       "I3=0 is out of range (allowed: > 0)"},
+      {"RigidBodyEulerNegativeMoment",
+       "run --problem rigid_body_euler:I1=-2,I2=1,I3=1 --method rk4 --dt 0.1 --t-end 1", 2,
+       "I1=-2 is out of range (allowed: > 0)"},
+      {"RigidBodyEulerNanMoment",
+       "run --problem rigid_body_euler:I1=2,I2=nan,I3=1 --method rk4 --dt 0.1 --t-end 1", 2,
+       "I2='nan' is not a finite number"},
       // --- the Lie–Poisson splitting runs on free rigid bodies only (applicable()) ---
       {"LiePoissonOnKepler", "run --problem kepler --method lie_poisson --dt 0.1 --t-end 1", 2,
        "integrates free rigid bodies only (rigid_body, rigid_body_euler"},
