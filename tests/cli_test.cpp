@@ -381,6 +381,48 @@ TEST(Cli, GateFormatsJunitAndJsonCarryTheVerdictsAndTheExitCode) {
   fs::remove(xml);
 }
 
+// gate --format junit|json stay valid whatever a gate name or a result path holds: a name with
+// control characters (TOML \u escapes: BEL, ESC, form feed, DEL) and a result path with a byte
+// that is not UTF-8 and one control character. The JUnit XML passes `xmllint --noout` (XML 1.0
+// forbids U+0001–U+001F but tab, newline and return even as character references, so they show
+// as \xNN) and the JSON reads back under Python's strict UTF-8 decoding and json parser.
+TEST(Cli, GateFormatsStayValidForControlCharactersAndNonUtf8Paths) {
+  const fs::path dir = scratch(std::string("odd\xff\x01path"));
+  fs::create_directories(dir);
+  fs::copy_file(std::string(GEOMINT_SOURCE_DIR) + "/results/momentum/summary.csv",
+                dir / "summary.csv");
+  const fs::path gates = scratch("control_gates.toml");
+  std::ofstream(gates) << "[[gate]]\nname = \"bell\\u0007 esc\\u001b ff\\u000c del\\u007f "
+                          "nul-free <&>\"\nscene = \"momentum\"\ncolumn = \"steps\"\nmax = 0\n";
+  const std::string results = "'" + (dir / "summary.csv").string() + "'";
+  const fs::path xml = scratch("control_gates.xml");
+  const Outcome junit = geomint("gate --format junit --verbose " + gates.string() + " " + results +
+                                " > '" + xml.string() + "'");
+  EXPECT_EQ(junit.exit_code, 1) << junit.output;
+  const Outcome lint = geomint_shell("xmllint --noout '" + xml.string() + "'");
+  EXPECT_EQ(lint.exit_code, 0) << lint.output;
+  std::ifstream in(xml);
+  const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("bell\\x07 esc\\x1B ff\\x0C"), std::string::npos) << report;
+  EXPECT_NE(report.find("odd\xEF\xBF\xBD\\x01path"), std::string::npos) << report;
+
+  const fs::path json = scratch("control_gates.json");
+  const Outcome written = geomint("gate --format json --verbose " + gates.string() + " " + results +
+                                  " > '" + json.string() + "'");
+  EXPECT_EQ(written.exit_code, 1) << written.output;
+  const Outcome strict = geomint_shell(
+      "/usr/bin/python3 -c \"import json, sys; text = open(sys.argv[1], 'rb').read()"
+      ".decode('utf-8', 'strict'); rows = json.loads(text); "
+      "assert rows[0]['gate'].startswith('bell\\x07 esc\\x1b ff\\x0c del\\x7f'), rows; "
+      "assert 'odd\\ufffd\\x01path' in rows[0]['message'], rows; print('ok')\" '" +
+      json.string() + "'");
+  EXPECT_EQ(strict.exit_code, 0) << strict.output;
+  EXPECT_EQ(strict.output, "ok\n");
+  fs::remove_all(dir);
+  fs::remove(xml);
+  fs::remove(json);
+}
+
 // gate --quiet (docs/CLI.md "Quiet and colour"): the text format prints the failing gates alone
 // (nothing when all pass), exit codes unchanged; geomint prints no colour (no escape sequence),
 // so NO_COLOR has nothing to turn off.

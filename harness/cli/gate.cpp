@@ -1,7 +1,8 @@
 // `geomint gate GATES RESULTS...`: result tables checked against the thresholds of a gates file
 // (harness/gate.hpp); exit 1 when a gate fails, 2 when none applies (docs/CLI.md "gate"). The
 // verdicts print as text, as JUnit XML (one <testsuite> per scene, one <testcase> per gate) for
-// CI systems to render, or as a JSON array of {scene, gate, passed, message}.
+// CI systems to render, or as a JSON array of {scene, gate, passed, message}; both are valid
+// whatever the gate names and paths hold (harness/text_escape.hpp).
 #include "harness/gate.hpp"
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 
 #include "harness/cli/verbs.hpp"
 #include "harness/report.hpp"
+#include "harness/text_escape.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint::cli {
@@ -33,37 +35,6 @@ std::string outcome_message(const GateOutcome& outcome, bool verbose) {
     for (const auto& line : outcome.lines) message += "\n" + line;
   }
   return message;
-}
-
-// The report's HTML escaping (harness/report.hpp) is valid XML too; a newline in an attribute
-// value would be read back as a space, so it becomes a character reference.
-std::string xml_escaped(const std::string& text) {
-  std::string out;
-  for (char c : html_escape(text)) {
-    if (c == '\n') {
-      out += "&#10;";
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-std::string json_escaped(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out;
 }
 
 // Plain text, no colour (docs/CLI.md "Quiet and colour"); --quiet prints the failing gates alone.
