@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <vector>
 
 #include "problems/spec.hpp"
 
@@ -38,11 +38,22 @@ void load_file(const fs::path& path, BenchmarkSamples& samples,
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("perf-compare: cannot read '{}'", file));
-  std::stringstream text;
-  text << in.rdbuf();
+  // Read in blocks up to the cap, so an endless input (/dev/zero, a pipe from `yes`) stops at it
+  // instead of at the end of memory.
+  std::string text;
+  std::vector<char> block(1 << 16);
+  while (in.read(block.data(), static_cast<std::streamsize>(block.size())) || in.gcount() > 0) {
+    text.append(block.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxBenchmarkFileBytes) {
+      throw InputError(fmt::format(
+          "{}: more than {} MiB, the limit of one benchmark file (an endless input, or not "
+          "Google Benchmark JSON?)",
+          file, kMaxBenchmarkFileBytes >> 20));
+    }
+  }
   json document;
   try {
-    document = json::parse(text.str());
+    document = json::parse(text);
   } catch (const json::parse_error& error) {
     throw InputError(fmt::format(
         "{}: not a complete JSON document (truncated or not Google Benchmark output?): {}", file,
@@ -98,13 +109,22 @@ void load_file(const fs::path& path, BenchmarkSamples& samples,
                       "expected)",
                       file, name, real_time));
     }
+    // Bounded so that medians, their ratio and the statistics stay finite (1e300 s overflowed
+    // to inf ns, and the ratio to nan).
+    const std::string unit = row["time_unit"].get<std::string>();
+    const double time_ns = real_time * unit_in_ns(file, name, unit);
+    if (!(time_ns >= kMinBenchmarkTimeNs && time_ns <= kMaxBenchmarkTimeNs)) {
+      throw InputError(fmt::format(
+          "{}: benchmark '{}' has real_time {:g} {} = {:g} ns, outside the range "
+          "[{:g}, {:g}] ns (1e-9 ns to about 31 years) that perf-compare accepts",
+          file, name, real_time, unit, time_ns, kMinBenchmarkTimeNs, kMaxBenchmarkTimeNs));
+    }
     const auto [it, inserted] = owner.emplace(name, file);
     if (!inserted && it->second != file) {
       throw InputError(fmt::format("perf-compare: benchmark '{}' is in both '{}' and '{}'", name,
                                    it->second, file));
     }
-    samples.real_time_ns[name].push_back(
-        real_time * unit_in_ns(file, name, row["time_unit"].get<std::string>()));
+    samples.real_time_ns[name].push_back(time_ns);
     ++iteration_rows;
   }
   if (iteration_rows == 0) {
@@ -178,16 +198,27 @@ MannWhitney mann_whitney_greater(const std::vector<double>& faster,
   MannWhitney result;
   const std::size_t n = faster.size(), m = slower.size();
   if (n == 0 || m == 0) return result;
-  bool ties = false;
-  for (double a : faster) {
-    for (double b : slower) {
-      if (b > a) {
-        result.u += 1;
-      } else if (b == a) {
-        result.u += 0.5;
-        ties = true;
-      }
+  // U from the ranks of the pooled sorted sample: a run of t equal values shared by f faster and
+  // s slower ones contributes, for each slower value, the faster values below the run plus ½f
+  // for the ties, exactly the pair count #{slower > faster} + ½#{slower = faster}. O((n+m) log).
+  std::vector<std::pair<double, bool>> pooled;  // (value, is_slower)
+  pooled.reserve(n + m);
+  for (double a : faster) pooled.emplace_back(a, false);
+  for (double b : slower) pooled.emplace_back(b, true);
+  std::sort(pooled.begin(), pooled.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  bool ties = false;  // a faster and a slower value equal
+  double faster_below = 0;
+  for (std::size_t i = 0; i < pooled.size();) {
+    std::size_t j = i;
+    double run_faster = 0, run_slower = 0;
+    for (; j < pooled.size() && pooled[j].first == pooled[i].first; ++j) {
+      (pooled[j].second ? run_slower : run_faster) += 1;
     }
+    result.u += run_slower * (faster_below + 0.5 * run_faster);
+    ties = ties || (run_faster > 0 && run_slower > 0);
+    faster_below += run_faster;
+    i = j;
   }
   if (!ties && n * m <= 10000) {
     // U counts pairs with slower > faster; by symmetry its null law is that of the q-binomial.
@@ -195,13 +226,10 @@ MannWhitney mann_whitney_greater(const std::vector<double>& faster,
     result.exact = true;
     return result;
   }
-  std::vector<double> pooled(faster);
-  pooled.insert(pooled.end(), slower.begin(), slower.end());
-  std::sort(pooled.begin(), pooled.end());
   double tie_sum = 0;
   for (std::size_t i = 0; i < pooled.size();) {
     std::size_t j = i;
-    while (j < pooled.size() && pooled[j] == pooled[i]) ++j;
+    while (j < pooled.size() && pooled[j].first == pooled[i].first) ++j;
     const double t = static_cast<double>(j - i);
     tie_sum += t * t * t - t;
     i = j;
@@ -256,6 +284,11 @@ std::vector<PerfComparison> compare_benchmarks(const BenchmarkSamples& base,
     row.base_median_ns = median(before);
     row.new_median_ns = median(after);
     row.ratio = row.new_median_ns / row.base_median_ns;
+    if (!std::isfinite(row.ratio)) {  // unreachable with the bounded times; kept as the guard
+      throw InputError(fmt::format(
+          "perf-compare: benchmark '{}': the ratio of the medians {:g} / {:g} ns is not finite",
+          name, row.new_median_ns, row.base_median_ns));
+    }
     row.p_slower = mann_whitney_greater(before, after).p_value;
     row.p_faster = mann_whitney_greater(after, before).p_value;
     if (row.p_slower < options.alpha && row.ratio > 1 + options.min_slowdown) {

@@ -4,6 +4,7 @@
 // relative threshold on the medians.
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -18,11 +19,18 @@ struct BenchmarkSamples {
   std::map<std::string, std::string> context;
 };
 
+// Limits of the input: one file's size (an endless input stops here), and one repetition's real
+// time in ns (so medians, ratios and statistics stay finite).
+inline constexpr std::size_t kMaxBenchmarkFileBytes = std::size_t{64} << 20;
+inline constexpr double kMinBenchmarkTimeNs = 1e-9;
+inline constexpr double kMaxBenchmarkTimeNs = 1e18;
+
 // Reads one JSON file or every *.json file of a folder. InputError naming the file and what is
 // wrong for anything short of a complete Google Benchmark JSON document: unparsable text (a
 // truncated file), a missing "context" or "benchmarks", an iteration row without a name, a
-// positive finite real_time or a known time_unit, an error_occurred row, a benchmark name in two
-// files of one folder, or no iteration row at all.
+// positive finite real_time or a known time_unit, a time outside [kMinBenchmarkTimeNs,
+// kMaxBenchmarkTimeNs], a file over kMaxBenchmarkFileBytes, an error_occurred row, a benchmark name
+// in two files of one folder, or no iteration row at all.
 BenchmarkSamples load_benchmark_samples(const std::string& path);
 
 // One-sided Mann–Whitney U test of H1: `slower` tends to be larger than `faster`. Returns the

@@ -6,10 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <random>
+#include <string>
 
 #include "problems/spec.hpp"
 
@@ -88,6 +92,52 @@ TEST(MannWhitney, NormalApproximationWithTiesIsCloseToTheExactLaw) {
   EXPECT_NEAR(approximate.p_value, exact.p_value, 1e-3);
   // Everything tied: no evidence.
   EXPECT_DOUBLE_EQ(mann_whitney_greater({1, 1, 1}, {1, 1, 1}).p_value, 1.0);
+}
+
+// U by its definition, #{(i, j): slower_j > faster_i} + ½ #{slower_j = faster_i}, over every
+// pair: the O(n·m) count mann_whitney_greater used before it ranked the pooled sample.
+double pairwise_u(const std::vector<double>& faster, const std::vector<double>& slower) {
+  double u = 0;
+  for (double a : faster) {
+    for (double b : slower) u += b > a ? 1.0 : b == a ? 0.5 : 0.0;
+  }
+  return u;
+}
+
+// The ranked U equals the pair count, bit for bit, on random samples drawn from a few values (so
+// ties within and across the samples are frequent), of unequal sizes, including all-tied ones;
+// and with the same U the p-value is the same function of it.
+TEST(MannWhitney, RankedStatisticEqualsThePairCountWithTies) {
+  std::mt19937 random(20261206);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 1 + static_cast<int>(random() % 40), m = 1 + static_cast<int>(random() % 40);
+    const int levels = 1 + static_cast<int>(random() % 12);
+    std::vector<double> faster(n), slower(m);
+    for (double& x : faster) x = 0.25 * static_cast<double>(random() % levels);
+    for (double& x : slower) x = 0.25 * static_cast<double>(random() % levels) + 0.25 * (trial % 3);
+    SCOPED_TRACE(testing::Message()
+                 << "trial " << trial << ": " << n << "x" << m << ", " << levels << " levels");
+    EXPECT_EQ(mann_whitney_greater(faster, slower).u, pairwise_u(faster, slower));
+    EXPECT_EQ(mann_whitney_greater(slower, faster).u, pairwise_u(slower, faster));
+  }
+}
+
+// 60 000 repetitions per side (ties included): the pair count took 30 s, the ranks take well
+// under a second. Logged, not asserted (the machine's load is not the test's business).
+TEST(MannWhitney, SixtyThousandPerSideLogsItsTime) {
+  std::mt19937 random(7);
+  std::vector<double> faster(60000), slower(60000);
+  for (double& x : faster) x = 1000 + static_cast<double>(random() % 5000);
+  for (double& x : slower) x = 1500 + static_cast<double>(random() % 5000);
+  const auto start = std::chrono::steady_clock::now();
+  const MannWhitney result = mann_whitney_greater(faster, slower);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  RecordProperty("mann_whitney_60000_seconds", std::to_string(seconds));
+  std::printf("mann_whitney_greater, 60000 x 60000: %.3f s (U = %.1f, p = %.3g)\n", seconds,
+              result.u, result.p_value);
+  EXPECT_FALSE(result.exact);
+  EXPECT_GT(result.u, 0.5 * 60000.0 * 60000.0);  // the slower side is shifted up
 }
 
 BenchmarkSamples samples_of(const std::vector<double>& times_ns) {
@@ -205,6 +255,19 @@ TEST_F(BenchmarkJson, RefusesTruncatedMalformedAndDuplicatedInput) {
   negative.insert(negative.find("1.5, \"cpu"), "-");
   refused(write("negative.json", negative), "real_time");
   refused(write("empty.json", R"({"context": {}, "benchmarks": []})"), "no benchmark");
+  // Times whose nanoseconds overflow (1e300 s = inf ns: the median was inf, the ratio nan) or
+  // leave [1e-9 ns, 1e18 ns] are input errors naming the benchmark.
+  for (const char* time : {"1e300, \"cpu_time\": 1, \"time_unit\": \"s\"",
+                           "1e10, \"cpu_time\": 1, \"time_unit\": \"s\"",
+                           "1e-320, \"cpu_time\": 1, \"time_unit\": \"ns\""}) {
+    std::string huge = text;
+    huge.replace(huge.find("1.5, \"cpu_time\": 1.5, \"time_unit\": \"us\""),
+                 std::string("1.5, \"cpu_time\": 1.5, \"time_unit\": \"us\"").size(), time);
+    refused(write("huge.json", huge), "benchmark 'BM_Step' has real_time");
+    refused(write("huge.json", huge), "outside the range");
+  }
+  // An endless input stops at the size limit instead of at the end of memory.
+  refused("/dev/zero", "64 MiB");
   // The same benchmark in two files of one folder.
   fs::create_directories(dir_ / "folder");
   write("folder/one.json", kDocument);

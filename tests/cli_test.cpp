@@ -423,6 +423,39 @@ TEST(Cli, GateFormatsStayValidForControlCharactersAndNonUtf8Paths) {
   fs::remove(json);
 }
 
+// perf-compare's CSV quotes fields per RFC 4180: templated benchmark names hold commas
+// (`BM_X<a, b>`) and may hold quotes; every data row has the header's 9 fields under Python's csv
+// reader and the names read back unchanged.
+TEST(Cli, PerfCompareQuotesBenchmarkNamesWithCommasAndQuotes) {
+  const auto document = [](double scale) {
+    std::string rows;
+    for (const std::string name : {"BM_X<a, b>", "BM_Y<\\\"q\\\", 2>", "BM_Plain"}) {
+      for (int k = 0; k < 6; ++k) {
+        rows += (rows.empty() ? "" : ",\n") + std::string("{\"name\": \"") + name +
+                "\", \"run_type\": \"iteration\", \"iterations\": 10, \"real_time\": " +
+                std::to_string(scale * (10 + 0.1 * k)) + ", \"time_unit\": \"us\"}";
+      }
+    }
+    return "{\"context\": {\"commit\": \"abc\"}, \"benchmarks\": [\n" + rows + "\n]}\n";
+  };
+  const fs::path base = scratch("perf_base.json"), candidate = scratch("perf_new.json");
+  std::ofstream(base) << document(1);
+  std::ofstream(candidate) << document(1);
+  const fs::path csv = scratch("perf.csv");
+  const Outcome compared = geomint("perf-compare --quiet " + base.string() + " " +
+                                   candidate.string() + " > " + csv.string());
+  EXPECT_EQ(compared.exit_code, 0) << compared.output;
+  const Outcome parsed = geomint_shell(
+      "grep -v '^#' " + csv.string() +
+      " | /usr/bin/python3 -c \"import csv, sys; rows = list(csv.reader(sys.stdin)); "
+      "assert all(len(r) == 9 for r in rows), rows; print('|'.join(r[0] for r in rows))\"");
+  EXPECT_EQ(parsed.exit_code, 0) << parsed.output;
+  EXPECT_EQ(parsed.output, "benchmark|BM_Plain|BM_X<a, b>|BM_Y<\"q\", 2>\n");
+  fs::remove(base);
+  fs::remove(candidate);
+  fs::remove(csv);
+}
+
 // gate --quiet (docs/CLI.md "Quiet and colour"): the text format prints the failing gates alone
 // (nothing when all pass), exit codes unchanged; geomint prints no colour (no escape sequence),
 // so NO_COLOR has nothing to turn off.

@@ -17,10 +17,30 @@ struct PerfCompareCliOptions {
   PerfCompareOptions compare;
 };
 
+// A CSV field per RFC 4180: quoted when it holds a comma, a quote or a line break (templated
+// benchmarks such as `BM_X<a, b>` do), with quotes doubled inside.
+std::string csv_field(const std::string& value) {
+  if (value.find_first_of(",\"\r\n") == std::string::npos) return value;
+  std::string out = "\"";
+  for (char c : value) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// A context value on one comment line: line breaks and other control characters as spaces.
+std::string one_line(std::string value) {
+  for (char& c : value) {
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  }
+  return value;
+}
+
 std::string provenance_line(const char* side, const BenchmarkSamples& samples) {
   const auto value = [&](const char* key) {
     const auto it = samples.context.find(key);
-    return it == samples.context.end() ? std::string("?") : it->second;
+    return it == samples.context.end() ? std::string("?") : one_line(it->second);
   };
   return fmt::format("# {}: commit {}, compiler {}, cpu {}, threads {}, host {}, {}", side,
                      value("commit"), value("compiler"), value("cpu_model"), value("threads"),
@@ -42,7 +62,7 @@ int run_perf_compare(const PerfCompareCliOptions& cli, const Context& context) {
   int slower = 0, faster = 0;
   for (const PerfComparison& row : rows) {
     const bool both = row.base_n > 0 && row.new_n > 0;
-    fmt::print("{},{},{},{:.6g},{:.6g},{},{},{},{}\n", row.name, row.base_n, row.new_n,
+    fmt::print("{},{},{},{:.6g},{:.6g},{},{},{},{}\n", csv_field(row.name), row.base_n, row.new_n,
                row.base_median_ns, row.new_median_ns, both ? fmt::format("{:.4f}", row.ratio) : "",
                both ? fmt::format("{:.3g}", row.p_slower) : "",
                both ? fmt::format("{:.3g}", row.p_faster) : "", row.verdict);
