@@ -24,8 +24,8 @@ cost_titles = "stormer_verlet~(h~=~0.001) yoshida4(verlet)~(0.003) hp:alpha=0.5~
 cost_class(r) = (r <= 5 ? 1 : r == 6 ? 2 : 3)
 cost_row(label) = sum [r=1:words(cost_rows)] ("kepler_cost_".word(cost_rows, r) eq label ? words(cost_rows) + 1 - r : 0)
 # Two rows' 100-period phase moved past the phase tracker's search window between checkpoints:
-# their summary.csv values are wrapped angles (README "Phase error on Kepler e = 0.6 at equal
-# cost"), so they are marked, not plotted.
+# their summary.csv values are wrapped angles (results/structure/README.md explains it under the
+# phase error at equal cost), so they are marked, not plotted.
 phase_lost(label) = (label eq "kepler_cost_avf" || label eq "kepler_cost_projection")
 
 png_big = "pngcairo noenhanced size 1000,1000 font 'DejaVu Sans,12'"
