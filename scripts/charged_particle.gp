@@ -29,7 +29,7 @@ field_y(label) = sum [f=1:words(fields)] (label eq word(fields, f) ? words(field
 offset(m) = (strstrt(m, "boris") == 1 ? 0.24 : strstrt(m, "del") == 1 ? 0.08 : strstrt(m, "implicit_midpoint") == 1 ? -0.08 : -0.24)
 
 png_big = "pngcairo noenhanced size 1000,1000 font 'DejaVu Sans,12'"
-pdf_big = "pdfcairo noenhanced size 7in,7in font 'DejaVu Sans,9'"
+pdf_big = pdf_for_png(1000, 1000, 12)
 svg_big = "svg noenhanced size 1000,1000 font 'DejaVu Sans,12' background rgb 'white'"
 
 do for [format in "png pdf svg"] {

@@ -26,7 +26,7 @@ resized(term, size, points) = term[1:strstrt(term, " size ")] . size . \
   sprintf(" font 'DejaVu Sans,%d'", points) . \
   (strstrt(term, " background ") > 0 ? term[strstrt(term, " background "):] : "")
 png_fpu = resized(png_term, "size 1000,950", 13)
-pdf_fpu = resized(pdf_term, "size 7in,6.65in", 10)
+pdf_fpu = pdf_for_png(1000, 950, 13)
 svg_fpu = resized(svg_term, "size 1000,950", 13)
 panel_left(k) = (k % 2 == 1 ? 0.1 : 0.6)
 panel_top(k) = (k <= 2 ? 0.83 : 0.41)

@@ -14,7 +14,7 @@ problem_title = "pendulum:theta0=1.2,omega0=1.7 kepler:e=0.5 FPU-beta~chain,~n~=
 spaced(s) = system("printf '%s' '".s."' | tr '~' ' '")
 
 png_big = "pngcairo noenhanced size 1000,900 font 'DejaVu Sans,12'"
-pdf_big = "pdfcairo noenhanced size 7in,6.3in font 'DejaVu Sans,9'"
+pdf_big = pdf_for_png(1000, 900, 12)
 svg_big = "svg noenhanced size 1000,900 font 'DejaVu Sans,12' background rgb 'white'"
 panel_left(k) = (k % 2 == 1 ? 0.1 : 0.6)
 panel_top(k) = (k <= 2 ? 0.87 : 0.41)

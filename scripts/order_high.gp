@@ -20,7 +20,7 @@ short(m) = (strstrt(m, "composition:") == 1 ? m[strstrt(m, "scheme=") + 7:] . "(
 anchor_h(p) = (p == 8 ? 0.4 : 0.1)
 
 png_big = "pngcairo noenhanced size 1000,900 font 'DejaVu Sans,12'"
-pdf_big = "pdfcairo noenhanced size 7in,6.3in font 'DejaVu Sans,9'"
+pdf_big = pdf_for_png(1000, 900, 12)
 svg_big = "svg noenhanced size 1000,900 font 'DejaVu Sans,12' background rgb 'white'"
 panel_left(k) = (k % 2 == 1 ? 0.1 : 0.6)
 panel_top(k) = (k <= 2 ? 0.88 : 0.43)

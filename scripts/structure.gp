@@ -29,7 +29,7 @@ cost_row(label) = sum [r=1:words(cost_rows)] ("kepler_cost_".word(cost_rows, r) 
 phase_lost(label) = (label eq "kepler_cost_avf" || label eq "kepler_cost_projection")
 
 png_big = "pngcairo noenhanced size 1000,1000 font 'DejaVu Sans,12'"
-pdf_big = "pdfcairo noenhanced size 7in,7in font 'DejaVu Sans,9'"
+pdf_big = pdf_for_png(1000, 1000, 12)
 svg_big = "svg noenhanced size 1000,1000 font 'DejaVu Sans,12' background rgb 'white'"
 # Three scatter panels in a row, the equal-cost panel below them at full width (its method names
 # need the room); panel(k) sets the margins of panel k in screen units.

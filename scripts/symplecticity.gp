@@ -45,7 +45,7 @@ set_rows = 'set ytics scale 0 font ",11"; set ytics (); unset arrow; unset for [
   'set yrange [0.4:words(KEYS) + 1.6]'
 
 png_tall = "pngcairo noenhanced size 1000,1200 font 'DejaVu Sans,12'"
-pdf_tall = "pdfcairo noenhanced size 7in,8.4in font 'DejaVu Sans,9'"
+pdf_tall = pdf_for_png(1000, 1200, 12)
 svg_tall = "svg noenhanced size 1000,1200 font 'DejaVu Sans,12' background rgb 'white'"
 
 do for [format in "png pdf svg"] {

@@ -24,7 +24,7 @@ title_of(panel) = (panel eq "stiff_spring" ? words_stiff_spring : (panel eq "fpu
 # common.gp's terminals with twice the height, for the 2 x 2 panels (cairo refuses a second size).
 tall(term, size) = term[1:strstrt(term, " size ")] . size . term[strstrt(term, " font "):]
 png_tall = tall(png_term, "size 1000,1150")
-pdf_tall = tall(pdf_term, "size 7in,8in")
+pdf_tall = pdf_for_png(1000, 1150, 11)
 svg_tall = tall(svg_term, "size 1000,1150")
 
 do for [format in "png pdf svg"] {
