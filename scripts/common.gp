@@ -71,6 +71,11 @@ key_above = "set key outside top center horizontal maxrows 3 samplen 3 width 1 s
 png_term = "pngcairo noenhanced size 1000,650 font 'DejaVu Sans,11'"
 pdf_term = "pdfcairo noenhanced size 7in,4.5in font 'DejaVu Sans,9'"
 svg_term = "svg noenhanced size 1000,650 font 'DejaVu Sans,11' background rgb 'white'"
+# A PDF laid out exactly as the PNG of w x h px with the same font: pngcairo draws an N-pt font at
+# 96 dpi (4/3 N px), so the PDF's page is w x h at 0.75 pt per px. The layout checks of the SVG
+# (tests/figures/figure_layout_check.py, at the PNG's text size) then hold for the PDF as well.
+pdf_for_png(w, h, points) = sprintf("pdfcairo noenhanced size %.3fin,%.3fin font 'DejaVu Sans,%g'", \
+  w * 0.75 / 72, h * 0.75 / 72, points)
 
 # Footer (issue 28, citation kit): every figure names the geomint version and commit that computed
 # its numbers. scripts/reproduce.sh passes the `# geomint:` provenance line of the scene's CSVs as

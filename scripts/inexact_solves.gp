@@ -44,6 +44,8 @@ do for [format in "png pdf svg"] {
   set logscale xy; set format x "1e%T"; set format y "1e%T"
   set xrange [3e-15:3e-4]
   set xlabel "Newton tolerance tol (dimensionless)"
+  # One more line under the x labels: the right panel's label would reach the provenance footer.
+  set bmargin 4.5
   set xtics 10000
   set key top left font ",8"
 

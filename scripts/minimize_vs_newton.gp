@@ -21,6 +21,8 @@ do for [format in "png pdf svg"] {
   set multiplot layout 1,2 title "hp:alpha=0.5 on spring_net:stiffness=1e4,model=nonlinear (explicit limit h*omega_max = 1.89)"
   set logscale xy; set format x "% g"; set format y "% g"
   set xlabel "h * omega_max (dimensionless)"; set key top left
+  # One more line under the x labels: the right panel's label would reach the provenance footer.
+  set bmargin 4.5
   set style line 51 lw 2 lc rgb "#e7298a" pt 6 ps 1.8 dt 2
   set style line 52 lw 2 lc rgb "#555555" pt 5 ps 1.0
   set xrange [0.2:600]

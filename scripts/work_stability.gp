@@ -24,21 +24,26 @@ title_of(panel) = (panel eq "stiff_spring" ? words_stiff_spring : (panel eq "fpu
 # common.gp's terminals with twice the height, for the 2 x 2 panels (cairo refuses a second size).
 tall(term, size) = term[1:strstrt(term, " size ")] . size . term[strstrt(term, " font "):]
 png_tall = tall(png_term, "size 1000,1150")
-pdf_tall = tall(pdf_term, "size 7in,8in")
+pdf_tall = pdf_for_png(1000, 1150, 11)
 svg_tall = tall(svg_term, "size 1000,1150")
 
 do for [format in "png pdf svg"] {
   if (format eq "png") { set term @png_tall } else { if (format eq "pdf") { set term @pdf_tall } else { set term @svg_tall } }
   do for [measure in "cpu eval"] {
     set output (measure eq "cpu" ? "work_stability." : "work_stability_evals.").format
+    # Two title lines (one would run past the canvas edges), and panels placed by hand so the
+    # bottom row's x labels keep a line of their own above the provenance footer.
     set multiplot layout 2,2 title (measure eq "cpu" ? \
-      "Simulated time per CPU-second at the largest stable step (cap h = 0.3, bar 0.1); fastest of 5 (bar: 3) timed repeats, bars down by the IQR" : \
-      "Simulated time per force + Hessian evaluation at the largest stable step (capped at h = 0.3, bar 0.1)")
+      "Simulated time per CPU-second at the largest stable step (step capped at h = 0.3, bar 0.1)\nfastest of 5 timed repeats (bar: 3), error bars down by the interquartile range" : \
+      "Simulated time per force + Hessian evaluation at the largest stable step\n(step capped at h = 0.3, bar 0.1)") \
+      margins screen 0.085, 0.98, 0.075, 0.9 spacing screen 0.1, 0.1
     set logscale xy; set format x "1e%T"; set format y "1e%T"
     set ylabel (measure eq "cpu" ? "simulated time / CPU second" : "simulated time / evaluation")
-    set key bottom left font ",8" maxrows 5
+    # The key sits in the bottom of each panel, below the data: extend every y range downwards.
+    set key bottom left font ",9" maxrows 5
+    set offsets 0, 0, 0, graph 0.25
     do for [panel in "stiff_spring fpu_stiff elastic_bar_young elastic_bar_mesh"] {
-      set title title_of(panel) font ",9"
+      set title title_of(panel) font ",10"
       set xlabel xlabel_of(panel)
       list = (panel[1:11] eq "elastic_bar" ? methods_bar : methods)
       if (measure eq "cpu") {
