@@ -37,9 +37,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// What the atomic writer appends to a file name for its temporary, ".<pid>.<n>.tmp"
+// What the atomic writer appends to a file name for its temporary, ".<pid>.<n>.h<tag>.tmp"
 // (harness/table.cpp), at its longest: a name is only writable when that one fits too.
-constexpr std::size_t kTemporarySuffix = 24;
+constexpr std::size_t kTemporarySuffix = 42;
 
 // A path for a message: a 100 kB path is not printed whole, but its start and its end (the
 // file name the message is about) are, so a deep working folder (a CI runner's TMPDIR) does not

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "harness/output_folder.hpp"
 #include "harness/paths.hpp"
 #include "harness/record.hpp"
 #include "harness/shard_files.hpp"
@@ -82,7 +83,10 @@ std::string resubmission(const std::set<int>& shards, const MergeOptions& option
     text += fmt::format("  (without Slurm: for i in {}; do {} --shard $i/{}; done)\n",
                         fmt::join(indices, " "), sweep_command, count);
   }
-  return text + fmt::format("then merge again: geomint merge {}", shell_quoted(options.out_dir));
+  return text + fmt::format("then merge again: {}",
+                            options.merge_command.empty()
+                                ? fmt::format("geomint merge {}", shell_quoted(options.out_dir))
+                                : options.merge_command);
 }
 
 }  // namespace
@@ -215,6 +219,8 @@ std::string shards_variant(const std::string& out_dir) {
 
 void merge_shards(const Scene& scene, const MergeOptions& options) {
   const SceneUnits units = scene_units(scene);
+  const OutputFolderLock lock(options.out_dir, OutputFolderLock::Mode::kExclusive, "geomint merge");
+  check_folder_scene(options.out_dir, options.scene_name);
   remove_stale_temporaries(scene, options.out_dir);
   const fs::path dir = fs::path(options.out_dir) / "shards";
   static const std::regex kName(R"(^([a-z_]+)\.([0-9]+)-of-([0-9]+)\.csv$)");
@@ -445,14 +451,21 @@ std::string sbatch_output_path(const std::string& path) {
 std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
   const fs::path folder = fs::absolute(options.scene_path).parent_path();
   const std::string scene_name = folder.filename().string();
-  const fs::path out_dir = options.quick ? folder / "quick" : folder;
+  const bool own_out = !options.out_dir.empty();
+  const fs::path out_dir = own_out         ? fs::absolute(options.out_dir).lexically_normal()
+                           : options.quick ? folder / "quick"
+                                           : folder;
+  const fs::path scripts_dir = own_out ? out_dir : folder;
+  // The sweep, merge and timing lines name the folder when it is not the scene's default.
+  const std::string out_words =
+      own_out ? " --out " + shell_quoted(one_line(out_dir.string(), "--out")) : "";
   const std::string cwd = fs::current_path().string();
   const std::string quick = options.quick ? " --quick" : "";
   const fs::path logs = out_dir / "slurm-logs";
   // Every path and value reaches the scripts through these, refused before any file is written.
   // The comment lines carry the paths too: a newline there would start a line of code.
   const std::string scene_comment = shell_quoted(one_line(options.scene_path, "the scene path"));
-  const std::string sweep_comment = shell_quoted((folder / "sweep.sbatch").string());
+  const std::string sweep_comment = shell_quoted((scripts_dir / "sweep.sbatch").string());
   const std::string logs_value = sbatch_output_path(logs.string());
   one_line(cwd, "the working folder");
   const std::string partition =
@@ -489,8 +502,8 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
           "#SBATCH --cpus-per-task={}\n",
           array, options.jobs) +
       body_start +
-      fmt::format("exec {} sweep {}{} --shard-from-env --shards {} --no-timing{}\n", geomint, scene,
-                  quick, options.shards,
+      fmt::format("exec {} sweep {}{}{} --shard-from-env --shards {} --no-timing{}\n", geomint,
+                  scene, quick, out_words, options.shards,
                   options.jobs > 1 ? fmt::format(" --jobs {}", options.jobs) : "");
   const std::string merge =
       header(
@@ -498,19 +511,20 @@ std::vector<std::string> write_slurm_scripts(const SlurmOptions& options) {
           "--dependency=afterok:<sweep job>)",
           "merge") +
       "#SBATCH --ntasks=1\n" + body_start +
-      fmt::format("exec {} merge {}\n", geomint, shell_quoted(out_dir.string()));
+      fmt::format("exec {} merge {}{}\n", geomint, shell_quoted(out_dir.string()),
+                  own_out ? " --scene " + scene : "");
   const std::string timing =
       header(
           "Timing passes, one at a time on one whole node, pinned (submit with "
           "--dependency=afterok:<merge job>)",
           "timing") +
       "#SBATCH --exclusive\n#SBATCH --nodes=1\n#SBATCH --ntasks=1\n" + body_start +
-      fmt::format("exec srun --cpu-bind=cores --ntasks=1 {} sweep {}{} --timing-only\n", geomint,
-                  scene, quick);
+      fmt::format("exec srun --cpu-bind=cores --ntasks=1 {} sweep {}{}{} --timing-only\n", geomint,
+                  scene, quick, out_words);
   std::vector<std::string> paths;
   for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
            {"sweep.sbatch", sweep}, {"merge.sbatch", merge}, {"timing.sbatch", timing}}) {
-    paths.push_back((folder / name).string());
+    paths.push_back((scripts_dir / name).string());
     write_file_atomic(paths.back(), text);
   }
   return paths;

@@ -54,6 +54,9 @@ struct MergeOptions {
   std::string scene_name;   // `# scene:` line
   std::string variant;      // `# variant:` line (shards_variant())
   std::string sbatch_path;  // sweep.sbatch named by the resubmission command
+  // The `geomint merge ...` command a refusal tells to run again (with --scene when the folder
+  // alone does not find the scene); empty: `geomint merge <out_dir>`.
+  std::string merge_command;
 };
 
 // The variant (`full`/`quick`) the shards in <out_dir>/shards were run with; InputError when
@@ -67,9 +70,11 @@ void merge_shards(const Scene& scene, const MergeOptions& options);
 
 // `geomint slurm`: sweep.sbatch (array of `count` shards, at most max_parallel at once,
 // --requeue), merge.sbatch and timing.sbatch (--exclusive, srun --cpu-bind=cores), written next
-// to the scene file. Returns their paths in submission order.
+// to the scene file, or with out_dir into out_dir, which then also receives the shards, the
+// tables and slurm-logs/. Returns their paths in submission order.
 struct SlurmOptions {
   std::string scene_path, geomint_path;
+  std::string out_dir;  // empty: scripts next to the scene, results in its folder (or quick/)
   bool quick = false;
   int shards = 0, max_parallel = 0;  // max_parallel 0: no limit
   std::string partition, time_limit;

@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "harness/order.hpp"
+#include "harness/output_folder.hpp"
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
@@ -499,12 +500,18 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
   check_sweep_outputs(plan, options);
-  remove_stale_outputs(plan, options.out_dir);
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;
   auto& stability_jobs = plan.stability_jobs;
   const bool sharded = options.shard_count > 0;
   const ShardId shard{options.shard_index, options.shard_count};
+  // The shards of one sweep write disjoint files and share the folder; anything else owns it.
+  const OutputFolderLock lock(
+      options.out_dir,
+      sharded ? OutputFolderLock::Mode::kShared : OutputFolderLock::Mode::kExclusive,
+      sharded ? fmt::format("geomint sweep --shard {}", shard_text(shard)) : "geomint sweep");
+  check_folder_scene(options.out_dir, options.scene_name);
+  remove_stale_outputs(plan, options.out_dir);
   // The units of this sweep by canonical index k (runs, order studies, stability searches):
   // all of them, or a shard's k mod N == i (round-robin, so long runs spread over the shards).
   const auto mine = [&](size_t k) {
@@ -668,7 +675,6 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
   check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
-  remove_stale_outputs(plan, options.out_dir);
   const fs::path out(options.out_dir);
   const fs::path summary_path = out / "summary.csv";
   if (!fs::exists(summary_path)) {
@@ -677,6 +683,10 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
         "first",
         summary_path.string(), options.out_dir));
   }
+  const OutputFolderLock lock(options.out_dir, OutputFolderLock::Mode::kExclusive,
+                              "geomint sweep --timing-only");
+  check_folder_scene(options.out_dir, options.scene_name);
+  remove_stale_outputs(plan, options.out_dir);
   CsvTable summary = read_csv_file(summary_path.string());
   SceneTables tables;
   tables.summary = std::move(summary.rows);

@@ -295,10 +295,18 @@ std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::str
 
 namespace {
 
-// <path>.<pid>.<n>.tmp: unique per process and per writer, so parallel writers never share one.
+// <path>.<pid>.<n>.h<tag>.tmp: unique per process and per writer, so parallel writers never share
+// one; the tag names the machine and PID namespace whose <pid> it is (temporary_host_tag).
 std::string temporary_name(const std::string& path) {
   static std::atomic<unsigned long> counter{0};
-  return fmt::format("{}.{}.{}.tmp", path, ::getpid(), counter++);
+  return fmt::format("{}.{}.{}.h{}.tmp", path, ::getpid(), counter++, temporary_host_tag());
+}
+
+std::string first_line_of(const char* path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
 }
 
 // The temporaries this process has open, for the SIGTERM/SIGINT handler. A signal handler may
@@ -349,26 +357,45 @@ extern "C" void remove_temporaries_and_reraise(int signal_number) {
   errno = saved_errno;
 }
 
-// "<name>.<digits>.<digits>.tmp" → the pid, or -1 when `file` is no temporary of `name`.
-long temporary_pid(const std::string& file, const std::string& name) {
+// A temporary of an output as read back from its name: "<name>.<pid>.<n>.h<tag>.tmp", or the
+// untagged "<name>.<pid>.<n>.tmp" of earlier geomint versions (tag empty).
+struct TemporaryName {
+  std::string name, tag;
+  long pid = -1;  // -1: not a temporary's name
+};
+
+TemporaryName parse_temporary_name(const std::string& file) {
   const std::string suffix = ".tmp";
-  if (file.size() <= name.size() + suffix.size() + 4 || file.compare(0, name.size(), name) != 0 ||
-      file[name.size()] != '.' ||
+  if (file.size() <= suffix.size() ||
       file.compare(file.size() - suffix.size(), suffix.size(), suffix) != 0) {
-    return -1;
+    return {};
   }
-  const std::string middle =
-      file.substr(name.size() + 1, file.size() - name.size() - 1 - suffix.size());
-  const auto dot = middle.find('.');
+  std::string rest = file.substr(0, file.size() - suffix.size());
+  // Fields from the end: [h<tag>,] <n>, <pid>; what precedes them is the output's name.
+  const auto take_last = [&rest]() -> std::string {
+    const auto dot = rest.rfind('.');
+    if (dot == std::string::npos || dot == 0) return "";
+    std::string field = rest.substr(dot + 1);
+    rest.resize(dot);
+    return field;
+  };
   const auto digits = [](const std::string& text) {
     return !text.empty() && text.size() <= 18 &&
            std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
-  if (dot == std::string::npos || !digits(middle.substr(0, dot)) ||
-      !digits(middle.substr(dot + 1))) {
-    return -1;
+  TemporaryName parsed;
+  std::string field = take_last();
+  if (field.size() == 17 && field[0] == 'h' &&
+      std::all_of(field.begin() + 1, field.end(),
+                  [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); })) {
+    parsed.tag = field.substr(1);
+    field = take_last();
   }
-  return std::stol(middle.substr(0, dot));
+  const std::string pid = take_last();
+  if (!digits(field) || !digits(pid) || rest.empty()) return {};
+  parsed.name = rest;
+  parsed.pid = std::stol(pid);
+  return parsed;
 }
 
 }  // namespace
@@ -386,6 +413,27 @@ void remove_temporaries_on_signals() {
   }
 }
 
+std::string temporary_host_tag() {
+  static const std::string tag = [] {
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+    // The PID namespace's identity ("pid:[4026531836]"): two containers, or `unshare --pid`, on
+    // one host and boot number their processes independently.
+    char name_space[256] = {};
+    const ssize_t length = ::readlink("/proc/self/ns/pid", name_space, sizeof name_space - 1);
+    if (length < 0) name_space[0] = '\0';
+    const std::string identity = fmt::format(
+        "{}\n{}\n{}", host, first_line_of("/proc/sys/kernel/random/boot_id"), name_space);
+    std::uint64_t hash = 14695981039346656037ull;  // FNV-1a 64
+    for (unsigned char c : identity) {
+      hash ^= c;
+      hash *= 1099511628211ull;
+    }
+    return fmt::format("{:016x}", hash);
+  }();
+  return tag;
+}
+
 size_t remove_stale_temporaries(const std::string& folder,
                                 const std::function<bool(const std::string&)>& is_output) {
   namespace fs = std::filesystem;
@@ -393,22 +441,25 @@ size_t remove_stale_temporaries(const std::string& folder,
   if (!fs::is_directory(folder, error)) return 0;
   size_t removed = 0;
   const long self = ::getpid();
+  const std::string here = temporary_host_tag();
+  const auto now = fs::file_time_type::clock::now();
   for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
-    const std::string file = it->path().filename().string();
-    if (file.size() < 4 || file.compare(file.size() - 4, 4, ".tmp") != 0) continue;
-    // The output name is what precedes ".<pid>.<n>.tmp".
-    const auto last = file.rfind('.', file.size() - 5);
-    if (last == std::string::npos || last == 0) continue;
-    const auto before = file.rfind('.', last - 1);
-    if (before == std::string::npos) continue;
-    const std::string name = file.substr(0, before);
-    const long pid = temporary_pid(file, name);
-    if (pid < 0 || pid == self || !is_output(name)) continue;
-    // A writer still alive on this machine keeps its file; a dead one (kill -9, a node lost)
-    // left debris.
-    if (pid <= std::numeric_limits<pid_t>::max() &&
-        (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM)) {
-      continue;
+    const TemporaryName temporary = parse_temporary_name(it->path().filename().string());
+    if (temporary.pid < 0 || !is_output(temporary.name)) continue;
+    if (temporary.tag == here) {
+      // A writer of this machine and PID namespace: kept while it is alive; a dead one (kill -9,
+      // an out-of-memory kill) left debris.
+      if (temporary.pid == self) continue;
+      if (temporary.pid <= std::numeric_limits<pid_t>::max() &&
+          (::kill(static_cast<pid_t>(temporary.pid), 0) == 0 || errno == EPERM)) {
+        continue;
+      }
+    } else {
+      // Another node of a shared file system, another container, or a geomint whose temporaries
+      // carried no tag: its PID says nothing here. Only age tells it is gone (a lost node).
+      std::error_code time_error;
+      const auto written = fs::last_write_time(it->path(), time_error);
+      if (time_error || now - written < kForeignTemporaryAge) continue;
     }
     std::error_code ignored;
     removed += fs::remove(it->path(), ignored);

@@ -3,6 +3,7 @@
 // Markdown tables for results/<scene>/table.md.
 #pragma once
 
+#include <chrono>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -86,9 +87,21 @@ class AtomicFileWriter {
 // a library user decides for their own program.
 void remove_temporaries_on_signals();
 
-// Removes the temporaries `<name>.<pid>.<n>.tmp` in `folder` that an AtomicFileWriter left when
-// its process was killed (kill -9, a lost node): `name` must satisfy is_output and the pid must
-// be neither this process nor a live process on this machine. Returns how many were removed.
+// 16 hex digits naming this machine and PID namespace (host name, boot id, the namespace of
+// /proc/self/ns/pid): an AtomicFileWriter's temporary is `<name>.<pid>.<n>.h<tag>.tmp`, so a
+// PID is only ever looked up where it was issued.
+std::string temporary_host_tag();
+
+// How old (last written) a temporary of another machine or PID namespace, or one without a tag,
+// must be before remove_stale_temporaries takes it for debris: a live writer of another node
+// writes its file far more often than this (docs/CLUSTER.md "Shared file systems").
+inline constexpr std::chrono::hours kForeignTemporaryAge{24};
+
+// Removes the temporaries `<name>.<pid>.<n>.h<tag>.tmp` in `folder` that an AtomicFileWriter left
+// when its process was killed (kill -9, a lost node): `name` must satisfy is_output, and either
+// the tag is this machine's and namespace's and the pid is neither this process nor a live one,
+// or the tag is another's (or absent) and the file was last written kForeignTemporaryAge ago or
+// more. Returns how many were removed.
 size_t remove_stale_temporaries(const std::string& folder,
                                 const std::function<bool(const std::string&)>& is_output);
 

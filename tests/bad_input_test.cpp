@@ -23,6 +23,8 @@
 #include <thread>
 #include <vector>
 
+#include "harness/table.hpp"
+
 namespace geomint {
 namespace {
 
@@ -34,7 +36,7 @@ struct Case {
   int exit_code;          // 0 ok, 1 a run failed (a row), 2 bad input
   std::string word;       // the output (stdout + stderr) must contain this
   // Files created in {dir} before the run: relative path → content; a path ending in '/' is a
-  // directory.
+  // directory; {tag} in a path is this machine's temporary_host_tag().
   std::vector<std::pair<std::string, std::string>> setup = {};
   // Files the run may leave in {dir} (relative paths, directories included). Bad input: none.
   std::set<std::string> outputs = {};
@@ -955,6 +957,12 @@ const std::vector<Case>& cases() {
        {{"scene.toml", scene(kRunBlock + "dt = 1e-7\nt_end = 1000.0\ntiming_repeats = 0\n")}},
        {"scene.toml"},
        10},
+      {"SlurmOutNotWritable",
+       "slurm {dir}/scene.toml --out /proc/geomint-slurm",
+       2,
+       "--out '/proc/geomint-slurm'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"}},
       {"SlurmShardsAboveUnits",
        "slurm {dir}/scene.toml --shards 5",
        2,
@@ -989,18 +997,57 @@ const std::vector<Case>& cases() {
         {"summary.csv",
          "# command: geomint sweep\nlabel,problem,method,status\nz,pendulum,stormer_verlet,ok\n"}},
        {"scene.toml", "summary.csv"}},
-      // --- debris: a rerun removes the temporaries a killed run left (pid 2147483646 is no
-      // live process), in the tables' folder, shards/ and the series folders ---
+      // --- one scene per output folder: a sweep, shard or merge refuses a folder holding
+      // another scene's tables, shards or series, and writes nothing there ---
+      {"SweepIntoOtherScenesFolder",
+       "sweep {dir}/scene.toml",
+       2,
+       "scene 'other'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n")},
+        {"summary.csv",
+         "# command: geomint sweep\n# scene: other\n# variant: full\nlabel,problem,method,status\n"
+         "a,pendulum,stormer_verlet,ok\n"}},
+       {"scene.toml", "summary.csv"}},
+      {"ShardIntoOtherScenesShards",
+       "sweep {dir}/scene.toml --shard 0/1",
+       2,
+       "scene 'work'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-2.csv", "# scene: other\n# shard: 0/2\ncanonical_index,label\n"}},
+       {"scene.toml", "shards", "shards/summary.0-of-2.csv"}},
+      {"SweepIntoOtherScenesSeries",
+       "sweep {dir}/scene.toml --out {dir}/out",
+       2,
+       "scene 'other'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n")},
+        {"out/", ""},
+        {"out/series/", ""},
+        {"out/series/b/", ""},
+        {"out/series/b/rk4.csv", "# command: geomint sweep results/other/scene.toml\nt,energy\n"}},
+       {"scene.toml", "out", "out/series", "out/series/b", "out/series/b/rk4.csv"}},
+      {"MergeIntoOtherScenesFolder",
+       "merge {dir}",
+       2,
+       "scene 'other'",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")},
+        {"shards/", ""},
+        {"shards/summary.0-of-1.csv", "# variant: full\n# shard: 0/1\ncanonical_index,label\n"},
+        {"order.csv", "# scene: other\nlabel\n"}},
+       {"scene.toml", "shards", "shards/summary.0-of-1.csv", "order.csv"}},
+      // --- debris: a rerun removes the temporaries a killed run of this machine left (pid
+      // 2147483646 is no live process; {tag} is this machine's, temporary_host_tag), in the
+      // tables' folder, shards/ and the series folders ---
       {"SweepRemovesStaleTemporaries",
        "sweep {dir}/scene.toml",
        0,
        "done",
        {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n"
                                          "series_every = 1\n")},
-        {"summary.csv.2147483646.0.tmp", "partial"},
-        {"table.md.2147483646.7.tmp", "partial"},
+        {"summary.csv.2147483646.0.h{tag}.tmp", "partial"},
+        {"table.md.2147483646.7.h{tag}.tmp", "partial"},
         {"series/a/", ""},
-        {"series/a/stormer_verlet.csv.2147483646.3.tmp", "partial"}},
+        {"series/a/stormer_verlet.csv.2147483646.3.h{tag}.tmp", "partial"}},
        {"scene.toml", "summary.csv", "table.md", "series", "series/a",
         "series/a/stormer_verlet.csv"},
        60},
@@ -1010,7 +1057,7 @@ const std::vector<Case>& cases() {
        "done",
        {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\ntiming_repeats = 0\n")},
         {"shards/", ""},
-        {"shards/summary.0-of-1.csv.2147483646.0.tmp", "partial"}},
+        {"shards/summary.0-of-1.csv.2147483646.0.h{tag}.tmp", "partial"}},
        {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
        60},
       {"MergeRemovesStaleTemporaries",
@@ -1021,9 +1068,9 @@ const std::vector<Case>& cases() {
         {"shards/", ""},
         {"shards/summary.0-of-1.csv",
          "# variant: full\n# scene_hash: x\n# shard: 0/1\ncanonical_index,label\n"},
-        {"shards/summary.0-of-1.csv.2147483646.2.tmp", "partial"},
-        {"summary.csv.2147483646.0.tmp", "partial"},
-        {"hosts.csv.2147483646.1.tmp", "partial"}},
+        {"shards/summary.0-of-1.csv.2147483646.2.h{tag}.tmp", "partial"},
+        {"summary.csv.2147483646.0.h{tag}.tmp", "partial"},
+        {"hosts.csv.2147483646.1.h{tag}.tmp", "partial"}},
        {"scene.toml", "shards", "shards/summary.0-of-1.csv"},
        60},
       // --- paths, Slurm scripts, CLI messages ---
@@ -1380,7 +1427,8 @@ TEST_P(BadInput, ExitCodeMessageAndNoStrayFiles) {
   fs::remove_all(base);
   fs::create_directories(dir);
   std::set<std::string> expected = c.outputs;
-  for (const auto& [path, content] : c.setup) {
+  for (const auto& [spelled, content] : c.setup) {
+    const std::string path = replace_all(spelled, "{tag}", temporary_host_tag());
     if (path.back() == '/') {
       fs::create_directories(dir / path);
     } else {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -282,28 +283,57 @@ TEST(CsvReader, RefusesDamagedTablesNamingTheLine) {
   EXPECT_EQ(rows[1].count("x"), 0u);
 }
 
-// A rerun removes only the temporaries of its own outputs whose process is gone.
+// A rerun removes only the temporaries of its own outputs whose process is gone: a PID is looked
+// up only on the machine and in the PID namespace that issued it (the tag in the name); another
+// node's temporary on a shared file system is debris only once it is a day old.
 TEST(StaleTemporaries, OnlyDeadWritersOfTheGivenOutputs) {
   const fs::path dir = scratch("stale");
   const std::string dead = "2147483646", self = std::to_string(::getpid()),
-                    parent = std::to_string(::getppid());
-  const std::vector<std::string> removed = {"summary.csv." + dead + ".0.tmp",
-                                            "table.md." + dead + ".12.tmp"};
+                    parent = std::to_string(::getppid()), here = ".h" + temporary_host_tag(),
+                    elsewhere = ".h0123456789abcdef";
+  ASSERT_NE(here, elsewhere);
+  const std::vector<std::string> removed = {"summary.csv." + dead + ".0" + here + ".tmp",
+                                            "table.md." + dead + ".12" + here + ".tmp"};
+  const std::vector<std::string> removed_old = {
+      "summary.csv." + dead + ".3" + elsewhere + ".tmp",  // another node's, a day old
+      "summary.csv." + dead + ".4.tmp"};                  // untagged (older geomint), a day old
   const std::vector<std::string> kept = {
-      "summary.csv." + self + ".0.tmp",    // this process is writing it
-      "summary.csv." + parent + ".1.tmp",  // a live process is writing it
-      "other.csv." + dead + ".0.tmp",      // not an output of this writer
-      "summary.csv." + dead + ".x.tmp",    // not the writer's pattern
+      "summary.csv." + self + ".0" + here + ".tmp",       // this process is writing it
+      "summary.csv." + parent + ".1" + here + ".tmp",     // a live process is writing it
+      "summary.csv." + dead + ".5" + elsewhere + ".tmp",  // another node's live writer
+      "summary.csv." + dead + ".6.tmp",                   // untagged, fresh
+      "other.csv." + dead + ".0" + here + ".tmp",         // not an output of this writer
+      "summary.csv." + dead + ".x" + here + ".tmp",       // not the writer's pattern
       "summary.csv.tmp",
       "summary.csv"};
   for (const auto& name : removed) std::ofstream(dir / name) << "x";
   for (const auto& name : kept) std::ofstream(dir / name) << "x";
+  for (const auto& name : removed_old) {
+    std::ofstream(dir / name) << "x";
+    fs::last_write_time(dir / name, fs::file_time_type::clock::now() - kForeignTemporaryAge -
+                                        std::chrono::minutes(1));
+  }
   const size_t count = remove_stale_temporaries(dir.string(), [](const std::string& name) {
     return name == "summary.csv" || name == "table.md";
   });
-  EXPECT_EQ(count, removed.size());
+  EXPECT_EQ(count, removed.size() + removed_old.size());
   for (const auto& name : removed) EXPECT_FALSE(fs::exists(dir / name)) << name;
+  for (const auto& name : removed_old) EXPECT_FALSE(fs::exists(dir / name)) << name;
   for (const auto& name : kept) EXPECT_TRUE(fs::exists(dir / name)) << name;
+  fs::remove_all(dir);
+}
+
+// The writer's temporaries carry the tag the remover compares.
+TEST(StaleTemporaries, WriterNamesCarryThisMachinesTag) {
+  const fs::path dir = scratch("tagged");
+  AtomicFileWriter writer((dir / "t.csv").string());
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
+  ASSERT_EQ(names.size(), 1u);
+  const std::string suffix = ".h" + temporary_host_tag() + ".tmp";
+  EXPECT_EQ(names[0].rfind("t.csv." + std::to_string(::getpid()) + ".", 0), 0u) << names[0];
+  EXPECT_EQ(names[0].substr(names[0].size() - suffix.size()), suffix) << names[0];
+  writer.commit();
   fs::remove_all(dir);
 }
 

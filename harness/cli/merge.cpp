@@ -34,7 +34,14 @@ int run_merge(const MergeCliOptions& cli, const Context& context) {
   const Scene scene = load_scene(scene_file, quick);
   options.scene_hash = scene_content_hash(scene_file, quick);
   options.scene_name = fs::absolute(scene_file).parent_path().filename().string();
-  options.sbatch_path = (fs::path(scene_file).parent_path() / "sweep.sbatch").string();
+  // `geomint slurm --out DIR` writes its scripts into DIR, else next to the scene.
+  const fs::path sbatch_in_dir = fs::path(cli.dir) / "sweep.sbatch";
+  options.sbatch_path = fs::exists(sbatch_in_dir)
+                            ? sbatch_in_dir.string()
+                            : (fs::path(scene_file).parent_path() / "sweep.sbatch").string();
+  // The command to merge again must find the scene as this one did.
+  options.merge_command = fmt::format("{} merge {}", context.program, shell_quoted(cli.dir));
+  if (!cli.scene.empty()) options.merge_command += " --scene " + shell_quoted(cli.scene);
   check_output_dir(cli.dir, "scene_dir");
   const SceneUnits units = scene_units(scene);
   std::vector<std::string> merged = {"table.md", "hosts.csv"};

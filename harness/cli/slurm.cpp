@@ -17,7 +17,7 @@ namespace geomint::cli {
 namespace {
 
 struct SlurmCliOptions {
-  std::string scene, partition, time;
+  std::string scene, partition, time, out;
   int shards = 0, max_parallel = 0;
   bool submit = false, quick = false;
 };
@@ -37,7 +37,12 @@ int run_slurm(const SlurmCliOptions& cli, const Context& context) {
   options.partition = cli.partition;
   options.time_limit = cli.time;
   options.geomint_path = std::filesystem::canonical("/proc/self/exe").string();
-  check_output_dir(std::filesystem::absolute(cli.scene).parent_path().string(), "scene folder");
+  options.out_dir = cli.out;
+  if (cli.out.empty()) {
+    check_output_dir(std::filesystem::absolute(cli.scene).parent_path().string(), "scene folder");
+  } else {
+    check_output_dir(cli.out, "--out");
+  }
   const auto scripts = write_slurm_scripts(options);
   for (const auto& path : scripts) fmt::print("{}\n", path);
   if (cli.submit) {
@@ -66,6 +71,9 @@ Verb add_slurm(CLI::App& app) {
   command->add_option("--partition", options->partition, "Slurm partition");
   command->add_option("--time", options->time,
                       "time limit of each job (Slurm format, e.g. 1:00:00)");
+  command->add_option("--out", options->out,
+                      "folder of the scripts, shards, logs and merged tables (default: scripts "
+                      "next to the scene, results in its folder or <folder>/quick)");
   command->add_flag("--quick", options->quick,
                     "the scene's CI-sized variant (into <folder>/quick)");
   command->add_flag("--submit", options->submit,
