@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `make test-cluster` (docs/CLUSTER.md "Running on a cluster", issue 16): a real single-node Slurm on this
 # machine runs a committed scene through `geomint slurm --submit` with 8 shards, and the merged,
-# timed tables must equal a single-machine sweep (timings and dates aside); then one shard is
-# made to fail, resubmitted alone from merge's message, and the tables are checked again.
+# timed tables must equal a single-machine sweep (timings and dates aside); then, into a folder
+# of its own (`--out`), one shard is made to fail, resubmitted alone and merged with the commands
+# merge's message prints, and the tables are checked again.
 # Needs root (it installs the Debian packages and starts munged, slurmctld and slurmd, every one
 # stopped by PID on exit). Usage: test-cluster.sh [GEOMINT_BINARY] [SCENE_NAME]
 set -euo pipefail
@@ -123,7 +124,7 @@ submitted_ids() { sed -n 's/.* as job \([0-9]*\)$/\1/p' "$1" | tr '\n' ' '; }
 
 # The merged and timed tables against the single-machine ones: equal but for timings and dates.
 compare_tables() {
-  /usr/bin/python3 - "$work/local" "$out" <<'EOF'
+  /usr/bin/python3 - "${1:-$work/local}" "$out" <<'EOF'
 import csv, io, sys
 # Machine-dependent: the timing columns (wall_s and its statistics wall_s_min, wall_s_iqr,
 # wall_s_repeats) and the dates (provenance, and the "How to cite" block of table.md).
@@ -173,24 +174,38 @@ compare_tables || fail "cycle 1 tables"
 grep -q '^# command: geomint sweep .* --quick$' "$out/summary.csv" || fail "command line"
 say "cycle of $shards shards + merge + timing: ${cycle} s; merged tables equal the local sweep"
 
-# 2. One shard fails (as a crashed node would): merge refuses, naming it; resubmit only it.
+# 2. One shard fails (as a crashed node would), into a folder of its own (`--out`, outside the
+# scene's folder): merge refuses, naming it; its printed commands, run as printed, resubmit only
+# that shard and merge again.
+out="$work/out"
+"$geomint" sweep "$scene" --quick --out "$out" 2> /dev/null  # the command this merge names
+mkdir -p "$work/local_out"
+cp "$out"/*.csv "$out/table.md" "$work/local_out/"
 rm -rf "$out"
-GEOMINT_FAIL_SHARD=3 "$geomint" slurm "$scene" --quick --shards $shards --submit > /dev/null \
-  2> "$work/submit2.txt"
+scene_files=$(cd "$(dirname "$scene")" && find . -type f | sort | xargs md5sum)
+GEOMINT_FAIL_SHARD=3 "$geomint" slurm "$scene" --quick --shards $shards --out "$out" --submit \
+  > /dev/null 2> "$work/submit2.txt"
 read -r -a jobs <<< "$(submitted_ids "$work/submit2.txt")"
 wait_jobs "${jobs[@]}" > /dev/null
+[ "$(cd "$(dirname "$scene")" && find . -type f | sort | xargs md5sum)" = "$scene_files" ] ||
+  fail "slurm --out wrote into the scene's folder"
 status=0
-"$geomint" merge "$out" 2> "$work/merge.txt" || status=$?
+"$geomint" merge "$out" --scene "$scene" 2> "$work/merge.txt" || status=$?
 [ $status -eq 1 ] || fail "merge with shard 3 missing exited $status, not 1"
 grep -q 'shard 3/8: summary.3-of-8.csv is missing' "$work/merge.txt" || fail "merge did not name shard 3"
 resubmit=$(grep -o 'sbatch --array=[0-9,]* [^ ]*sweep.sbatch' "$work/merge.txt")
-[ "$resubmit" = "sbatch --array=3 $(dirname "$scene")/sweep.sbatch" ] || fail "resubmission: $resubmit"
+[ "$resubmit" = "sbatch --array=3 $out/sweep.sbatch" ] || fail "resubmission: $resubmit"
+merge_again=$(sed -n 's/^then merge again: //p' "$work/merge.txt")
 say "merge refused as it should: $(head -n 2 "$work/merge.txt" | tail -n 1 | sed 's/^ *//')"
 sweep_job=$(${resubmit/sbatch/sbatch --parsable})
-merge_job=$(sbatch --parsable --dependency=afterok:"$sweep_job" "$(dirname "$scene")/merge.sbatch")
-timing_job=$(sbatch --parsable --dependency=afterok:"$merge_job" "$(dirname "$scene")/timing.sbatch")
-states=$(wait_jobs "$sweep_job" "$merge_job" "$timing_job")
-all_completed $states || fail "resubmitted jobs ended: $(echo $states)"
-compare_tables || fail "tables after the resubmission"
-say "resubmitted shard 3 alone; merged tables equal the local sweep again"
+states=$(wait_jobs "$sweep_job")
+all_completed $states || fail "resubmitted shard ended: $(echo $states)"
+geomint() { "$geomint" "$@"; }
+eval "$merge_again" 2> "$work/merge_again.txt" || fail "'$merge_again' failed: $(cat "$work/merge_again.txt")"
+timing_job=$(sbatch --parsable "$out/timing.sbatch")
+states=$(wait_jobs "$timing_job")
+all_completed $states || fail "timing job ended: $(echo $states)"
+compare_tables "$work/local_out" || fail "tables after the resubmission"
+grep -q '^# command: geomint sweep .* --quick --out .*$' "$out/summary.csv" || fail "command line"
+say "resubmitted shard 3 alone, merged as merge printed; tables in --out equal the local sweep"
 say "passed in $(($(date +%s) - start)) s (the 8-shard cycle: ${cycle} s)"
