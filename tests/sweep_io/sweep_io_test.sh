@@ -26,20 +26,19 @@ cd "$work"
 scene="$work/scene/scene.toml"
 out="$work/out"
 
-# A scene of two runs (two units, so two shards) with series; `steps` sets how long each runs.
+# A scene of two runs (two units, so two shards) with series: unit 0 (block a) runs to t = $1,
+# unit 1 (block b) to t = $2 (default $1), so shard 1/2 can end while shard 0/2 still runs; $3
+# is timing_repeats (default 0).
 write_scene() {
-  cat > "$scene" <<EOF
-title = "sweep io"
-[[runs]]
-label = "a"
-problems = ["pendulum"]
-methods = ["stormer_verlet", "symplectic_euler_a"]
-dt = 1e-4
-t_end = $1
-series_every = 1000
-timing_repeats = ${2:-0}
-max_steps = 1000000000
-EOF
+  echo 'title = "sweep io"' > "$scene"
+  local label method t_end
+  for block in "a stormer_verlet $1" "b symplectic_euler_a ${2:-$1}"; do
+    read -r label method t_end <<< "$block"
+    printf '[[runs]]\nlabel = "%s"\nproblems = ["pendulum"]\nmethods = ["%s"]\ndt = 1e-4\n' \
+      "$label" "$method" >> "$scene"
+    printf 't_end = %s\nseries_every = 1000\ntiming_repeats = %s\nmax_steps = 1000000000\n' \
+      "$t_end" "${3:-0}" >> "$scene"
+  done
 }
 # Waits (10 s at most) until a file matching the glob pattern exists.
 wait_for() {
@@ -56,7 +55,7 @@ namespaces)
   # Two shards into one folder from two PID namespaces, as from two nodes of a shared file system:
   # each namespace numbers its processes from 1, so a PID of one says nothing in the other.
   unshare --pid --fork --mount-proc true 2> /dev/null || { say "skipped: unshare not permitted"; exit 77; }
-  write_scene 400
+  write_scene 1000 1
   # Shard A's geomint gets PID ~10 in its namespace (processes started before it), shard B's 2:
   # A's PID is not alive in B's namespace.
   in_namespace() {
@@ -71,18 +70,19 @@ namespaces)
   pids+=($a)
   wait_for "$out/series/a/stormer_verlet.csv.*.tmp"
   in_namespace 0 --shard 1/2 2> "$tmp/b.log" || fail "shard B exited $?: $(cat "$tmp/b.log")"
+  kill -0 $a 2> /dev/null || fail "shard A ended before shard B: the shards did not overlap"
   wait $a || fail "shard A exited $?: $(cat "$tmp/a.log")"
   "$geomint" merge "$out" --scene "$scene" 2> "$tmp/merge.log" || fail "merge: $(cat "$tmp/merge.log")"
-  for method in stormer_verlet symplectic_euler_a; do
-    [ -s "$out/series/a/$method.csv" ] || fail "the series of $method is lost: $(ls "$out/series/a")"
+  for series in a/stormer_verlet b/symplectic_euler_a; do
+    [ -s "$out/series/$series.csv" ] || fail "the series $series is lost: $(ls -R "$out/series")"
   done
   if grep -q ',error,' "$out/summary.csv"; then fail "error rows: $(grep ',error,' "$out/summary.csv")"; fi
   [ "$(grep -c ',ok,' "$out/summary.csv")" = 2 ] || fail "summary: $(cat "$out/summary.csv")"
-  ! compgen -G "$out/series/a/*.tmp" > /dev/null || fail "temporaries left"
+  ! compgen -G "$out/series/*/*.tmp" > /dev/null || fail "temporaries left"
   say "both shards' series survived and merged"
   ;;
 lock)
-  write_scene 300
+  write_scene 1000 1
   # A sweep holds the folder: a second sweep, and a shard, are refused at once naming it.
   "$geomint" sweep "$scene" --out "$out" --no-timing 2> "$tmp/a.log" &
   a=$!
@@ -107,11 +107,10 @@ lock)
   wait_for "$out/series/a/*.tmp"
   timeout 60 "$geomint" sweep "$scene" --out "$out" --shard 1/2 2> "$tmp/e.log" ||
     fail "a second shard was refused: $(cat "$tmp/e.log")"
+  kill -0 $d 2> /dev/null || fail "shard 0/2 ended before shard 1/2: the shards did not overlap"
   status=0
   timeout 20 "$geomint" merge "$out" --scene "$scene" 2> "$tmp/f.log" || status=$?
-  if kill -0 $d 2> /dev/null; then
-    [ $status = 2 ] || fail "a merge while a shard runs exited $status, not 2: $(cat "$tmp/f.log")"
-  fi
+  [ $status = 2 ] || fail "a merge while a shard runs exited $status, not 2: $(cat "$tmp/f.log")"
   wait $d || fail "shard 0/2 exited $?: $(cat "$tmp/d.log")"
   "$geomint" merge "$out" --scene "$scene" 2> "$tmp/g.log" || fail "merge: $(cat "$tmp/g.log")"
   say "a second sweep was refused naming the first; shards shared the folder"
@@ -140,7 +139,7 @@ merge_again)
 slurm_out)
   # geomint slurm --out: the scripts, shards, logs and tables all in the folder; run here
   # without Slurm (the array index from SLURM_ARRAY_TASK_ID, srun replaced by a pass-through).
-  write_scene 1 1
+  write_scene 1 1 1
   "$geomint" slurm "$scene" --shards 2 --out "$out" > "$tmp/printed.txt" 2> "$tmp/slurm.log" ||
     fail "geomint slurm --out exited $?: $(cat "$tmp/slurm.log")"
   printf '%s\n' "$out/sweep.sbatch" "$out/merge.sbatch" "$out/timing.sbatch" |
