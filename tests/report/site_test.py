@@ -468,7 +468,11 @@ def browser(geomint, source, work):
                  ".narrative table")]:
             shot = work / f"screenshot_{name}.png"
             shot.unlink(missing_ok=True)
-            browser.screenshot(page.as_uri(), shot, scroll_to)
+            try:
+                browser.screenshot(page.as_uri(), shot, scroll_to)
+            except RuntimeError as error:  # e.g. no narrative table on the page
+                problems.append(f"no screenshot of {page}: {error}")
+                continue
             if not shot.is_file():
                 problems.append(f"no screenshot of {page} at {shot}")
                 continue
