@@ -28,6 +28,7 @@ write_basic_package_version_file(${CMAKE_BINARY_DIR}/geomintConfigVersion.cmake
 install(FILES ${CMAKE_BINARY_DIR}/geomintConfig.cmake ${CMAKE_BINARY_DIR}/geomintConfigVersion.cmake
               ${CMAKE_SOURCE_DIR}/cmake/FindCHOLMOD.cmake
               ${CMAKE_SOURCE_DIR}/cmake/FindHYPRE.cmake
+              ${CMAKE_SOURCE_DIR}/cmake/FindCMarkGFM.cmake
         DESTINATION ${GEOMINT_CMAKE_DIR})
 # The licence (GPL-3.0-or-later, the build links GSL) and the citation file travel with the package.
 install(FILES ${CMAKE_SOURCE_DIR}/LICENSE ${CMAKE_SOURCE_DIR}/CITATION.cff

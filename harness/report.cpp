@@ -54,8 +54,13 @@ td.claim { white-space: normal; min-width: 30em; }
 tbody tr:nth-child(even) { background: #fafafa; }
 .pass { color: #176317; } .fail { color: #a51d1d; font-weight: bold; } .none { color: #666; }
 ul.gates { list-style: none; padding-left: 0.5em; }
-figure { display: inline-block; margin: 0.5em; vertical-align: top; }
-figure img { max-width: 36em; width: 100%; border: 1px solid #ddd; }
+.narrative td, .narrative th { white-space: normal; }
+.narrative table { margin: 0.5em 0; }
+figure { display: inline-block; width: 48%; margin: 0.5em 0.5%; vertical-align: top; }
+figure.wide { display: block; width: auto; margin: 1em 0; }
+figure img { width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #333; }
+.measured { color: #444; font-size: 0.95em; }
 dl.provenance dt { font-weight: bold; float: left; clear: left; width: 7em; }
 dl.provenance dd { margin-left: 8em; }
 footer { margin-top: 3em; color: #666; font-size: 0.85em; }
@@ -69,8 +74,19 @@ std::string read_text(const fs::path& path) {
   return text.str();
 }
 
-bool starts_with(const std::string& text, const std::string& prefix) {
-  return text.compare(0, prefix.size(), prefix) == 0;
+// A link target that is not a relative path: an anchor, or a URL with a scheme (https:, mailto:,
+// and javascript:, which cmark-gfm's safe mode then drops).
+bool is_absolute_link(const std::string& target) {
+  if (target.empty() || target[0] == '#') return true;
+  const size_t colon = target.find(':');
+  if (colon == std::string::npos || colon == 0) return false;
+  for (size_t k = 0; k < colon; ++k) {
+    const char c = target[k];
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '+' && c != '-' && c != '.') {
+      return false;
+    }
+  }
+  return std::isalpha(static_cast<unsigned char>(target[0])) != 0;
 }
 
 // The path a URL names: %XX escapes decoded (a README writes `a%20b.md` for `a b.md`); a `%` not
@@ -121,57 +137,6 @@ std::string shorten_number(const std::string& text) {
   return fmt::format("{:.6g}", value);
 }
 
-// Inline Markdown on one paragraph's text: `code`, **bold**, [text](url), ![alt](image); the rest
-// escaped.
-std::string inline_markdown(const std::string& text,
-                            const std::function<std::string(const std::string&)>& link) {
-  std::string out;
-  size_t k = 0;
-  while (k < text.size()) {
-    if (text[k] == '`') {
-      const size_t close = text.find('`', k + 1);
-      if (close != std::string::npos) {
-        out += "<code>" + html_escape(text.substr(k + 1, close - k - 1)) + "</code>";
-        k = close + 1;
-        continue;
-      }
-    }
-    if (text.compare(k, 2, "**") == 0) {
-      const size_t close = text.find("**", k + 2);
-      if (close != std::string::npos && close > k + 2) {
-        out += "<strong>" + inline_markdown(text.substr(k + 2, close - k - 2), link) + "</strong>";
-        k = close + 2;
-        continue;
-      }
-    }
-    if (text.compare(k, 2, "![") == 0) {
-      const size_t close = text.find("](", k + 2);
-      const size_t end = close == std::string::npos ? close : text.find(')', close + 2);
-      if (end != std::string::npos && text.find('\n', k) > end) {
-        const std::string target = text.substr(close + 2, end - close - 2);
-        out += "<img src=\"" + html_escape(link ? link(target) : target) + "\" alt=\"" +
-               html_escape(text.substr(k + 2, close - k - 2)) + "\">";
-        k = end + 1;
-        continue;
-      }
-    }
-    if (text[k] == '[') {
-      const size_t close = text.find("](", k + 1);
-      const size_t end = close == std::string::npos ? close : text.find(')', close + 2);
-      if (end != std::string::npos && text.find('\n', k) > end) {
-        const std::string target = text.substr(close + 2, end - close - 2);
-        out += "<a href=\"" + html_escape(link ? link(target) : target) + "\">" +
-               inline_markdown(text.substr(k + 1, close - k - 1), link) + "</a>";
-        k = end + 1;
-        continue;
-      }
-    }
-    out += html_escape(std::string(1, text[k]));
-    ++k;
-  }
-  return out;
-}
-
 // The version and SHA of a `# geomint: 0.1.0 (b9e01576494f)` provenance line.
 std::pair<std::string, std::string> version_and_sha(const std::string& line) {
   const size_t open = line.find(" (");
@@ -179,14 +144,23 @@ std::pair<std::string, std::string> version_and_sha(const std::string& line) {
   return {line.substr(0, open), line.substr(open + 2, line.size() - open - 3)};
 }
 
+// A figure as the page shows it: the file shown (SVG over PNG), its caption from figures.toml
+// ("" when it has none) and whether it spans the page.
+struct PageFigure {
+  std::string file, caption;
+  bool wide = false;
+};
+
 struct ScenePage {
   std::string name, title, headline;
-  fs::path source;                       // results/<scene>/ (or its quick/ folder)
-  std::vector<CsvTable> tables;          // in page order
-  std::vector<std::string> images;       // figures shown on the page (SVG over PNG)
-  std::vector<std::string> image_files;  // every PNG and SVG of the folder, copied next to it
+  std::string claim_html, measured_html;  // the README's headline row ("" when it has none)
+  fs::path source;                        // results/<scene>/ (or its quick/ folder)
+  std::vector<CsvTable> tables;           // in page order
+  std::vector<PageFigure> figures;        // in figures.toml's order, then the uncaptioned ones
+  std::vector<std::string> image_files;   // every PNG and SVG of the folder, copied next to it
   std::vector<GateOutcome> outcomes;
   std::string narrative_html;
+  std::string table_md_html;  // table.md rendered, written as table.html ("" without table.md)
   int passed = 0, failed = 0;
   // Why the tables are not of the scene.toml beside them ("" when they are, or unknown): set
   // when table.md's recorded scene hash differs from the file's (published variant only; the
@@ -272,14 +246,24 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
   if (!page.stale.empty()) {
     html += "<p class=\"fail\">Stale tables: " + html_escape(page.stale) + "</p>\n";
   }
-  html += page.narrative_html;
-  if (!page.images.empty()) {
+  if (!page.narrative_html.empty()) {
+    html += "<div class=\"narrative\">\n" + page.narrative_html + "</div>\n";
+  }
+  if (!page.table_md_html.empty()) {
+    html += "<p>The scene's Markdown table: <a href=\"table.html\">table.md</a>.</p>\n";
+  }
+  if (!page.figures.empty()) {
     html += "<h2>Figures</h2>\n";
-    for (const auto& image : page.images) {
+    for (const auto& figure : page.figures) {
+      // Each figure links to its full-size file; an uncaptioned one (no figures.toml entry)
+      // gets no <figcaption>, which the site test reports.
       html += fmt::format(
-          "<figure><img src=\"{1}\" alt=\"{0}\"><figcaption>{0}</figcaption>"
-          "</figure>\n",
-          html_escape(image), html_escape(url_path(image)));
+          "<figure{0}><a href=\"{1}\"><img src=\"{1}\" alt=\"{2}\"></a>{3}</figure>\n",
+          figure.wide ? " class=\"wide\"" : "", html_escape(url_path(figure.file)),
+          html_escape(figure.caption.empty() ? figure.file : markdown_plain_text(figure.caption)),
+          figure.caption.empty()
+              ? std::string()
+              : "<figcaption>" + markdown_inline_html(figure.caption) + "</figcaption>");
     }
   }
   if (page.tables.empty()) {
@@ -324,6 +308,17 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
   return html + "</main>\n" + footer(options, generator);
 }
 
+// table.md as the site shows it: the scene's Markdown tables (table.html next to the page).
+std::string table_md_page_html(const ScenePage& page, const ReportOptions& options,
+                               const std::string& generator) {
+  std::string html = page_head(page.title + ": table.md", "../style.css");
+  html += fmt::format(
+      "<nav><a href=\"../index.html\">All scenes</a> &gt; <a href=\"index.html\">{}</a></nav>\n"
+      "<main>\n<h1>{}: table.md</h1>\n<div class=\"narrative\">\n",
+      html_escape(page.name), html_escape(page.title));
+  return html + page.table_md_html + "</div>\n</main>\n" + footer(options, generator);
+}
+
 std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions& options,
                        const std::string& generator) {
   std::string html = page_head("geomint results", "style.css");
@@ -351,12 +346,21 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
                           page.failed ? "FAIL" : "PASS", page.passed, page.passed + page.failed);
     }
     if (!page.stale.empty()) gates += " <span class=\"fail\">STALE</span>";
+    // The README's headline claim and its measured number; without one, the description's
+    // first sentence.
+    const std::string claim =
+        page.claim_html.empty()
+            ? html_escape(page.headline)
+            : page.claim_html + (page.measured_html.empty()
+                                     ? std::string()
+                                     : "<br><span class=\"measured\">Measured: " +
+                                           page.measured_html + "</span>");
     html += fmt::format(
         "<tr><td><a href=\"{5}/index.html\">{0}</a></td><td "
         "class=\"claim\"><strong>{1}</strong><br>{2}</td>"
         "<td>{3}</td><td>{4}</td></tr>\n",
-        html_escape(page.name), html_escape(page.title), html_escape(page.headline), gates,
-        page.tables.size(), html_escape(url_path(page.name)));
+        html_escape(page.name), html_escape(page.title), claim, gates, page.tables.size(),
+        html_escape(url_path(page.name)));
   }
   html += "</tbody>\n</table></div>\n";
   html +=
@@ -369,13 +373,14 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
 
 // A relative link of a scene README, seen from the page: files the site copies stay as they
 // are; anything else points back into the results folder, relative to the page.
+// The scene's table.md, rendered by the site as table.html next to the page, is linked there.
 std::string rewrite_link(const std::string& target, const fs::path& scene_dir,
-                         const fs::path& page_dir) {
-  if (target.empty() || target[0] == '#' || target.find("://") != std::string::npos ||
-      starts_with(target, "mailto:")) {
-    return target;
-  }
+                         const fs::path& page_dir, bool table_md_rendered) {
+  if (is_absolute_link(target)) return target;
   const std::string file = target.substr(0, target.find('#'));
+  if (table_md_rendered && (file == "table.md" || file == "./table.md")) {
+    return "table.html" + target.substr(file.size());
+  }
   const std::string ext = fs::path(file).extension().string();
   if (file.find('/') == std::string::npos && (ext == ".csv" || ext == ".png" || ext == ".svg")) {
     return target;
@@ -389,7 +394,8 @@ std::string rewrite_link(const std::string& target, const fs::path& scene_dir,
 }
 
 ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
-                          const std::vector<Gate>& gates, const fs::path& final_out) {
+                          const std::vector<Gate>& gates, const fs::path& final_out,
+                          const std::map<std::string, HeadlineClaim>& claims) {
   ScenePage page;
   page.name = folder.filename().string();
   const fs::path scene_file = folder / "scene.toml";
@@ -399,6 +405,10 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
   page.title = scene["title"].value_or(page.name);
   description = scene["description"].value_or(std::string());
   page.headline = first_sentence(description);
+  if (const auto claim = claims.find(page.name); claim != claims.end()) {
+    page.claim_html = claim->second.claim_html;
+    page.measured_html = claim->second.measured_html;
+  }
   page.source = options.quick ? folder / "quick" : folder;
   // A symbolic link would publish whatever it points to (any file of the machine) as a result
   // of the scene: links are left out, with a note.
@@ -410,31 +420,32 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
     return true;
   };
   std::vector<fs::path> csvs;
+  std::vector<std::string> images;  // figures shown on the page (SVG over PNG)
   if (!skip_link(page.source) && fs::is_directory(page.source)) {
     for (const auto& entry : fs::directory_iterator(page.source)) {
       const std::string ext = entry.path().extension().string();
       if ((ext == ".csv" || ext == ".png" || ext == ".svg") && skip_link(entry.path())) continue;
       if (!entry.is_regular_file()) continue;
       if (ext == ".csv") csvs.push_back(entry.path());
-      if (ext == ".png" || ext == ".svg") page.images.push_back(entry.path().filename().string());
+      if (ext == ".png" || ext == ".svg") images.push_back(entry.path().filename().string());
     }
     std::sort(csvs.begin(), csvs.end(), [](const fs::path& a, const fs::path& b) {
       const int ra = table_rank(a.stem().string()), rb = table_rank(b.stem().string());
       return ra != rb ? ra < rb : a.filename() < b.filename();
     });
     // A figure drawn as both PNG and SVG is shown once, as SVG (sharp at any zoom).
-    std::sort(page.images.begin(), page.images.end());
-    page.image_files = page.images;  // README.md may link either form
+    std::sort(images.begin(), images.end());
+    page.image_files = images;  // README.md may link either form
     const std::vector<std::string>& all_images = page.image_files;
-    page.images.erase(std::remove_if(page.images.begin(), page.images.end(),
-                                     [&all_images](const std::string& image) {
-                                       const fs::path path(image);
-                                       if (path.extension() != ".png") return false;
-                                       const std::string svg = path.stem().string() + ".svg";
-                                       return std::binary_search(all_images.begin(),
-                                                                 all_images.end(), svg);
-                                     }),
-                      page.images.end());
+    images.erase(std::remove_if(images.begin(), images.end(),
+                                [&all_images](const std::string& image) {
+                                  const fs::path path(image);
+                                  if (path.extension() != ".png") return false;
+                                  const std::string svg = path.stem().string() + ".svg";
+                                  return std::binary_search(all_images.begin(), all_images.end(),
+                                                            svg);
+                                }),
+                 images.end());
     for (const auto& csv : csvs) page.tables.push_back(read_csv_file(csv.string()));
   }
   if (!page.tables.empty() && !gates.empty()) {
@@ -469,12 +480,34 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
           recorded, current, page.name);
     }
   }
-  const fs::path readme = folder / "README.md";
+  // Captioned figures in figures.toml's order, then any figure it does not list.
+  const std::vector<FigureCaption> captions =
+      images.empty() ? std::vector<FigureCaption>{} : read_figure_captions(folder.string());
+  for (const auto& caption : captions) {
+    const std::string stem = fs::path(caption.file).stem().string();
+    for (auto image = images.begin(); image != images.end(); ++image) {
+      if (fs::path(*image).stem().string() != stem) continue;
+      page.figures.push_back({*image, caption.caption, caption.wide});
+      images.erase(image);
+      break;
+    }
+  }
+  for (const auto& image : images) page.figures.push_back({image, "", false});
+
   const fs::path page_dir = final_out / page.name;
-  if (fs::exists(readme) && !skip_link(readme)) {
-    page.narrative_html = markdown_to_html(read_text(readme), [&](const std::string& target) {
-      return rewrite_link(target, folder, page_dir);
+  const fs::path source_table_md = page.source / "table.md";
+  const bool render_table_md = fs::is_regular_file(source_table_md) && !skip_link(source_table_md);
+  const auto link = [&](const std::string& target) {
+    return rewrite_link(target, folder, page_dir, render_table_md);
+  };
+  if (render_table_md) {
+    page.table_md_html = markdown_to_html(read_text(source_table_md), [&](const std::string& t) {
+      return rewrite_link(t, page.source, page_dir, true);
     });
+  }
+  const fs::path readme = folder / "README.md";
+  if (fs::exists(readme) && !skip_link(readme)) {
+    page.narrative_html = markdown_to_html(read_text(readme), link);
   } else if (!description.empty()) {
     page.narrative_html = markdown_to_html(description);
   }
@@ -634,76 +667,6 @@ std::string table_citation(const CsvTable& table, const std::string& scene,
   return text;
 }
 
-std::string markdown_to_html(const std::string& markdown,
-                             const std::function<std::string(const std::string&)>& link) {
-  std::vector<std::string> lines;
-  std::istringstream in(markdown);
-  for (std::string line; std::getline(in, line);) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    lines.push_back(line);
-  }
-  std::string html, paragraph, list_tag;
-  std::vector<std::string> items;
-  const auto flush = [&] {
-    if (!paragraph.empty()) html += "<p>" + inline_markdown(paragraph, link) + "</p>\n";
-    paragraph.clear();
-    if (!items.empty()) {
-      html += "<" + list_tag + ">\n";
-      for (const auto& item : items) html += "<li>" + inline_markdown(item, link) + "</li>\n";
-      html += "</" + list_tag + ">\n";
-    }
-    items.clear();
-  };
-  const auto trimmed = [](const std::string& s) {
-    const size_t a = s.find_first_not_of(" \t");
-    return a == std::string::npos ? std::string() : s.substr(a);
-  };
-  for (size_t k = 0; k < lines.size(); ++k) {
-    const std::string line = trimmed(lines[k]);
-    if (starts_with(line, "```")) {
-      flush();
-      std::string code;
-      for (++k; k < lines.size() && !starts_with(trimmed(lines[k]), "```"); ++k) {
-        code += lines[k] + "\n";
-      }
-      html += "<pre><code>" + html_escape(code) + "</code></pre>\n";
-      continue;
-    }
-    if (line.empty()) {
-      flush();
-      continue;
-    }
-    const size_t hashes = line.find_first_not_of('#');
-    if (hashes >= 1 && hashes <= 6 && hashes != std::string::npos && line[hashes] == ' ') {
-      flush();
-      // The page's own <h1> is the scene title: the README's levels move one down.
-      const size_t level = std::min<size_t>(hashes + 1, 6);
-      html += fmt::format("<h{0}>{1}</h{0}>\n", level,
-                          inline_markdown(trimmed(line.substr(hashes)), link));
-      continue;
-    }
-    const bool bullet = starts_with(line, "- ") || starts_with(line, "* ");
-    const size_t digits = line.find_first_not_of("0123456789");
-    const bool numbered =
-        digits > 0 && digits != std::string::npos && line.compare(digits, 2, ". ") == 0;
-    if (bullet || numbered) {
-      const std::string tag = bullet ? "ul" : "ol";
-      if (!paragraph.empty() || (!items.empty() && tag != list_tag)) flush();
-      list_tag = tag;
-      items.push_back(trimmed(line.substr(bullet ? 2 : digits + 2)));
-      continue;
-    }
-    if (!items.empty() && lines[k][0] == ' ') {  // an indented continuation of the item
-      items.back() += " " + line;
-      continue;
-    }
-    if (!items.empty()) flush();
-    paragraph += (paragraph.empty() ? "" : "\n") + line;
-  }
-  flush();
-  return html;
-}
-
 std::string csv_table_html(const CsvTable& table, const std::string& file_name) {
   const std::vector<Row> rows = rows_with_short_specs(table.rows);
   std::string html =
@@ -765,8 +728,29 @@ ReportSummary write_report(const ReportOptions& given) {
         fmt::format("report: --results '{}' holds no scene (no <scene>/scene.toml folder in it)",
                     options.results_dir));
   }
+  // The index's claims: the README's `claim | measured | scene` table, links relative to the
+  // index page.
+  const fs::path claims_path =
+      options.claims_path.empty()
+          ? fs::weakly_canonical(fs::absolute(results)).parent_path() / "README.md"
+          : fs::path(options.claims_path);
+  std::map<std::string, HeadlineClaim> claims;
+  if (fs::exists(claims_path) || !options.claims_path.empty()) {
+    const fs::path claims_dir = claims_path.parent_path();
+    claims = headline_claims(read_text(claims_path), [&](const std::string& target) {
+      if (is_absolute_link(target)) return target;
+      const std::string file = target.substr(0, target.find('#'));
+      return url_path(
+                 fs::relative(fs::weakly_canonical(fs::absolute(claims_dir / url_decoded(file))),
+                              fs::weakly_canonical(out))
+                     .generic_string()) +
+             target.substr(file.size());
+    });
+  }
   std::vector<ScenePage> pages;
-  for (const auto& folder : folders) pages.push_back(load_scene_page(folder, options, gates, out));
+  for (const auto& folder : folders) {
+    pages.push_back(load_scene_page(folder, options, gates, out, claims));
+  }
   if (options.quick && std::all_of(pages.begin(), pages.end(),
                                    [](const ScenePage& page) { return page.tables.empty(); })) {
     throw InputError(fmt::format(
@@ -792,6 +776,12 @@ ReportSummary write_report(const ReportOptions& given) {
       const fs::path dir = partial / page.name;
       fs::create_directories(dir);
       write_text(dir / "index.html", scene_page_html(page, options, generator));
+      if (!page.table_md_html.empty()) {
+        write_text(dir / "table.html", table_md_page_html(page, options, generator));
+      }
+      for (const auto& figure : page.figures) {
+        if (figure.caption.empty()) ++summary.uncaptioned_figures;
+      }
       for (const auto& table : page.tables) {
         fs::copy_file(table.path, dir / fs::path(table.path).filename());
       }

@@ -1,6 +1,7 @@
 // Tests of the results site writer (harness/report.hpp, docs/REPORT.md): golden pages built from
-// the fixture scenes of tests/report/results/, escaping, the Markdown subset, gate verdicts and
-// the replace-only-our-own-site rule. GEOMINT_UPDATE_GOLDEN=1 rewrites the golden files.
+// the fixture scenes of tests/report/results/, escaping, CommonMark with GitHub tables, figure
+// captions, the index's claims, gate verdicts and the replace-only-our-own-site rule.
+// GEOMINT_UPDATE_GOLDEN=1 rewrites the golden files.
 #include "harness/report.hpp"
 
 #include <gtest/gtest.h>
@@ -119,15 +120,181 @@ TEST(ReportHtml, EscapesEveryMarkupCharacter) {
             "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;");
 }
 
-TEST(ReportHtml, RendersTheMarkdownSubset) {
+TEST(ReportHtml, RendersCommonMark) {
   EXPECT_EQ(markdown_to_html("# T\n\npara `a<b>` and [l](u.csv)\n\n- x\n- y\n"),
             "<h2>T</h2>\n<p>para <code>a&lt;b&gt;</code> and <a href=\"u.csv\">l</a></p>\n"
             "<ul>\n<li>x</li>\n<li>y</li>\n</ul>\n");
   EXPECT_EQ(markdown_to_html("```\n<x>\n```\n"), "<pre><code>&lt;x&gt;\n</code></pre>\n");
-  EXPECT_EQ(markdown_to_html("2. b\n10. c\n"), "<ol>\n<li>b</li>\n<li>c</li>\n</ol>\n");
-  // An image, not "!" and a link.
+  EXPECT_EQ(markdown_to_html("2. b\n3. c\n"), "<ol start=\"2\">\n<li>b</li>\n<li>c</li>\n</ol>\n");
   EXPECT_EQ(markdown_to_html("see ![a<b](f.png) now\n"),
-            "<p>see <img src=\"f.png\" alt=\"a&lt;b\"> now</p>\n");
+            "<p>see <img src=\"f.png\" alt=\"a&lt;b\" /> now</p>\n");
+  // Emphasis, strikethrough and autolinks (the hand-written subset printed the first as text).
+  EXPECT_EQ(markdown_to_html("*e* **s** ~~x~~ https://a.org\n"),
+            "<p><em>e</em> <strong>s</strong> <del>x</del> <a "
+            "href=\"https://a.org\">https://a.org</a></p>\n");
+}
+
+// GitHub tables: one cell per Markdown cell, escaped pipes inside a cell, inline markup in cells.
+TEST(ReportHtml, RendersGfmTables) {
+  const std::string html =
+      markdown_to_html("| pair | formulation 1 |\n|---|:-:|\n| *a* | `x \\| y` |\n| b |\n");
+  EXPECT_NE(html.find("<table>"), std::string::npos) << html;
+  EXPECT_EQ(html.find("|---"), std::string::npos) << html;
+  size_t cells = 0;
+  for (const char* tag : {"<th>", "<th ", "<td>", "<td "}) {
+    for (size_t at = html.find(tag); at != std::string::npos; at = html.find(tag, at + 1)) ++cells;
+  }
+  EXPECT_EQ(cells, 6u) << html;  // a short row is padded to the header's two cells
+  EXPECT_NE(html.find("<td><em>a</em></td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<code>x | y</code>"), std::string::npos) << html;
+  // Alignment as a style attribute: HTML5 (and tidy) know no align attribute.
+  EXPECT_NE(html.find("<th style=\"text-align: center\">"), std::string::npos) << html;
+}
+
+// Raw HTML and javascript: URLs never reach the page (cmark-gfm's safe mode).
+TEST(ReportHtml, OmitsRawHtml) {
+  const std::string html =
+      markdown_to_html("<script>alert(1)</script>\n\nx <b onclick=\"y\">b</b> [l](javascript:z)\n");
+  EXPECT_EQ(html.find("<script"), std::string::npos) << html;
+  EXPECT_EQ(html.find("<b "), std::string::npos) << html;
+  EXPECT_EQ(html.find("javascript:"), std::string::npos) << html;
+  EXPECT_NE(html.find(" l</p>"), std::string::npos) << html;  // the link's text, no <a href="">
+}
+
+// Link targets are rewritten on the parsed document: links and images, in tables too, never the
+// text of a code span that looks like a link.
+TEST(ReportHtml, RewritesLinksOnTheDocument) {
+  const auto link = [](const std::string& target) { return "R/" + target; };
+  const std::string html = markdown_to_html(
+      "[a](x.md) ![i](f.png) `[c](y.md)`\n\n| t |\n|---|\n| [b](z.md) |\n\n[r]\n\n[r]: w.md\n",
+      link);
+  for (const char* rewritten : {"href=\"R/x.md\"", "src=\"R/f.png\"", "href=\"R/z.md\"",
+                                "href=\"R/w.md\"", "<code>[c](y.md)</code>"}) {
+    EXPECT_NE(html.find(rewritten), std::string::npos) << rewritten << " in " << html;
+  }
+}
+
+// The index's claims come from the README's `claim | measured | scene` table, whatever its column
+// order, extra columns or other tables; rows that name no scene are skipped; a row naming two
+// scenes gives both the same claim.
+TEST(ReportHtml, ReadsHeadlineClaimsFromTheReadmeTable) {
+  const std::string readme =
+      "# P\n\n| document | what |\n|---|---|\n| [a](results/x/README.md) | not a claim |\n\n"
+      "| Scene | extra | Measured | Claim |\n|---|---|---|---|\n"
+      "| [x](results/x/README.md) | - | 1.5e-3 at `h` | *x* keeps H \\| bounded |\n"
+      "| [docs](docs/A.md) | - | 2 | no scene |\n"
+      "| [y](results/y/README.md), [z](./results/z/) | - | 3 | shared |\n"
+      "| [x](results/x/) | - | 9 | a later row |\n";
+  const auto claims = headline_claims(readme);
+  ASSERT_EQ(claims.size(), 3u);
+  EXPECT_EQ(claims.at("x").claim_html, "<em>x</em> keeps H | bounded");
+  EXPECT_EQ(claims.at("x").measured_html, "1.5e-3 at <code>h</code>");
+  EXPECT_EQ(claims.at("y").claim_html, "shared");
+  EXPECT_EQ(claims.at("z").measured_html, "3");
+  // No such table, or one without a claim column: no claims.
+  EXPECT_TRUE(
+      headline_claims("| scene | measured |\n|---|---|\n| [x](results/x/) | 1 |\n").empty());
+  EXPECT_TRUE(headline_claims("no table\n").empty());
+  // A shortened table (a measured column cut away) still gives the claims.
+  EXPECT_EQ(headline_claims("| claim | scene |\n|---|---|\n| c 1 | [x](results/x/) |\n")
+                .at("x")
+                .measured_html,
+            "");
+}
+
+// figures.toml is validated as a whole: each mistake is an InputError naming the file and key.
+TEST_F(ReportTest, ValidatesFiguresToml) {
+  fs::copy_file(kFixture / "results" / "tiny" / "energy.png", dir_ / "energy.png");
+  const auto error_of = [&](const std::string& text) -> std::string {
+    std::ofstream(dir_ / "figures.toml") << text;
+    try {
+      read_figure_captions(dir_.string());
+    } catch (const InputError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  const std::string ok = "[[figure]]\nfile = \"energy.png\"\ncaption = \"What it shows.\"\n";
+  EXPECT_EQ(error_of(ok), "");
+  ASSERT_EQ(read_figure_captions(dir_.string()).size(), 1u);
+  EXPECT_FALSE(read_figure_captions(dir_.string())[0].wide);
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {ok + "colour = 1\n", "unknown key 'colour'"},
+           {"title = 1\n" + ok, "unknown key 'title'"},
+           {"[[figure]]\nfile = \"missing.png\"\ncaption = \"x\"\n",
+            "no such figure 'missing.png'"},
+           {"[[figure]]\nfile = \"energy.png\"\ncaption = \" \"\n", "key 'caption' is empty"},
+           {"[[figure]]\nfile = \"energy.png\"\n", "caption"},
+           {"[[figure]]\ncaption = \"x\"\n", "file"},
+           {"[[figure]]\nfile = \"../energy.png\"\ncaption = \"x\"\n", "key 'file' must name"},
+           {ok + ok, "listed twice"},
+           {"[[figure]\n", "malformed"}}) {
+    const std::string message = error_of(text);
+    EXPECT_NE(message.find(expected), std::string::npos) << text << " gave: " << message;
+    EXPECT_NE(message.find("figures.toml"), std::string::npos) << message;
+  }
+}
+
+// Figures: each links to its full-size file with its figures.toml caption, in the file's order;
+// a figure without an entry is still shown, uncaptioned, and counted.
+TEST_F(ReportTest, ShowsFiguresWithTheirCaptions) {
+  const ReportSummary summary = write_fixture_site();
+  EXPECT_EQ(summary.uncaptioned_figures, 0);
+  const std::string page = read_text(dir_ / "site" / "tiny" / "index.html");
+  const size_t phase = page.find(
+      "<figure class=\"wide\"><a href=\"phase.svg\"><img src=\"phase.svg\" alt=\"Phase portrait");
+  const size_t energy = page.find(
+      "<figure><a href=\"energy.png\"><img src=\"energy.png\" alt=\"Relative energy error");
+  ASSERT_NE(phase, std::string::npos) << page;
+  ASSERT_NE(energy, std::string::npos) << page;
+  EXPECT_LT(phase, energy);
+  EXPECT_NE(page.find("<figcaption>Phase portrait of the <em>fixture</em> run: a closed "
+                      "curve.</figcaption>"),
+            std::string::npos);
+
+  const fs::path results = dir_ / "results";
+  fs::copy(kFixture / "results", results, fs::copy_options::recursive);
+  fs::remove(results / "tiny" / "figures.toml");
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site2").string();
+  EXPECT_EQ(write_report(options).uncaptioned_figures, 2);
+  std::ofstream(results / "tiny" / "figures.toml") << "[[figure]]\nfile = \"energy.png\"\n";
+  EXPECT_THROW(write_report(options), InputError);
+}
+
+// The index shows each scene's claim and measured number from the README's headline table; a
+// scene without a row shows its description's first sentence.
+TEST_F(ReportTest, IndexShowsTheHeadlineClaims) {
+  write_fixture_site();
+  const std::string index = read_text(dir_ / "site" / "index.html");
+  EXPECT_NE(index.find("Störmer–Verlet keeps the energy <em>bounded</em><br><span "
+                       "class=\"measured\">Measured: max |H − H0| 1.5e-3 at <code>h = "
+                       "0.1</code></span>"),
+            std::string::npos)
+      << index;
+  EXPECT_NE(index.find("Shown as the narrative when there is no README:"), std::string::npos);
+}
+
+// table.md is rendered as table.html next to the page, its Markdown tables as HTML tables, and
+// the README's links to table.md lead there.
+TEST_F(ReportTest, RendersTableMdAsAPage) {
+  const fs::path results = dir_ / "results";
+  fs::copy(kFixture / "results", results, fs::copy_options::recursive);
+  std::ofstream(results / "tiny" / "table.md")
+      << "# tiny\n\n| method | error |\n|---|---|\n| a | 1 |\n| b | 2 |\n";
+  std::ofstream(results / "tiny" / "README.md", std::ios::app) << "\nSee [the table](table.md).\n";
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site").string();
+  write_report(options);
+  const std::string table = read_text(dir_ / "site" / "tiny" / "table.html");
+  EXPECT_NE(table.find("<table>"), std::string::npos) << table;
+  EXPECT_NE(table.find("<td>b</td>"), std::string::npos) << table;
+  EXPECT_EQ(table.find("|---"), std::string::npos) << table;
+  EXPECT_NE(
+      read_text(dir_ / "site" / "tiny" / "index.html").find("<a href=\"table.html\">the table</a>"),
+      std::string::npos);
 }
 
 // --out is replaced whole: a folder the verb did not write is refused and left as it was.

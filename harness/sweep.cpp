@@ -20,6 +20,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "harness/order.hpp"
@@ -791,6 +792,23 @@ TableCitation table_citation(const std::vector<std::pair<std::string, std::strin
 
 namespace {
 
+// A scene's description is plain text ("h*omega", "q_k", "<= 1"): its Markdown punctuation is
+// backslash-escaped so that table.md (and the results site) shows it as written, not as emphasis,
+// code or HTML; a line that would open a heading, list or quote starts with its escaped mark.
+std::string markdown_text(const std::string& text) {
+  std::string out;
+  bool line_start = true;
+  for (const char c : text) {
+    const bool inline_mark = std::string_view("\\`*_[]<>|~").find(c) != std::string_view::npos;
+    const bool block_mark =
+        line_start && std::string_view("#-+=").find(c) != std::string_view::npos;
+    if (inline_mark || block_mark) out += '\\';
+    out += c;
+    if (c != ' ') line_start = c == '\n';
+  }
+  return out;
+}
+
 // "| name | value |" with an absent value shown as such, so a block is never half empty.
 constexpr const char* kSceneHashField = "scene hash";
 
@@ -845,7 +863,7 @@ std::string recorded_scene_hash(const std::string& table_md_path) {
 std::string scene_markdown(const Scene& scene, const SceneTables& tables,
                            const std::string& command_line, const TableCitation& citation) {
   std::string markdown = fmt::format("# {}\n\n", scene.title);
-  if (!scene.description.empty()) markdown += scene.description + "\n\n";
+  if (!scene.description.empty()) markdown += markdown_text(scene.description) + "\n\n";
   if (!tables.summary.empty()) {
     const auto columns = scene.table_columns.empty()
                              ? column_union(tables.summary, standard_columns())

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "harness/report.hpp"
 #include "harness/table.hpp"
 #include "harness/toml_reader.hpp"
 #include "problems/spec.hpp"
@@ -85,6 +86,20 @@ TEST_F(SweepTables, MarkdownEndsWithTheHowToCiteBlock) {
   EXPECT_NE(cite.find("> geomint " + version + " (git " + sha + "), scene tables_scene"),
             std::string::npos)
       << cite;
+}
+
+// The description is plain text: rendered as Markdown (GitHub, the results site) it reads as
+// written, with no emphasis, code, HTML or heading made of its punctuation.
+TEST(SceneMarkdown, DescriptionIsTextNotMarkup) {
+  Scene scene;
+  scene.title = "t";
+  scene.description =
+      "h*omega < 2 for q_k *and* _p_ [x](y) `c` a|b ~~d~~ \\n\n# not a heading\n- nor a list";
+  const std::string html = markdown_to_html(scene_markdown(scene, {}, "geomint sweep", {}));
+  EXPECT_NE(html.find("<p>h*omega &lt; 2 for q_k *and* _p_ [x](y) `c` a|b ~~d~~ \\n\n# not a "
+                      "heading\n- nor a list</p>"),
+            std::string::npos)
+      << html;
 }
 
 TEST_F(SweepTables, MarkdownOnlyRebuildsTheSameTableFromTheCsvs) {

@@ -13,6 +13,7 @@ PACKAGES=(
   libsuitesparse-dev libmetis-dev libopenblas-dev libhypre-dev
   clang libclang-rt-14-dev python3 ccache
   libxml2-utils tidy chromium python3-yaml
+  libcmark-gfm-dev libcmark-gfm-extensions-dev
 )
 if [ "${1:-}" = cluster ]; then
   shift
