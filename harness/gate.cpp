@@ -3,6 +3,7 @@
 #include "harness/gate.hpp"
 
 #include <fmt/format.h>
+#include <fnmatch.h>
 
 #include <algorithm>
 #include <cmath>
@@ -147,18 +148,94 @@ ResultFile read_result_file(const fs::path& path) {
   return file;
 }
 
-}  // namespace
+// The same file reached by two spellings must be recognised (a cycle through "./x.toml").
+fs::path canonical_or_absolute(const fs::path& path) {
+  std::error_code error;
+  const fs::path canonical = fs::weakly_canonical(fs::absolute(path), error);
+  return error ? fs::absolute(path).lexically_normal() : canonical;
+}
 
-std::vector<Gate> load_gates(const std::string& path) {
-  const std::string file_where = fmt::format("gates file '{}'", path);
-  const toml::table root = parse_toml_file(path, "gates file", "GATES.toml");
+bool has_wildcard(const std::string& text) {
+  return text.find_first_of("*?[") != std::string::npos;
+}
+
+// The files an `include` entry names: a path relative to the folder of the including file (or
+// absolute); a component with * ? [...] matches the names in its folder (fnmatch, no hidden
+// names), sorted. A plain path that does not exist, or a pattern that matches nothing, is an
+// input error naming the including file.
+std::vector<fs::path> resolve_include(const fs::path& from, const std::string& include) {
+  const std::string where = fmt::format("gates file '{}': include '{}'", from.string(), include);
+  if (include.empty()) throw InputError(where + ": an empty path");
+  const fs::path relative(include);
+  const fs::path base = relative.is_absolute() ? fs::path() : from.parent_path();
+  std::vector<fs::path> found = {base};
+  for (const fs::path& component : relative) {
+    std::vector<fs::path> next;
+    const std::string part = component.string();
+    if (!has_wildcard(part)) {
+      for (const auto& prefix : found) next.push_back(prefix / component);
+    } else {
+      for (const auto& prefix : found) {
+        std::error_code error;
+        const fs::path folder = prefix.empty() ? fs::path(".") : prefix;
+        if (!fs::is_directory(folder, error)) continue;
+        for (const auto& entry : fs::directory_iterator(folder, error)) {
+          const std::string name = entry.path().filename().string();
+          if (fnmatch(part.c_str(), name.c_str(), FNM_PERIOD) == 0) next.push_back(prefix / name);
+        }
+      }
+      std::sort(next.begin(), next.end());
+    }
+    found = std::move(next);
+  }
+  std::vector<fs::path> files;
+  for (const auto& path : found) {
+    std::error_code error;
+    if (fs::is_regular_file(path, error)) files.push_back(path.lexically_normal());
+  }
+  if (files.empty()) {
+    throw InputError(has_wildcard(include)
+                         ? fmt::format("{}: the pattern matches no file", where)
+                         : fmt::format("{}: no such file '{}'", where,
+                                       (base / relative).lexically_normal().string()));
+  }
+  return files;
+}
+
+// A gates file beside a scene.toml is that scene's own: its gates name that scene (or none),
+// so a gate copied from another scene's file cannot sit where it never applies.
+void check_scene_folder(const fs::path& path, const std::vector<Gate>& gates, std::size_t first) {
+  const fs::path folder = canonical_or_absolute(path).parent_path();
+  std::error_code error;
+  if (!fs::exists(folder / "scene.toml", error)) return;
+  const std::string scene = folder.filename().string();
+  for (std::size_t k = first; k < gates.size(); ++k) {
+    if (!gates[k].scene.empty() && gates[k].scene != scene) {
+      throw InputError(fmt::format(
+          "gates file '{}', gate '{}': scene '{}' is not the scene of the folder it sits in "
+          "('{}'); move the gate to results/{}/gates.toml",
+          path.string(), gates[k].name, gates[k].scene, scene, gates[k].scene));
+    }
+  }
+}
+
+// Reads one gates file and, depth first in the order given, the files it includes; `chain` holds
+// the files being read (an include back onto one of them is a cycle), `origin` the file each gate
+// name came from (a name may appear once across every file read).
+void load_gates_file(const fs::path& path, std::vector<fs::path>& chain,
+                     std::map<std::string, std::string>& origin, std::vector<Gate>& gates) {
+  const std::string file_where = fmt::format("gates file '{}'", path.string());
+  const toml::table root = parse_toml_file(path.string(), "gates file", "GATES.toml");
   TomlBlock top(root, file_where);
   top.known("gate");
+  const std::vector<std::string> includes = top.strings("include", false);
   top.finish();
   const auto blocks = array_of_tables(root, "gate", file_where);
-  if (blocks.empty()) throw InputError(fmt::format("{}: no [[gate]] blocks", file_where));
-  std::vector<Gate> gates;
-  std::set<std::string> names;
+  if (blocks.empty() && includes.empty()) {
+    throw InputError(fmt::format("{}: no [[gate]] blocks and no 'include'", file_where));
+  }
+  chain.push_back(canonical_or_absolute(path));
+  const std::size_t first_own = gates.size();
   int index = 0;
   for (const toml::table* table : blocks) {
     ++index;
@@ -171,9 +248,13 @@ std::vector<Gate> load_gates(const std::string& path) {
     block.finish();
     Gate gate;
     gate.name = block.string("name", true);
-    block.rename(fmt::format("gates file '{}', gate '{}'", path, gate.name));
-    if (!names.insert(gate.name).second) {
-      throw InputError(fmt::format("{}: name used twice", block.where()));
+    gate.file = path.string();
+    block.rename(fmt::format("gates file '{}', gate '{}'", path.string(), gate.name));
+    if (const auto [first, inserted] = origin.emplace(gate.name, gate.file); !inserted) {
+      throw InputError(first->second == gate.file
+                           ? fmt::format("{}: name used twice", block.where())
+                           : fmt::format("{}: name used twice (also in gates file '{}')",
+                                         block.where(), first->second));
     }
     gate.column = block.string("column", true);
     if (const auto file = block.optional_string("file")) {
@@ -243,6 +324,33 @@ std::vector<Gate> load_gates(const std::string& path) {
     }
     check_gate_column(gate, block.where());
     gates.push_back(std::move(gate));
+  }
+  check_scene_folder(path, gates, first_own);
+  for (const std::string& include : includes) {
+    for (const fs::path& included : resolve_include(path, include)) {
+      const fs::path canonical = canonical_or_absolute(included);
+      if (std::find(chain.begin(), chain.end(), canonical) != chain.end()) {
+        std::vector<std::string> cycle;
+        for (const auto& file : chain) cycle.push_back(file.string());
+        cycle.push_back(canonical.string());
+        throw InputError(fmt::format("{}: include '{}' is a cycle ({})", file_where, include,
+                                     fmt::join(cycle, " -> ")));
+      }
+      load_gates_file(included, chain, origin, gates);
+    }
+  }
+  chain.pop_back();
+}
+
+}  // namespace
+
+std::vector<Gate> load_gates(const std::string& path) {
+  std::vector<fs::path> chain;
+  std::map<std::string, std::string> origin;
+  std::vector<Gate> gates;
+  load_gates_file(path, chain, origin, gates);
+  if (gates.empty()) {
+    throw InputError(fmt::format("gates file '{}': its includes hold no [[gate]] blocks", path));
   }
   return gates;
 }

@@ -24,6 +24,7 @@ struct GateCheck {
 // reported as not applicable, so one gates file serves any subset of the scenes.
 struct Gate {
   std::string name;
+  std::string file;   // the gates file it was read from (an included one, as resolved)
   std::string scene;  // results/<scene>/ ("" = every scene given)
   std::string table;  // "summary", "order", "stability", ... ("" = every table)
   std::vector<std::string> variants = {"full", "quick"};   // which sweeps it gates
@@ -37,8 +38,15 @@ struct Gate {
   }
 };
 
-// Parses a gates file; InputError names the file, block and key for malformed input (unknown
-// or missing keys, wrong types, NaN bounds, min > max, a gate with neither bounds nor `equals`).
+// Parses a gates file and the files it includes (`include = ["<scene>/gates.toml",
+// "*/gates.toml"]`, paths relative to the including file's folder, a * ? [...] component matching
+// names; read in the order listed, matches sorted), its own gates first. Which tables a gate checks
+// does not depend on the file it sits in: `scene` and `table` are names matched against the results
+// given. InputError names the file, block and key for malformed input (unknown or missing keys,
+// wrong types, NaN bounds, min > max, a gate with neither bounds nor `equals`), an include of a
+// missing file or a pattern matching none, an include cycle, a gate name used twice (in one file or
+// across files), a file with neither gates nor includes, and a gate in a scene's folder (beside its
+// scene.toml) that names another scene.
 std::vector<Gate> load_gates(const std::string& path);
 
 // A result table with where it came from. The scene and variant come from the `# scene:` and

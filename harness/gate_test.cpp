@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "harness/metrics.hpp"
 #include "problems/spec.hpp"
@@ -246,6 +247,106 @@ TEST(Gate, MalformedGatesFilesAreInputErrorsNamingTheProblem) {
   std::filesystem::create_directories(empty);
   EXPECT_THROW(load_result_files({empty.string()}), InputError);
   EXPECT_THROW(load_gates(empty.string()), InputError);
+}
+
+// A scratch folder of gates files: relative path → text.
+std::filesystem::path write_tree(const std::string& name,
+                                 const std::vector<std::pair<std::string, std::string>>& files) {
+  const auto root = std::filesystem::temp_directory_path() /
+                    ("geomint_gate_" + std::to_string(::getpid()) + "_" + name);
+  std::filesystem::remove_all(root);
+  for (const auto& [path, text] : files) {
+    std::filesystem::create_directories((root / path).parent_path());
+    std::ofstream(root / path) << text;
+  }
+  return root;
+}
+
+std::string gate_block(const std::string& name, const std::string& scene) {
+  return "[[gate]]\nname = '" + name + "'\nscene = '" + scene + "'\ncolumn = 'x'\nmin = 0\n";
+}
+
+// Includes resolve against the including file's folder, patterns match sorted names, a file's
+// own gates come before those it includes, and each gate records the file it came from.
+TEST(Gate, IncludesResolveBesideTheIncludingFileInOrder) {
+  const auto root = write_tree(
+      "include",
+      {{"all.toml", "include = ['results/*/gates.toml', 'extra.toml']\n" + gate_block("top", "")},
+       {"extra.toml", gate_block("extra", "b")},
+       {"results/b/gates.toml", gate_block("b1", "b") + gate_block("b2", "b")},
+       {"results/a/gates.toml", gate_block("a1", "a")},
+       {"results/a/notes.toml", gate_block("not included", "a")}});
+  const auto gates = load_gates((root / "all.toml").string());
+  std::vector<std::string> names, files;
+  for (const auto& gate : gates) {
+    names.push_back(gate.name);
+    files.push_back(std::filesystem::relative(gate.file, root).generic_string());
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"top", "a1", "b1", "b2", "extra"}));
+  EXPECT_EQ(files,
+            (std::vector<std::string>{"all.toml", "results/a/gates.toml", "results/b/gates.toml",
+                                      "results/b/gates.toml", "extra.toml"}));
+  // A scene's own file read directly gives the same gates as through the include.
+  const auto own = load_gates((root / "results" / "b" / "gates.toml").string());
+  ASSERT_EQ(own.size(), 2u);
+  EXPECT_EQ(own[0].name, "b1");
+  std::filesystem::remove_all(root);
+}
+
+// Each malformed include is an input error naming the file at fault.
+TEST(Gate, BadIncludesAreInputErrorsNamingTheFile) {
+  const auto expect_error = [](const std::filesystem::path& path, const std::string& words) {
+    try {
+      load_gates(path.string());
+      ADD_FAILURE() << path << ": no error, expected one with '" << words << "'";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(words), std::string::npos) << error.what();
+    }
+  };
+  auto root = write_tree("missing", {{"g.toml", "include = ['a/gates.toml']\n"}});
+  expect_error(root / "g.toml", "g.toml': include 'a/gates.toml': no such file");
+  root = write_tree("nomatch", {{"g.toml", "include = ['*/gates.toml']\n"}});
+  expect_error(root / "g.toml", "matches no file");
+  root = write_tree("cycle", {{"g.toml", "include = ['a/g.toml']\n"},
+                              {"a/g.toml", "include = ['../b.toml']\n" + gate_block("x", "")},
+                              {"b.toml", "include = ['./g.toml']\n"}});
+  expect_error(root / "g.toml", "b.toml': include './g.toml' is a cycle");
+  root = write_tree("self", {{"g.toml", "include = ['g.toml']\n" + gate_block("x", "")}});
+  expect_error(root / "g.toml", "is a cycle");
+  root = write_tree("twice", {{"g.toml", "include = ['a.toml', 'b.toml']\n"},
+                              {"a.toml", gate_block("same", "a")},
+                              {"b.toml", gate_block("same", "b")}});
+  expect_error(root / "g.toml", "b.toml', gate 'same': name used twice (also in gates file");
+  root = write_tree("empty", {{"g.toml", "include = ['a.toml']\n"}, {"a.toml", "# nothing\n"}});
+  expect_error(root / "g.toml", "a.toml': no [[gate]] blocks and no 'include'");
+  root = write_tree("type", {{"g.toml", "include = 'a.toml'\n"}, {"a.toml", gate_block("a", "")}});
+  expect_error(root / "g.toml", "include");
+  root = write_tree("scene", {{"s/scene.toml", "title = 's'\n"},
+                              {"s/gates.toml", gate_block("a", "s") + gate_block("b", "t")}});
+  expect_error(root / "s" / "gates.toml", "gate 'b': scene 't' is not the scene of the folder");
+  std::filesystem::remove_all(root);
+}
+
+// The repository's gates sit beside their scenes: results/gates.toml includes every
+// results/<scene>/gates.toml, each of whose gates is of that scene, and every scene has one.
+TEST(Gate, RepositoryGatesLiveInTheirScenesFolders) {
+  const std::filesystem::path results = std::filesystem::path(GEOMINT_SOURCE_DIR) / "results";
+  std::map<std::string, int> per_file;
+  for (const auto& gate : load_gates((results / "gates.toml").string())) {
+    const std::filesystem::path file(gate.file);
+    EXPECT_EQ(file.filename(), "gates.toml") << gate.name;
+    EXPECT_EQ(gate.scene, file.parent_path().filename().string()) << gate.name;
+    ++per_file[gate.scene];
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(results)) {
+    if (!std::filesystem::exists(entry.path() / "scene.toml")) continue;
+    const std::string scene = entry.path().filename().string();
+    EXPECT_TRUE(std::filesystem::exists(entry.path() / "gates.toml")) << scene << " has no gates";
+    EXPECT_GT(per_file[scene], 0) << scene;
+    EXPECT_EQ(load_gates((entry.path() / "gates.toml").string()).size(),
+              static_cast<std::size_t>(per_file[scene]))
+        << scene;
+  }
 }
 
 TEST(Gate, RepositoryGatesPassOnTheCommittedResults) {

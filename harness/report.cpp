@@ -1,6 +1,7 @@
 // `geomint report` (docs/REPORT.md): the results site. Every page is written
 // from the tables as committed (their `# key: value` provenance, docs/DESIGN.md §5) and the gates
-// of results/gates.toml run through check_gates, so the site cannot disagree with `make gates`.
+// of each scene (results/<scene>/gates.toml, or --gates) run through check_gates, so the site
+// cannot disagree with `make gates`.
 #include "harness/report.hpp"
 
 #include <fmt/format.h>
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "citation_info.hpp"  // generated from cmake/citation.cmake (harness/CMakeLists.txt)
@@ -162,6 +164,7 @@ struct ScenePage {
   std::string narrative_html;
   std::string table_md_html;  // table.md rendered, written as table.html ("" without table.md)
   int passed = 0, failed = 0;
+  bool has_gates = false;  // a gate names this scene (its results/<scene>/gates.toml or --gates)
   // Why the tables are not of the scene.toml beside them ("" when they are, or unknown): set
   // when table.md's recorded scene hash differs from the file's (published variant only; the
   // quick tables are rewritten by every `make gate-quick`).
@@ -237,7 +240,8 @@ std::string scene_page_html(const ScenePage& page, const ReportOptions& options,
   html += fmt::format("<p>Scene <code>{}</code> ({} tables). Gates: ", html_escape(page.name),
                       options.quick ? "CI-sized --quick" : "published");
   if (page.passed + page.failed == 0) {
-    html += "<span class=\"none\">none</span>";
+    html += page.has_gates ? "<span class=\"none\">none applies</span>"
+                           : "<span class=\"none\">none (no gates file)</span>";
   } else {
     html += fmt::format("<span class=\"{}\">{} of {} passed</span>", page.failed ? "fail" : "pass",
                         page.passed, page.passed + page.failed);
@@ -340,7 +344,8 @@ std::string index_html(const std::vector<ScenePage>& pages, const ReportOptions&
       "<div class=\"scroll\"><table>\n<thead><tr><th>Scene</th><th>Claim</th><th>Gates</th>"
       "<th>Tables</th></tr></thead>\n<tbody>\n";
   for (const auto& page : pages) {
-    std::string gates = "<span class=\"none\">none</span>";
+    std::string gates = page.has_gates ? "<span class=\"none\">none applies</span>"
+                                       : "<span class=\"none\">no gates file</span>";
     if (page.passed + page.failed > 0) {
       gates = fmt::format("<span class=\"{}\">{} {}/{}</span>", page.failed ? "fail" : "pass",
                           page.failed ? "FAIL" : "PASS", page.passed, page.passed + page.failed);
@@ -448,6 +453,8 @@ ScenePage load_scene_page(const fs::path& folder, const ReportOptions& options,
                  images.end());
     for (const auto& csv : csvs) page.tables.push_back(read_csv_file(csv.string()));
   }
+  page.has_gates = std::any_of(gates.begin(), gates.end(),
+                               [&page](const Gate& gate) { return gate.scene == page.name; });
   if (!page.tables.empty() && !gates.empty()) {
     // The tables on the page, not the folder's: a left-out link is not checked either.
     std::vector<std::string> table_paths;
@@ -695,11 +702,11 @@ ReportSummary write_report(const ReportOptions& given) {
         "e.g. results)",
         options.results_dir));
   }
-  if (options.gates_path.empty()) options.gates_path = (results / "gates.toml").string();
-  const std::vector<Gate> gates =
-      fs::exists(options.gates_path) || options.gates_path != (results / "gates.toml").string()
-          ? load_gates(options.gates_path)
-          : std::vector<Gate>{};
+  const bool default_gates = options.gates_path.empty();
+  if (default_gates) options.gates_path = (results / "gates.toml").string();
+  std::vector<Gate> gates = fs::exists(options.gates_path) || !default_gates
+                                ? load_gates(options.gates_path)
+                                : std::vector<Gate>{};
   const fs::path out = site_folder(options.out_dir);
   check_site_folder(options, out);
   std::vector<fs::path> folders;
@@ -723,6 +730,17 @@ ReportSummary write_report(const ReportOptions& given) {
     folders.push_back(entry.path());
   }
   std::sort(folders.begin(), folders.end());
+  if (default_gates) {
+    // Each scene's own results/<scene>/gates.toml, also when <results>/gates.toml does not
+    // include it (or does not exist); a file already read through an include is not read twice.
+    std::set<fs::path> read;
+    for (const auto& gate : gates) read.insert(fs::weakly_canonical(fs::absolute(gate.file)));
+    for (const auto& folder : folders) {
+      const fs::path own = folder / "gates.toml";
+      if (!fs::exists(own) || read.count(fs::weakly_canonical(fs::absolute(own)))) continue;
+      for (auto& gate : load_gates(own.string())) gates.push_back(std::move(gate));
+    }
+  }
   if (folders.empty()) {
     throw InputError(
         fmt::format("report: --results '{}' holds no scene (no <scene>/scene.toml folder in it)",

@@ -385,6 +385,31 @@ TEST_F(ReportTest, EncodesPathsInLinks) {
   EXPECT_NE(page.find("href=\"../../results/other%20dir/n.md\""), std::string::npos) << page;
 }
 
+// Without --gates, each scene's own results/<scene>/gates.toml is checked on its page, whether or
+// not <results>/gates.toml exists or includes it; a scene without one says so (never a silent 0).
+TEST_F(ReportTest, ChecksEachScenesOwnGatesFile) {
+  const fs::path results = dir_ / "results";
+  fs::copy(kFixture / "results", results, fs::copy_options::recursive);
+  const std::string all = read_text(results / "gates.toml");
+  // The fixture's gates of `tiny`, moved beside it (the "elsewhere" gate is left behind).
+  std::ofstream(results / "tiny" / "gates.toml") << all.substr(
+      all.find("[[gate]]"), all.find("[[gate]]\nname = \"elsewhere") - all.find("[[gate]]"));
+  fs::remove(results / "gates.toml");
+  ReportOptions options;
+  options.results_dir = results.string();
+  options.out_dir = (dir_ / "site").string();
+  ReportSummary summary = write_report(options);
+  EXPECT_EQ(summary.gates_passed, 2);
+  EXPECT_EQ(summary.gates_failed, 1);
+  EXPECT_NE(read_text(dir_ / "site" / "bare" / "index.html").find("none (no gates file)"),
+            std::string::npos);
+  EXPECT_NE(read_text(dir_ / "site" / "index.html").find("no gates file"), std::string::npos);
+  // An include list that names the scene's file reads it once, not twice.
+  std::ofstream(results / "gates.toml") << "include = ['tiny/gates.toml']\n";
+  summary = write_report(options);
+  EXPECT_EQ(summary.gates_passed + summary.gates_failed, 3);
+}
+
 // A symbolic link in a scene folder would publish its target (any file of the machine): links
 // are left out of the site and the gates, with a note naming them.
 TEST_F(ReportTest, LeavesOutSymbolicLinks) {

@@ -76,7 +76,7 @@ TEST_P(CommittedScene, CheapRowsReproduce) {
     if (!committed.count("wall_s") || !parse_number(committed.at("wall_s"), wall)) continue;
     if (wall > kMaxRowWallSeconds || spent + wall > kSceneBudgetSeconds) continue;
     // A timeout row (wall_budget_s spent) ends where the clock did: its metrics are not
-    // reproducible, only its status (results/gates.toml checks it).
+    // reproducible, only its status (results/<scene>/gates.toml checks it).
     if (committed.count("status") && committed.at("status") == "timeout") continue;
     spent += wall;
     RunConfig config;

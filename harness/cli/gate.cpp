@@ -7,8 +7,10 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "harness/cli/verbs.hpp"
 #include "harness/report.hpp"
@@ -17,6 +19,8 @@
 
 namespace geomint::cli {
 namespace {
+
+namespace fs = std::filesystem;
 
 struct GateCliOptions {
   std::string gates_path;
@@ -92,9 +96,50 @@ void print_json(const std::vector<const GateOutcome*>& applied, bool verbose) {
   fmt::print("{}]\n", applied.empty() ? "" : "\n");
 }
 
-int run_gate(const GateCliOptions& cli, const Context& context) {
+// `geomint gate FOLDER [RESULTS...]`: a folder in the gates position stands for FOLDER/gates.toml,
+// and without RESULTS for the results of FOLDER too (`geomint gate results/momentum`).
+GateCliOptions resolve_folder(GateCliOptions cli) {
+  std::error_code error;
+  if (fs::is_directory(cli.gates_path, error)) {
+    if (cli.results.empty()) cli.results.push_back(cli.gates_path);
+    cli.gates_path = (fs::path(cli.gates_path) / "gates.toml").string();
+    if (!fs::exists(cli.gates_path, error)) {
+      throw InputError(fmt::format(
+          "gate: folder given for the gates file, but '{}' does not exist (a scene's gates live "
+          "in results/<scene>/gates.toml; give a gates file, then the results)",
+          cli.gates_path));
+    }
+  } else if (cli.results.empty()) {
+    throw InputError(
+        fmt::format("gate: give the results to check after the gates file '{}' (scene folders "
+                    "results/<scene>, results/<scene>/quick, or CSV files)",
+                    cli.gates_path));
+  }
+  return cli;
+}
+
+// The scenes among the results that no gate applies to: said, not passed over as zero gates.
+std::vector<std::string> ungated_scenes(const std::vector<ResultFile>& files,
+                                        const std::vector<GateOutcome>& outcomes) {
+  std::set<std::string> scenes, gated;
+  for (const auto& file : files) scenes.insert(file.scene);
+  for (const auto& outcome : outcomes) {
+    if (!outcome.applicable) continue;
+    if (outcome.gate->scene.empty()) return {};  // a gate of every scene
+    gated.insert(outcome.gate->scene);
+  }
+  std::vector<std::string> ungated;
+  for (const auto& scene : scenes) {
+    if (!gated.count(scene)) ungated.push_back(scene);
+  }
+  return ungated;
+}
+
+int run_gate(const GateCliOptions& given, const Context& context) {
+  const GateCliOptions cli = resolve_folder(given);
   const std::vector<Gate> gates = load_gates(cli.gates_path);
-  const auto outcomes = check_gates(gates, load_result_files(cli.results));
+  const std::vector<ResultFile> files = load_result_files(cli.results);
+  const auto outcomes = check_gates(gates, files);
   std::vector<const GateOutcome*> applied;
   int failed = 0;
   for (const auto& outcome : outcomes) {
@@ -107,6 +152,12 @@ int run_gate(const GateCliOptions& cli, const Context& context) {
         "gate: none of the {} gate(s) in '{}' applies to the results given (their scenes "
         "and variants differ); nothing was checked",
         outcomes.size(), cli.gates_path));
+  }
+  // On stderr, so the JUnit and JSON documents on stdout stay whole.
+  for (const auto& scene : ungated_scenes(files, outcomes)) {
+    inform(context, fmt::format("gate: no gate of '{}' (or the files it includes) applies to "
+                                "scene '{}': it has no gates file (results/{}/gates.toml)",
+                                cli.gates_path, scene, scene));
   }
   if (cli.format == "junit") {
     print_junit(applied, cli.verbose);
@@ -128,14 +179,17 @@ Verb add_gate(CLI::App& app) {
   auto options = std::make_shared<GateCliOptions>();
   auto* command = app.add_subcommand(
       "gate", "Check result CSVs against the thresholds of a gates file (exit 1 on failure)");
-  command->add_option("gates", options->gates_path, "GATES.toml with [[gate]] blocks")->required();
+  command
+      ->add_option("gates", options->gates_path,
+                   "GATES.toml with [[gate]] blocks and/or include = [...], or a scene folder "
+                   "(its gates.toml)")
+      ->required();
   command->add_flag("--verbose", options->verbose,
                     "print every checked row, not only the failing ones");
-  command
-      ->add_option("results", options->results,
-                   "result CSV files (summary.csv, order.csv, ...) or scene folders "
-                   "(results/<scene>, results/<scene>/quick)")
-      ->required();
+  command->add_option(
+      "results", options->results,
+      "result CSV files (summary.csv, order.csv, ...) or scene folders "
+      "(results/<scene>, results/<scene>/quick); default: the folder given as GATES");
   command
       ->add_option("--format", options->format,
                    "text (default), junit (JUnit XML: a testsuite per scene, a testcase per "

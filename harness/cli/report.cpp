@@ -18,7 +18,8 @@ Verb add_report(CLI::App& app) {
   command->add_option("--results", options->results_dir,
                       "folder of <scene>/scene.toml scenes (default: results)");
   command->add_option("--gates", options->gates_path,
-                      "gates file checked on each scene (default: <results>/gates.toml)");
+                      "gates file checked on each scene (default: <results>/gates.toml and each "
+                      "<scene>/gates.toml)");
   command->add_option("--claims", options->claims_path,
                       "Markdown whose claim | measured | scene table gives the index's claims "
                       "(default: <results>/../README.md)");
