@@ -116,8 +116,9 @@ reproduce-all: build
 	@$(MAKE) --no-print-directory report
 
 # The results site (docs/REPORT.md): site/index.html and one page per scene, from the committed
-# tables and results/gates.toml; opens from file://. report-quick: the CI-sized tables of
-# results/<scene>/quick/ (after gate-quick; `make test` writes it to $(BUILD_DIR)/site-quick).
+# tables and each scene's results/<scene>/gates.toml (GATES includes them all); opens from
+# file://. report-quick: the CI-sized tables of results/<scene>/quick/ (after gate-quick;
+# `make test` writes it to $(BUILD_DIR)/site-quick).
 SITE ?= site
 report: build
 	@$(BUILD_DIR)/geomint report --results results --gates $(GATES) --out $(SITE)
@@ -134,8 +135,9 @@ citation: configure
 reproduce-quick: build
 	@QUICK=1 bash scripts/reproduce.sh $(BUILD_DIR)/geomint $(SCENES)
 
-# Accuracy gates: the published claims (results/gates.toml) checked against the result tables;
-# exits 1 and prints the failing rows when a number left its band. Run after reproduce-figures.
+# Accuracy gates: the published claims (each scene's results/<scene>/gates.toml, all included by
+# results/gates.toml) checked against the result tables; exits 1 and prints the failing rows when
+# a number left its band, and names a scene without gates. Run after reproduce-figures.
 GATES ?= results/gates.toml
 gates: build
 	@$(BUILD_DIR)/geomint gate $(GATES) $(addprefix results/,$(SCENES))

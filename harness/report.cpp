@@ -734,12 +734,16 @@ ReportSummary write_report(const ReportOptions& given) {
     // Each scene's own results/<scene>/gates.toml, also when <results>/gates.toml does not
     // include it (or does not exist); a file already read through an include is not read twice.
     std::set<fs::path> read;
+    bool own_files = false;  // a scene's own file not read through an include
     for (const auto& gate : gates) read.insert(fs::weakly_canonical(fs::absolute(gate.file)));
     for (const auto& folder : folders) {
       const fs::path own = folder / "gates.toml";
       if (!fs::exists(own) || read.count(fs::weakly_canonical(fs::absolute(own)))) continue;
       for (auto& gate : load_gates(own.string())) gates.push_back(std::move(gate));
+      own_files = true;
     }
+    // The index names where the verdicts come from.
+    if (own_files) options.gates_path = (results / "<scene>" / "gates.toml").string();
   }
   if (folders.empty()) {
     throw InputError(

@@ -312,6 +312,32 @@ TEST(Cli, GateExitsZeroOnPassOneOnFailTwoOnBadInput) {
   EXPECT_EQ(geomint("gate " + failing.string() + " /nonexistent.csv").exit_code, 2);
 }
 
+// A scene's gates beside it (docs/GATING.md "Where gates live"): `geomint gate FOLDER` checks
+// FOLDER/gates.toml on FOLDER's tables, and a scene among the results that no gate applies to is
+// named on stderr (it has no gates file) rather than passing as zero gates.
+TEST(Cli, GateFindsASceneFoldersOwnGatesAndNamesScenesWithout) {
+  const fs::path root = scratch("own_gates");
+  fs::remove_all(root);
+  for (const char* scene : {"gated", "ungated"}) {
+    fs::create_directories(root / scene);
+    std::ofstream(root / scene / "summary.csv") << "# scene: " << scene << "\nlabel,status\na,ok\n";
+  }
+  std::ofstream(root / "gated" / "gates.toml")
+      << "[[gate]]\nname = \"gated runs\"\nscene = \"gated\"\ncolumn = \"status\"\nequals = "
+         "\"ok\"\n";
+  const Outcome own = geomint("gate " + (root / "gated").string());
+  EXPECT_EQ(own.exit_code, 0) << own.output;
+  EXPECT_NE(own.output.find("PASS gated runs (1 row(s))"), std::string::npos) << own.output;
+  std::ofstream(root / "gates.toml") << "include = [\"*/gates.toml\"]\n";
+  const Outcome both = geomint("gate " + (root / "gates.toml").string() + " " +
+                               (root / "gated").string() + " " + (root / "ungated").string());
+  EXPECT_EQ(both.exit_code, 0) << both.output;
+  EXPECT_NE(both.output.find("scene 'ungated': it has no gates file"), std::string::npos)
+      << both.output;
+  EXPECT_EQ(both.output.find("scene 'gated':"), std::string::npos) << both.output;
+  fs::remove_all(root);
+}
+
 // `geomint gate --format junit|json` (docs/CLI.md "gate"): the same verdicts and exit codes as the
 // text format. Two scenes, a passing gate in one and a failing gate (with '<' and '"' in its name,
 // which the writers must escape) in the other: the JUnit XML parses (xmllint --noout, Debian's
