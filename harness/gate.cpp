@@ -336,6 +336,15 @@ void load_gates_file(const fs::path& path, std::vector<fs::path>& chain,
         throw InputError(fmt::format("{}: include '{}' is a cycle ({})", file_where, include,
                                      fmt::join(cycle, " -> ")));
       }
+      // Two includes reaching one file (a pattern and a name of it) would repeat its gates.
+      std::set<std::string> read;
+      for (const Gate& gate : gates) read.insert(gate.file);
+      if (std::any_of(read.begin(), read.end(), [&canonical](const std::string& file) {
+            return canonical_or_absolute(file) == canonical;
+          })) {
+        throw InputError(fmt::format("{}: include '{}' reaches '{}', which is already included",
+                                     file_where, include, included.string()));
+      }
       load_gates_file(included, chain, origin, gates);
     }
   }

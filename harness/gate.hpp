@@ -44,9 +44,9 @@ struct Gate {
 // does not depend on the file it sits in: `scene` and `table` are names matched against the results
 // given. InputError names the file, block and key for malformed input (unknown or missing keys,
 // wrong types, NaN bounds, min > max, a gate with neither bounds nor `equals`), an include of a
-// missing file or a pattern matching none, an include cycle, a gate name used twice (in one file or
-// across files), a file with neither gates nor includes, and a gate in a scene's folder (beside its
-// scene.toml) that names another scene.
+// missing file or a pattern matching none, an include cycle, a file included twice, a gate name
+// used twice (in one file or across files), a file with neither gates nor includes, and a gate in a
+// scene's folder (beside its scene.toml) that names another scene.
 std::vector<Gate> load_gates(const std::string& path);
 
 // A result table with where it came from. The scene and variant come from the `# scene:` and

@@ -313,6 +313,9 @@ TEST(Gate, BadIncludesAreInputErrorsNamingTheFile) {
   expect_error(root / "g.toml", "b.toml': include './g.toml' is a cycle");
   root = write_tree("self", {{"g.toml", "include = ['g.toml']\n" + gate_block("x", "")}});
   expect_error(root / "g.toml", "is a cycle");
+  root = write_tree(
+      "diamond", {{"g.toml", "include = ['a.toml', '*.toml']\n"}, {"a.toml", gate_block("a", "")}});
+  expect_error(root / "g.toml", "which is already included");
   root = write_tree("twice", {{"g.toml", "include = ['a.toml', 'b.toml']\n"},
                               {"a.toml", gate_block("same", "a")},
                               {"b.toml", gate_block("same", "b")}});
