@@ -59,10 +59,19 @@ std::vector<std::string> layout_names(const Problem& problem, bool velocities) {
   return names;
 }
 
+// The header for `problem`, spelled out up to 3 degrees of freedom ("t,q0,q1,p0,p1").
 std::string expected_header(const Problem& problem) {
   const int n = problem.dof();
-  if (problem.has(kFirstOrderOnly)) return fmt::format("t,y0,...,y{}", n - 1);
-  return fmt::format("t,q0,...,q{0},p0,...,p{0} or t,q0,...,q{0},v0,...,v{0}", n - 1);
+  const auto range = [n](const char* letter) {
+    if (n <= 3) {
+      std::vector<std::string> names;
+      for (int i = 0; i < n; ++i) names.push_back(fmt::format("{}{}", letter, i));
+      return fmt::format("{}", fmt::join(names, ","));
+    }
+    return fmt::format("{0}0,{0}1,...,{0}{1}", letter, n - 1);
+  };
+  if (problem.has(kFirstOrderOnly)) return fmt::format("t,{}", range("y"));
+  return fmt::format("t,{0},{1} or t,{0},{2}", range("q"), range("p"), range("v"));
 }
 
 std::string trim(std::string_view text) {
@@ -77,7 +86,8 @@ std::vector<std::string> split_fields(std::string_view line) {
   size_t start = 0;
   while (true) {
     const size_t comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? comma : comma - start)));
+    fields.push_back(
+        trim(line.substr(start, comma == std::string_view::npos ? comma : comma - start)));
     if (comma == std::string_view::npos) return fields;
     start = comma + 1;
   }
@@ -94,7 +104,8 @@ std::optional<double> parse_number(const std::string& text) {
 
 // The column index of `name` as geomint writes it (q3, q_3); -1 when absent.
 int column_of(const std::map<std::string, int>& columns, const std::string& letter, int i) {
-  for (const std::string& name : {fmt::format("{}{}", letter, i), fmt::format("{}_{}", letter, i)}) {
+  for (const std::string& name :
+       {fmt::format("{}{}", letter, i), fmt::format("{}_{}", letter, i)}) {
     if (auto it = columns.find(name); it != columns.end()) return it->second;
   }
   return -1;
@@ -129,8 +140,8 @@ Table read_csv(const std::string& path, const std::string& text, const Problem& 
                            at + 1, expected_header(problem)));
   }
   if (!series_problem.empty() && series_problem != problem.spec()) {
-    fail(path, fmt::format("the series was written for the problem '{}', not '{}'",
-                           series_problem, problem.spec()));
+    fail(path, fmt::format("the series was written for the problem '{}', not '{}'", series_problem,
+                           problem.spec()));
   }
   std::map<std::string, int> columns;
   for (int c = 0; c < static_cast<int>(header.size()); ++c) {
@@ -153,8 +164,8 @@ Table read_csv(const std::string& path, const std::string& text, const Problem& 
     source.push_back(c);
   };
   if (columns.count("t") == 0) {
-    fail(path, fmt::format("line {}: no column t (the header is {})", at + 1,
-                           expected_header(problem)));
+    fail(path,
+         fmt::format("line {}: no column t (the header is {})", at + 1, expected_header(problem)));
   }
   source.push_back(columns.at("t"));
   for (int i = 0; i < n; ++i) require(first_order ? "y" : "q", i);
@@ -169,8 +180,8 @@ Table read_csv(const std::string& path, const std::string& text, const Problem& 
   // line) carries energy, invariants and residuals too, which are recomputed, not read.
   if (series_problem.empty() && header.size() != source.size()) {
     for (const std::string& name : header) {
-      if (std::find_if(source.begin(), source.end(),
-                       [&](int c) { return header[c] == name; }) == source.end()) {
+      if (std::find_if(source.begin(), source.end(), [&](int c) { return header[c] == name; }) ==
+          source.end()) {
         fail(path, fmt::format("line {}: unexpected column '{}' (problem '{}': the header is {})",
                                at + 1, name, problem.spec(), expected_header(problem)));
       }
@@ -188,8 +199,8 @@ Table read_csv(const std::string& path, const std::string& text, const Problem& 
       const std::string& field = fields[source[k]];
       const std::optional<double> value = parse_number(field);
       if (!value) {
-        fail(path, fmt::format("line {}, column {}: '{}' is not a number", l + 1,
-                               header[source[k]], field));
+        fail(path, fmt::format("line {}, column {}: '{}' is not a number", l + 1, header[source[k]],
+                               field));
       }
       row.push_back(*value);
     }
@@ -212,8 +223,8 @@ Table read_npy(const std::string& path, const std::string& bytes, const Problem&
   const auto byte = [&](size_t i) { return static_cast<uint8_t>(bytes[i]); };
   const int major = byte(6);
   if (major != 1 && major != 2) {
-    fail(path, fmt::format(".npy format version {}.{} (versions 1.0 and 2.0 are read)", major,
-                           byte(7)));
+    fail(path,
+         fmt::format(".npy format version {}.{} (versions 1.0 and 2.0 are read)", major, byte(7)));
   }
   size_t header_length = 0, data_start = 0;
   if (major == 1) {
@@ -319,10 +330,10 @@ Table read_npy(const std::string& path, const std::string& bytes, const Problem&
   if (rows > static_cast<long long>(bytes.size())) fail(path, ".npy data cut short");
   const size_t data_bytes = static_cast<size_t>(rows * width) * sizeof(double);
   if (bytes.size() - data_start != data_bytes) {
-    fail(path, fmt::format(".npy data is {} bytes, the shape ({}, {}) needs {}{}",
-                           bytes.size() - data_start, rows, width, data_bytes,
-                           bytes.size() - data_start < data_bytes ? " (the file was cut short)"
-                                                                  : ""));
+    fail(path,
+         fmt::format(".npy data is {} bytes, the shape ({}, {}) needs {}{}",
+                     bytes.size() - data_start, rows, width, data_bytes,
+                     bytes.size() - data_start < data_bytes ? " (the file was cut short)" : ""));
   }
   Table table;
   table.velocities = velocities;
@@ -349,8 +360,8 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
                            bool npy_velocities) {
   const std::string bytes = read_bytes(path);
   const bool npy = ends_with(path, ".npy");
-  Table table = npy ? read_npy(path, bytes, problem, npy_velocities)
-                    : read_csv(path, bytes, problem);
+  Table table =
+      npy ? read_npy(path, bytes, problem, npy_velocities) : read_csv(path, bytes, problem);
   if (table.rows.size() < 2) {
     fail(path, fmt::format("{} data row{}: a trajectory needs the initial state and at least one "
                            "step",
@@ -365,9 +376,9 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
       }
     }
     if (r > 0 && !(row[0] > table.rows[r - 1][0])) {
-      fail(path, fmt::format("{}, column t: t = {} does not increase (the row before has {})",
-                             table.where[r], format_number(row[0]),
-                             format_number(table.rows[r - 1][0])));
+      fail(path,
+           fmt::format("{}, column t: t = {} does not increase (the row before has {})",
+                       table.where[r], format_number(row[0]), format_number(table.rows[r - 1][0])));
     }
   }
   const int n = problem.dof();
@@ -395,11 +406,11 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
   std::vector<double> expected = {initial.t};
   for (double x : initial.q) expected.push_back(x);
   if (!first_order) {
-    const Vec second = table.velocities
-                           ? (lagrangian != nullptr ? lagrangian->velocity(initial.q, initial.p)
-                                                    : Vec(problem.inverse_mass().cwiseProduct(
-                                                          initial.p)))
-                           : initial.p;
+    const Vec second =
+        table.velocities
+            ? (lagrangian != nullptr ? lagrangian->velocity(initial.q, initial.p)
+                                     : Vec(problem.inverse_mass().cwiseProduct(initial.p)))
+            : initial.p;
     for (double x : second) expected.push_back(x);
   }
   const std::vector<double>& first = table.rows.front();
@@ -418,9 +429,9 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
 }
 
 const std::vector<std::string>& score_optional_metrics() {
-  static const std::vector<std::string> names = {
-      std::string(metric::period_measured.name), std::string(metric::energy_growth_exponent.name),
-      std::string(metric::valid_time.name)};
+  static const std::vector<std::string> names = {std::string(metric::period_measured.name),
+                                                 std::string(metric::energy_growth_exponent.name),
+                                                 std::string(metric::valid_time.name)};
   return names;
 }
 
@@ -485,28 +496,28 @@ RunRecord score_trajectory(const Problem& problem, const Trajectory& trajectory,
 OrderFit score_order(const Problem& problem, const std::vector<Trajectory>& trajectories,
                      const std::vector<RunRecord>& records) {
   if (static_cast<int>(trajectories.size()) < kMinOrderLevels) {
-    throw InputError(fmt::format("score --order: {} file{} given; a fit needs at least {}, at "
-                                 "successively smaller steps",
-                                 trajectories.size(), trajectories.size() == 1 ? "" : "s",
-                                 kMinOrderLevels));
+    throw InputError(
+        fmt::format("score --order: {} file{} given; a fit needs at least {}, at "
+                    "successively smaller steps",
+                    trajectories.size(), trajectories.size() == 1 ? "" : "s", kMinOrderLevels));
   }
   std::vector<double> dts;
   const double t_last = trajectories.front().states.back().t;
   for (const Trajectory& trajectory : trajectories) {
     const double dt = trajectory.states[1].t - trajectory.states[0].t;
     if (!dts.empty() && !(dt < dts.back())) {
-      throw InputError(fmt::format("score --order: {}: its first step {} is not smaller than the "
-                                   "previous file's {} (give the files from the largest step to "
-                                   "the smallest)",
-                                   trajectory.path, format_number(dt),
-                                   format_number(dts.back())));
+      throw InputError(
+          fmt::format("score --order: {}: its first step {} is not smaller than the "
+                      "previous file's {} (give the files from the largest step to "
+                      "the smallest)",
+                      trajectory.path, format_number(dt), format_number(dts.back())));
     }
     const double t = trajectory.states.back().t;
     if (std::abs(t - t_last) > 1e-9 * std::max(1.0, std::abs(t_last))) {
-      throw InputError(fmt::format("score --order: {}: it ends at t = {}, {} at t = {} (every "
-                                   "file must end at the same time)",
-                                   trajectory.path, format_number(t), trajectories.front().path,
-                                   format_number(t_last)));
+      throw InputError(fmt::format(
+          "score --order: {}: it ends at t = {}, {} at t = {} (every "
+          "file must end at the same time)",
+          trajectory.path, format_number(t), trajectories.front().path, format_number(t_last)));
     }
     dts.push_back(dt);
   }
@@ -521,9 +532,9 @@ OrderFit score_order(const Problem& problem, const std::vector<Trajectory>& traj
   for (size_t i = 0; i < trajectories.size(); ++i) {
     const State& last = trajectories[i].states.back();
     state_scale = std::max(state_scale, std::sqrt(last.q.squaredNorm() + last.p.squaredNorm()));
-    errors.push_back(exact ? records[i].metrics.at(metric::error_final.key())
-                           : std::sqrt((last.q - finest.q).squaredNorm() +
-                                       (last.p - finest.p).squaredNorm()));
+    errors.push_back(
+        exact ? records[i].metrics.at(metric::error_final.key())
+              : std::sqrt((last.q - finest.q).squaredNorm() + (last.p - finest.p).squaredNorm()));
   }
   // Without an exact solution the finest file is the reference and has no error of its own.
   if (!exact) errors.back() = nan;

@@ -79,8 +79,8 @@ int run_score(const ScoreOptions& options, const Context& context) {
     const auto cell = [&](const std::string& key) {
       return row.count(key) ? row.at(key) : std::string("-");
     };
-    inform(context, fmt::format("{}: dt={} error_final={}", record.method, cell("dt"),
-                                cell("error_final")));
+    inform(context,
+           fmt::format("{}: dt={} error_final={}", record.method, cell("dt"), cell("error_final")));
   }
   if (!std::isfinite(fit->order)) {
     fmt::print(stderr, "{}: no order fit: {}\n", context.program, fit->note);
@@ -99,9 +99,10 @@ Verb add_score(CLI::App& app) {
       "score", "Compute the metrics of trajectories written by any program (CSV or .npy)");
   command->add_option("--problem", options->problem_spec, "problem spec the trajectories solve")
       ->required();
-  command->add_option("files", options->files,
-                      "trajectory files: CSV with header t,q0..,p0.. (or v0..), a geomint "
-                      "series, or .npy (2-D float64, columns t, q, p)")
+  command
+      ->add_option("files", options->files,
+                   "trajectory files: CSV with header t,q0..,p0.. (or v0..), a geomint "
+                   "series, or .npy (2-D float64, columns t, q, p)")
       ->required();
   command->add_option("--out", options->out_path, "write the rows here instead of stdout");
   command->add_option("--start-tol", options->start_tol,
