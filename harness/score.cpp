@@ -118,7 +118,8 @@ Table read_csv(const std::string& path, const std::string& text, const Problem& 
   }
   std::vector<std::string_view> lines;
   for (size_t start = 0; start < text.size();) {
-    const size_t end = text.find('\n', start);
+    // The text ends in '\n' (checked above), so every line has its end.
+    const size_t end = std::min(text.find('\n', start), text.size());
     std::string_view line(text.data() + start, end - start);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     lines.push_back(line);
