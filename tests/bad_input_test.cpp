@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <string>
 #include <thread>
@@ -84,6 +85,25 @@ std::string bench_json(const std::vector<double>& times_us) {
   return "{\"context\": {\"commit\": \"abc\"},\n\"benchmarks\": [\n" + rows + "\n]}\n";
 }
 const std::string kBenchJson = bench_json({10, 11, 12, 10.5, 11.5, 10.2});
+
+// A .npy file (format 1.0) with the header dict `dict` and the float64 `values` (score cases).
+std::string npy_file(const std::string& dict, const std::vector<double>& values) {
+  std::string header = dict;
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return bytes;
+}
+const std::string kPendulumNpyDict = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }";
+const std::vector<double> kPendulumRows = {0, 0.5, 0, 0.1, 0.49, 0.1};
+const std::string kPendulumNpy = npy_file(kPendulumNpyDict, kPendulumRows);
+// A valid pendulum trajectory (its default initial state θ0 = 0.5, p0 = 0) in CSV.
+const std::string kPendulumCsv = "t,q0,p0\n0,0.5,0\n0.1,0.49,-0.05\n";
+const std::string kScore = "score --problem pendulum --out {dir}/out.csv ";
 
 const std::vector<Case>& cases() {
   static const std::vector<Case> all = {
@@ -1493,6 +1513,147 @@ const std::vector<Case>& cases() {
        {},
        30,
        "GEOMINT_THREADS=257"},
+      // --- score: trajectories written by other programs (harness/score.hpp); the inputs stay,
+      // nothing else is written ---
+      {"ScoreTruncatedCsv",
+       kScore + "a.csv",
+       2,
+       "a.csv: the last line has no terminating newline",
+       {{"a.csv", "t,q0,p0\n0,0.5,0\n0.1,0.49,-0.05"}},
+       {"a.csv"}},
+      {"ScoreNanCsv",
+       kScore + "a.csv",
+       2,
+       "a.csv: line 3, column p0: nan is not a finite",
+       {{"a.csv", "t,q0,p0\n0,0.5,0\n0.1,0.49,nan\n"}},
+       {"a.csv"}},
+      {"ScoreNonMonotoneTime",
+       kScore + "a.csv",
+       2,
+       "a.csv: line 4, column t: t = 0.1 does not",
+       {{"a.csv", kPendulumCsv + "0.1,0.48,-0.1\n"}},
+       {"a.csv"}},
+      {"ScoreShortRow",
+       kScore + "a.csv",
+       2,
+       "a.csv: line 3: 2 fields, the header has 3",
+       {{"a.csv", "t,q0,p0\n0,0.5,0\n0.1,0.49\n"}},
+       {"a.csv"}},
+      {"ScoreWrongWidthForDof",
+       kScore + "a.csv",
+       2,
+       "unexpected column 'q1'",
+       {{"a.csv", "t,q0,q1,p0,p1\n0,0.5,0,0,0\n0.1,0.49,0,-0.05,0\n"}},
+       {"a.csv"}},
+      {"ScoreHeaderless",
+       kScore + "a.csv",
+       2,
+       "a.csv: line 1: no header",
+       {{"a.csv", "0,0.5,0\n0.1,0.49,-0.05\n"}},
+       {"a.csv"}},
+      {"ScoreEmptyFile",
+       kScore + "a.csv",
+       2,
+       "a.csv: the file is empty",
+       {{"a.csv", ""}},
+       {"a.csv"}},
+      {"ScoreStartOffInitialState",
+       kScore + "a.csv",
+       2,
+       "a.csv: line 2, column q0: the first row is not the initial state",
+       {{"a.csv", "t,q0,p0\n0,0.6,0\n0.1,0.49,-0.05\n"}},
+       {"a.csv"}},
+      {"ScoreStartTolNegative",
+       kScore + "--start-tol -1 a.csv",
+       2,
+       "--start-tol must be a finite number >= 0",
+       {{"a.csv", kPendulumCsv}},
+       {"a.csv"}},
+      {"ScoreOneBadFileOfTwo",
+       kScore + "good.csv bad.csv",
+       2,
+       "bad.csv: line 3, column q0",
+       {{"good.csv", kPendulumCsv}, {"bad.csv", "t,q0,p0\n0,0.5,0\n0.1,inf,0\n"}},
+       {"good.csv", "bad.csv"}},
+      {"ScoreNpyWrongDtype",
+       kScore + "a.npy",
+       2,
+       ".npy dtype '<f4'",
+       {{"a.npy",
+         npy_file("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", kPendulumRows)}},
+       {"a.npy"}},
+      {"ScoreNpyBigEndian",
+       kScore + "a.npy",
+       2,
+       ".npy dtype '>f8'",
+       {{"a.npy",
+         npy_file("{'descr': '>f8', 'fortran_order': False, 'shape': (2, 3), }", kPendulumRows)}},
+       {"a.npy"}},
+      {"ScoreNpyWrongShape",
+       kScore + "a.npy",
+       2,
+       ".npy array has 2 columns",
+       {{"a.npy",
+         npy_file("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 2), }", kPendulumRows)}},
+       {"a.npy"}},
+      {"ScoreNpyOneDimensional",
+       kScore + "a.npy",
+       2,
+       "a 2-D array",
+       {{"a.npy",
+         npy_file("{'descr': '<f8', 'fortran_order': False, 'shape': (6,), }", kPendulumRows)}},
+       {"a.npy"}},
+      {"ScoreNpyFortranOrder",
+       kScore + "a.npy",
+       2,
+       "Fortran order",
+       {{"a.npy",
+         npy_file("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 3), }", kPendulumRows)}},
+       {"a.npy"}},
+      {"ScoreNpyTruncatedData",
+       kScore + "a.npy",
+       2,
+       "the file was cut short",
+       {{"a.npy", kPendulumNpy.substr(0, kPendulumNpy.size() - 8)}},
+       {"a.npy"}},
+      {"ScoreNpyTruncatedHeader",
+       kScore + "a.npy",
+       2,
+       ".npy header cut short",
+       {{"a.npy", kPendulumNpy.substr(0, 40)}},
+       {"a.npy"}},
+      {"ScoreNpyNan",
+       kScore + "a.npy",
+       2,
+       "a.npy: row 1, column p0",
+       {{"a.npy", npy_file(kPendulumNpyDict,
+                           {0, 0.5, 0, 0.1, 0.49, std::numeric_limits<double>::quiet_NaN()})}},
+       {"a.npy"}},
+      {"ScoreNpyNoMagic",
+       kScore + "a.npy",
+       2,
+       "no \\x93NUMPY magic",
+       {{"a.npy", kPendulumCsv}},
+       {"a.npy"}},
+      {"ScoreMissingFile", kScore + "nosuch.csv", 2, "nosuch.csv: cannot be read"},
+      {"ScoreMethodMetric",
+       kScore + "--metric symplecticity_defect a.csv",
+       2,
+       "a trajectory alone gives only",
+       {{"a.csv", kPendulumCsv}},
+       {"a.csv"}},
+      {"ScoreOrderTooFewFiles",
+       kScore + "--order a.csv b.csv",
+       2,
+       "a fit needs at least 3",
+       {{"a.csv", kPendulumCsv}, {"b.csv", kPendulumCsv}},
+       {"a.csv", "b.csv"}},
+      {"ScoreSeriesOfAnotherProblem",
+       kScore + "a.csv",
+       2,
+       "written for the problem 'harmonic",
+       {{"a.csv", "# problem: harmonic:mass=1,omega=1,q0=1,v0=0\n" + kPendulumCsv}},
+       {"a.csv"}},
   };
   return all;
 }

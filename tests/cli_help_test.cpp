@@ -3,7 +3,7 @@
 // After an intended change of a help text, regenerate the golden files from the new binary:
 //   mkdir -p /tmp/gbin && ln -sf "$PWD/build/geomint" /tmp/gbin/geomint &&
 //   PATH=/tmp/gbin:$PATH geomint --help > tests/golden/help/geomint.txt &&
-//   for v in list run order sweep merge slurm reference modes gate report perf-compare; do
+//   for v in list run order score sweep merge slurm reference modes gate report perf-compare; do
 //     PATH=/tmp/gbin:$PATH geomint $v --help > tests/golden/help/$v.txt; done
 // (CLI11 prints argv[0] in its Usage line, so the program runs as plain `geomint`, via PATH).
 #include <gtest/gtest.h>
