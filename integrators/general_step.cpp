@@ -1,22 +1,23 @@
 // DEL α-rule and implicit midpoint steps on the general Lagrangian kind (docs/MECHANICS_GENERAL.md
 // §2–3; ../shared/MECHANICS.md §2). The step Jacobians are not symmetric (α L_vq − (1−α) L_qv),
-// so Newton factorises them with Eigen's PartialPivLU (dense: these problems have a few dof).
+// so each step's equation goes to dense_newton (integrators/dense_newton.hpp: Eigen's
+// PartialPivLU, these problems have a few dof); this file supplies R, J and the stopping test.
 #include "integrators/general_step.hpp"
 
 #include <fmt/format.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <vector>
+
+#include "integrators/dense_newton.hpp"
 
 namespace geomint {
 namespace {
 
 bool finite(const Vec& x) { return x.allFinite(); }
 
-// ‖x‖∞ without the NaN-swallowing of max over an empty vector.
-double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
+double inf_norm(const Vec& x) { return dense_inf_norm(x); }
 
 }  // namespace
 
@@ -34,57 +35,38 @@ StepStatus general_del_step(const LagrangianSystem& system, State& state, double
   const Vec q0 = state.q;
   const Vec p0 = state.p;
   Vec v = system.velocity(q0, p0);
-  Vec L_q, residual;
-  DenseMatrix M, L_vq, L_qq, jacobian;
-  // R(v) = L_v(q̄, v) − h(1−α)L_q(q̄, v) − p₀ at q̄ = q₀ + αh v; returns the size of its terms.
-  const auto evaluate = [&](const Vec& velocity) {
+  Vec L_q;
+  DenseMatrix M, L_vq, L_qq;
+  double scale = 0;  // the size of R's terms at the last evaluated v
+  DenseNewtonSystem equation;
+  // R(v) = L_v(q̄, v) − h(1−α)L_q(q̄, v) − p₀ at q̄ = q₀ + αh v.
+  equation.residual = [&](const Vec& velocity, Vec& residual) {
     const Vec q_bar = q0 + (alpha * h) * velocity;
     system.lagrangian_q(q_bar, velocity, L_q);
     ++counters.force_evals;
     const Vec p_bar = system.momentum(q_bar, velocity);
     residual = p_bar - (h * (1 - alpha)) * L_q - p0;
-    return inf_norm(p_bar) + std::abs(h) * inf_norm(L_q) + inf_norm(p0);
+    scale = inf_norm(p_bar) + std::abs(h) * inf_norm(L_q) + inf_norm(p0);
+  };
+  equation.converged = [&](const Vec& residual, double floor) {
+    return inf_norm(residual) <= floor * scale;
   };
   // ∂R/∂v = L_vv + hα L_vq − h(1−α) L_qv − h²α(1−α) L_qq (h times ∂R/∂q₁ of MECHANICS.md §2).
-  const auto factorise = [&](const Vec& velocity) {
+  equation.jacobian = [&](const Vec& velocity, DenseMatrix& jacobian) {
     const Vec q_bar = q0 + (alpha * h) * velocity;
     system.mass_matrix(q_bar, M);
     system.lagrangian_vq(q_bar, velocity, L_vq);
     system.lagrangian_qq(q_bar, velocity, L_qq);
     jacobian = M + (h * alpha) * L_vq - (h * (1 - alpha)) * L_vq.transpose() -
                (h * h * alpha * (1 - alpha)) * L_qq;
-    ++counters.factorizations;
-    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
   };
-  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
-  for (int iteration = 0;; ++iteration) {
-    const double scale = evaluate(v);
-    if (!finite(residual)) return StepStatus::failure("nan", "general del: non-finite residual");
-    if (inf_norm(residual) <= floor * scale) {
-      // One more correction with a fresh LU, kept only if it lowers ‖R‖: the momentum maps of a
-      // variational step are exact only for the exact solve (discrete Noether), so p_φ wants the
-      // residual at its round-off floor, not at the tolerance.
-      const Vec before = residual;
-      const Vec polished = v - factorise(v).solve(residual);
-      ++counters.linear_solves;
-      evaluate(polished);
-      if (finite(residual) && inf_norm(residual) < inf_norm(before)) {
-        v = polished;
-      } else {
-        evaluate(v);
-      }
-      break;
-    }
-    if (iteration == newton.max_iterations) {
-      return StepStatus::failure(
-          "newton_max_iter",
-          fmt::format("general del: |R| = {:.3g} after {} Newton iterations (tol {:.3g})",
-                      inf_norm(residual), iteration, newton.tolerance));
-    }
-    v -= factorise(v).solve(residual);
-    ++counters.linear_solves;
-    ++counters.newton_iters;
-  }
+  // The momentum maps of a variational step are exact only for the exact solve (discrete
+  // Noether), so p_φ wants the residual at its round-off floor (the polish), and L_q below must
+  // be that of the accepted v.
+  equation.reevaluate_after_rejected_polish = true;
+  equation.method = "general del";
+  const StepStatus status = dense_newton(equation, v, newton, counters);
+  if (!status.ok) return status;
   const Vec q_bar = q0 + (alpha * h) * v;
   state.p = system.momentum(q_bar, v) + (h * alpha) * L_q;  // L_q is at the accepted v
   state.q = q0 + h * v;
@@ -102,11 +84,11 @@ StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State&
   Vec z0(2 * n);
   z0 << state.q, state.p;
   Vec z = z0;  // the midpoint z̄, started at z₀
-  Vec f(2 * n), residual(2 * n), L_q;
-  DenseMatrix field_jacobian, jacobian;
+  Vec f(2 * n), L_q;
   // R(z̄) = z̄ − z₀ − (h/2) f(z̄), block-wise scales for the q and p rows (different units).
   double q_scale = 0, p_scale = 0;
-  const auto evaluate = [&](const Vec& midpoint) {
+  DenseNewtonSystem equation;
+  equation.residual = [&](const Vec& midpoint, Vec& residual) {
     const Vec q = midpoint.head(n);
     const Vec v = system.velocity(q, midpoint.tail(n));
     system.lagrangian_q(q, v, L_q);
@@ -116,40 +98,18 @@ StepStatus general_implicit_midpoint_step(const LagrangianSystem& system, State&
     q_scale = inf_norm(z0.head(n)) + std::abs(h) * inf_norm(v);
     p_scale = inf_norm(z0.tail(n)) + std::abs(h) * inf_norm(L_q);
   };
-  const auto converged = [&](double floor) {
+  equation.converged = [&](const Vec& residual, double floor) {
     return inf_norm(residual.head(n)) <= floor * q_scale &&
            inf_norm(residual.tail(n)) <= floor * p_scale;
   };
-  const auto factorise = [&](const Vec& midpoint) {
+  DenseMatrix field_jacobian;
+  equation.jacobian = [&](const Vec& midpoint, DenseMatrix& jacobian) {
     system.hamiltonian_vector_field_jacobian(midpoint.head(n), midpoint.tail(n), field_jacobian);
     jacobian = DenseMatrix::Identity(2 * n, 2 * n) - (h / 2) * field_jacobian;
-    ++counters.factorizations;
-    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
   };
-  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
-  for (int iteration = 0;; ++iteration) {
-    evaluate(z);
-    if (!finite(residual)) {
-      return StepStatus::failure("nan", "general implicit midpoint: non-finite residual");
-    }
-    if (converged(floor)) {
-      const Vec before = residual;
-      const Vec polished = z - factorise(z).solve(residual);
-      ++counters.linear_solves;
-      evaluate(polished);
-      if (finite(residual) && inf_norm(residual) < inf_norm(before)) z = polished;
-      break;
-    }
-    if (iteration == newton.max_iterations) {
-      return StepStatus::failure(
-          "newton_max_iter",
-          fmt::format("general implicit midpoint: |R| = {:.3g} after {} Newton iterations",
-                      inf_norm(residual), iteration));
-    }
-    z -= factorise(z).solve(residual);
-    ++counters.linear_solves;
-    ++counters.newton_iters;
-  }
+  equation.method = "general implicit midpoint";
+  const StepStatus status = dense_newton(equation, z, newton, counters);
+  if (!status.ok) return status;
   const Vec z1 = 2 * z - z0;
   state.q = z1.head(n);
   state.p = z1.tail(n);
@@ -170,10 +130,10 @@ StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& st
   Vec z(2 * n * s);
   for (long i = 0; i < s; ++i) z.segment(2 * n * i, 2 * n) << q0, p0;
   std::vector<Vec> velocities(s), forces(s);  // v(Q_j, P_j) and L_q(Q_j, v_j)
-  Vec residual(2 * n * s);
-  DenseMatrix field_jacobian, jacobian(2 * n * s, 2 * n * s);
+  DenseMatrix field_jacobian;
   double q_scale = 0, p_scale = 0;
-  const auto evaluate = [&](const Vec& stages) {
+  DenseNewtonSystem equation;
+  equation.residual = [&](const Vec& stages, Vec& residual) {
     double largest_v = 0, largest_force = 0;
     for (long j = 0; j < s; ++j) {
       const Vec Q = stages.segment(2 * n * j, n);
@@ -183,6 +143,7 @@ StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& st
       largest_v = std::max(largest_v, inf_norm(velocities[j]));
       largest_force = std::max(largest_force, inf_norm(forces[j]));
     }
+    residual.resize(2 * n * s);
     for (long i = 0; i < s; ++i) {
       Vec q_row = stages.segment(2 * n * i, n) - q0;
       Vec p_row = stages.segment(2 * n * i + n, n) - p0;
@@ -195,7 +156,7 @@ StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& st
     q_scale = inf_norm(q0) + std::abs(h) * largest_v;
     p_scale = inf_norm(p0) + std::abs(h) * largest_force;
   };
-  const auto converged = [&](double floor) {
+  equation.converged = [&](const Vec& residual, double floor) {
     for (long i = 0; i < s; ++i) {
       if (inf_norm(residual.segment(2 * n * i, n)) > floor * q_scale) return false;
       if (inf_norm(residual.segment(2 * n * i + n, n)) > floor * p_scale) return false;
@@ -203,7 +164,8 @@ StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& st
     return true;
   };
   // ∂R_i/∂(Q_j, P_j) = δ_ij I − h diag(a_ij I, â_ij I) J_j, J_j the field Jacobian at stage j.
-  const auto factorise = [&](const Vec& stages) {
+  equation.jacobian = [&](const Vec& stages, DenseMatrix& jacobian) {
+    jacobian.resize(2 * n * s, 2 * n * s);
     jacobian.setIdentity();
     for (long j = 0; j < s; ++j) {
       system.hamiltonian_vector_field_jacobian(stages.segment(2 * n * j, n),
@@ -214,37 +176,12 @@ StepStatus general_partitioned_rk_step(const LagrangianSystem& system, State& st
             (h * a_hat(i, j)) * field_jacobian.bottomRows(n);
       }
     }
-    ++counters.factorizations;
-    return Eigen::PartialPivLU<DenseMatrix>(jacobian);
   };
-  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
-  for (int iteration = 0;; ++iteration) {
-    evaluate(z);
-    if (!finite(residual)) {
-      return StepStatus::failure("nan", "general partitioned RK: non-finite residual");
-    }
-    if (converged(floor)) {
-      const Vec before = residual;
-      const Vec polished = z - factorise(z).solve(residual);
-      ++counters.linear_solves;
-      evaluate(polished);
-      if (finite(residual) && inf_norm(residual) < inf_norm(before)) {
-        z = polished;
-      } else {
-        evaluate(z);  // the stage velocities and forces of the accepted z
-      }
-      break;
-    }
-    if (iteration == newton.max_iterations) {
-      return StepStatus::failure(
-          "newton_max_iter",
-          fmt::format("general partitioned RK: |R| = {:.3g} after {} Newton iterations",
-                      inf_norm(residual), iteration));
-    }
-    z -= factorise(z).solve(residual);
-    ++counters.linear_solves;
-    ++counters.newton_iters;
-  }
+  // The update below reads the stage velocities and forces of the accepted z.
+  equation.reevaluate_after_rejected_polish = true;
+  equation.method = "general partitioned RK";
+  const StepStatus status = dense_newton(equation, z, newton, counters);
+  if (!status.ok) return status;
   for (long j = 0; j < s; ++j) {
     state.q += (h * b[j]) * velocities[j];
     state.p += (h * b[j]) * forces[j];

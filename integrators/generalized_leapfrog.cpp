@@ -3,10 +3,10 @@
 // implicit in p½ and q₁ unless H is separable, where it is Störmer–Verlet.
 #include <fmt/format.h>
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
+#include "integrators/dense_newton.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
@@ -14,48 +14,7 @@
 namespace geomint {
 namespace {
 
-double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
-
-Eigen::PartialPivLU<DenseMatrix> factorise(const DenseMatrix& jacobian, Counters& counters) {
-  ++counters.factorizations;
-  return Eigen::PartialPivLU<DenseMatrix>(jacobian);
-}
-
-// Newton on R(x) = 0 from x, converged when ‖R‖∞ ≤ floor·(the size of R's terms), then one
-// polishing correction kept only if it lowers ‖R‖ (symplecticity, like discrete Noether for
-// the variational steps, holds for the exact solve, not to the tolerance).
-template <class Residual, class Jacobian>
-StepStatus solve(Vec& x, const Residual& residual_of, const Jacobian& jacobian_of, double floor,
-                 const char* unknown, const GeneralNewtonSettings& newton, Counters& counters) {
-  double scale = 0;
-  Vec residual = residual_of(x, scale);
-  for (int iteration = 0;; ++iteration) {
-    if (!residual.allFinite()) {
-      return StepStatus::failure(
-          "nan", fmt::format("generalized_leapfrog: non-finite residual for {}", unknown));
-    }
-    if (inf_norm(residual) <= floor * scale) break;
-    if (iteration == newton.max_iterations) {
-      return StepStatus::failure(
-          "newton_max_iter",
-          fmt::format("generalized_leapfrog: |R({})| = {:.3g} after {} Newton iterations (tol "
-                      "{:.3g})",
-                      unknown, inf_norm(residual), iteration, newton.tolerance));
-    }
-    x -= factorise(jacobian_of(x), counters).solve(residual);
-    ++counters.linear_solves;
-    ++counters.newton_iters;
-    residual = residual_of(x, scale);
-  }
-  const Vec polished = x - factorise(jacobian_of(x), counters).solve(residual);
-  ++counters.linear_solves;
-  double polished_scale = 0;
-  const Vec polished_residual = residual_of(polished, polished_scale);
-  if (polished_residual.allFinite() && inf_norm(polished_residual) < inf_norm(residual)) {
-    x = polished;
-  }
-  return StepStatus::success();
-}
+double inf_norm(const Vec& x) { return dense_inf_norm(x); }
 
 }  // namespace
 
@@ -63,8 +22,9 @@ StepStatus solve(Vec& x, const Residual& residual_of, const Jacobian& jacobian_o
 //   1. p½ = p₀ + (h/2) L_q(q₀, v(q₀, p½))                    Newton, J = I − (h/2) ∂L_q/∂p
 //   2. q₁ = q₀ + (h/2)[v(q₀, p½) + v(q₁, p½)]               Newton, J = I − (h/2) ∂v/∂q
 //   3. p₁ = p½ + (h/2) L_q(q₁, v(q₁, p½))                    explicit
-// Both Jacobians are blocks of hamiltonian_vector_field_jacobian and are not symmetric, so each
-// Newton step factorises with a partially pivoted LU (dense: these problems have a few dof). On
+// Both Jacobians are blocks of hamiltonian_vector_field_jacobian and are not symmetric; each
+// equation goes to dense_newton (integrators/dense_newton.hpp: partially pivoted LU, a polishing
+// correction kept only if it lowers ‖R‖, since symplecticity holds for the exact solve). On
 // a separable problem v = M⁻¹p and L_q = −∇V(q) do not couple, both solves are explicit, and the
 // step is Störmer–Verlet's kick–drift–kick (the method computes it as such, no Hessian needed).
 StepStatus general_leapfrog_step(const LagrangianSystem& system, State& state, double h,
@@ -72,9 +32,13 @@ StepStatus general_leapfrog_step(const LagrangianSystem& system, State& state, d
   const long n = state.q.size();
   const Vec q0 = state.q;
   const Vec p0 = state.p;
-  const double floor = std::max(newton.tolerance, 16 * 2.220446049250313e-16);
   Vec L_q;
   DenseMatrix field_jacobian;
+  // Both equations stop at ‖R‖∞ ≤ floor·(the size of R's terms), `scale` as of the last R.
+  double scale = 0;
+  const auto converged = [&](const Vec& residual, double floor) {
+    return inf_norm(residual) <= floor * scale;
+  };
 
   // 1. p½: R(P) = P − p₀ − (h/2) L_q(q₀, v(q₀, P)).
   Vec p_half = p0;
@@ -83,37 +47,39 @@ StepStatus general_leapfrog_step(const LagrangianSystem& system, State& state, d
     ++counters.force_evals;
     return Vec((h / 2) * L_q);
   };
-  StepStatus status = solve(
-      p_half,
-      [&](const Vec& P, double& scale) {
-        const Vec kick = half_kick(q0, P);
-        scale = inf_norm(P) + inf_norm(p0) + inf_norm(kick);
-        return Vec(P - p0 - kick);
-      },
-      [&](const Vec& P) {
-        system.hamiltonian_vector_field_jacobian(q0, P, field_jacobian);
-        return DenseMatrix(DenseMatrix::Identity(n, n) -
-                           (h / 2) * field_jacobian.bottomRightCorner(n, n));
-      },
-      floor, "p_half", newton, counters);
+  DenseNewtonSystem kick_equation;
+  kick_equation.residual = [&](const Vec& P, Vec& residual) {
+    const Vec kick = half_kick(q0, P);
+    scale = inf_norm(P) + inf_norm(p0) + inf_norm(kick);
+    residual = P - p0 - kick;
+  };
+  kick_equation.converged = converged;
+  kick_equation.jacobian = [&](const Vec& P, DenseMatrix& jacobian) {
+    system.hamiltonian_vector_field_jacobian(q0, P, field_jacobian);
+    jacobian = DenseMatrix::Identity(n, n) - (h / 2) * field_jacobian.bottomRightCorner(n, n);
+  };
+  kick_equation.method = "generalized_leapfrog";
+  kick_equation.unknown = "p_half";
+  StepStatus status = dense_newton(kick_equation, p_half, newton, counters);
   if (!status.ok) return status;
 
   // 2. q₁: R(Q) = Q − q₀ − (h/2)[v(q₀, p½) + v(Q, p½)].
   const Vec start_drift = (h / 2) * system.velocity(q0, p_half);
   Vec q1 = q0 + 2 * start_drift;
-  status = solve(
-      q1,
-      [&](const Vec& Q, double& scale) {
-        const Vec end_drift = (h / 2) * system.velocity(Q, p_half);
-        scale = inf_norm(Q) + inf_norm(q0) + inf_norm(start_drift) + inf_norm(end_drift);
-        return Vec(Q - q0 - start_drift - end_drift);
-      },
-      [&](const Vec& Q) {
-        system.hamiltonian_vector_field_jacobian(Q, p_half, field_jacobian);
-        return DenseMatrix(DenseMatrix::Identity(n, n) -
-                           (h / 2) * field_jacobian.topLeftCorner(n, n));
-      },
-      floor, "q1", newton, counters);
+  DenseNewtonSystem drift_equation;
+  drift_equation.residual = [&](const Vec& Q, Vec& residual) {
+    const Vec end_drift = (h / 2) * system.velocity(Q, p_half);
+    scale = inf_norm(Q) + inf_norm(q0) + inf_norm(start_drift) + inf_norm(end_drift);
+    residual = Q - q0 - start_drift - end_drift;
+  };
+  drift_equation.converged = converged;
+  drift_equation.jacobian = [&](const Vec& Q, DenseMatrix& jacobian) {
+    system.hamiltonian_vector_field_jacobian(Q, p_half, field_jacobian);
+    jacobian = DenseMatrix::Identity(n, n) - (h / 2) * field_jacobian.topLeftCorner(n, n);
+  };
+  drift_equation.method = "generalized_leapfrog";
+  drift_equation.unknown = "q1";
+  status = dense_newton(drift_equation, q1, newton, counters);
   if (!status.ok) return status;
 
   // 3. p₁ = p½ + (h/2) L_q(q₁, v(q₁, p½)).
