@@ -26,10 +26,10 @@ StepStatus dense_newton(const DenseNewtonSystem& system, Vec& x,
   for (int iteration = 0;; ++iteration) {
     system.residual(x, residual);
     if (!residual.allFinite()) {
-      return StepStatus::failure(
-          "nan", system.unknown.empty()
-                     ? fmt::format("{}: non-finite residual", system.method)
-                     : fmt::format("{}: non-finite residual for {}", system.method, system.unknown));
+      return StepStatus::failure("nan", system.unknown.empty()
+                                            ? fmt::format("{}: non-finite residual", system.method)
+                                            : fmt::format("{}: non-finite residual for {}",
+                                                          system.method, system.unknown));
     }
     if (system.converged(residual, floor)) break;
     if (iteration == newton.max_iterations) {

@@ -136,7 +136,12 @@ LinearSolverOptions read_linear_solver_option(Params& params) {
   return options;
 }
 
-struct NewtonSolver::Factorisation {
+namespace {
+
+// The linear algebra of a NewtonSolver, kept across solves (NewtonSolver::Factorisation is this;
+// NewtonRun below works on it): one factorisation (or CG preconditioner) of the Newton matrix
+// for each LinearSolverKind, its pattern for symbolic reuse, and the AMG refresh state.
+struct LinearFactorisation {
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
   MetisLdlt ldlt_metis;
   Eigen::CholmodSupernodalLLT<SparseMatrix> cholmod;
@@ -151,7 +156,7 @@ struct NewtonSolver::Factorisation {
   double amg_baseline_iterations = -1;
   bool amg_refresh = false;
   double amg_refresh_growth = 2.0;
-  // Counters of the solve in progress (set by NewtonSolver::solve).
+  // Counters of the solve in progress (set by NewtonRun::start).
   int* factorizations_counter = nullptr;
   int* amg_setups_counter = nullptr;
   int* cg_iterations_counter = nullptr;
@@ -186,7 +191,7 @@ struct NewtonSolver::Factorisation {
   std::vector<SparseMatrix::StorageIndex> outer;
   std::vector<SparseMatrix::StorageIndex> inner;
 
-  Factorisation() {
+  LinearFactorisation() {
     // METIS nested dissection only (CHOLMOD's default also tries AMD and keeps the sparser
     // factor: on a 3-D mesh METIS wins and the extra analysis is wasted); no messages on stderr —
     // a non-positive-definite matrix is an expected outcome here (the SPD safeguard).
@@ -415,6 +420,10 @@ struct NewtonSolver::Factorisation {
   }
 };
 
+}  // namespace
+
+struct NewtonSolver::Factorisation : LinearFactorisation {};
+
 NewtonOptions read_newton_options(Params& params, const std::string& residual_scale) {
   NewtonOptions options;
   options.tolerance = params.real(
@@ -576,304 +585,415 @@ NewtonProfile newton_profile() {
   return profile;
 }
 
-NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
-  NewtonResult result;
-  const SolveProfile profile(result);
-  const double relative_tolerance = std::max(options_.tolerance, kRoundoffFloor);
-  result.threshold = std::max(relative_tolerance * residual_scale, kSubnormalResidual);
-  double scale = residual_scale;
-  Factorisation& f = *factorisation_;
-  f.factorizations_counter = &result.factorizations;
-  f.amg_setups_counter = &result.amg_setups;
-  f.cg_iterations_counter = &result.cg_iterations;
-  f.amg_refresh_growth = options_.linear.amg_refresh_growth;
+namespace {
 
-  Vec residual;
-  auto evaluate = [&](const Vec& at, Vec& r) {
-    ++result.residual_evals;
-    const PhaseTimer timer(profile_totals().residual_ns);
-    system.residual(at, r);
-    if (r.size() != at.size()) {
-      throw std::logic_error(
-          fmt::format("Newton residual has size {} for {} unknowns", r.size(), at.size()));
+// One call of NewtonSolver::solve, split into its phases. Each phase updates the shared state
+// below and the NewtonResult; NewtonSolver::solve strings them together:
+//   start()                              R(x₀), scale, merit, linear solver, reuse of a held factor
+//   loop: converged test → polish()      (NewtonOptions::polish)
+//         iteration cap   → fail()
+//         iterate():  held_direction() or assemble() + newton_direction() [+ shifted_direction()]
+//                     roundoff_step()    (converged when the correction is below x's rounding)
+//                     descent_check()    (objective form)
+//                     line_search() → accept_step()
+// The order of every evaluation, comparison and counter update is that of the single loop the
+// phases were cut from, so results and work counters are bit for bit those of before.
+class NewtonRun {
+ public:
+  NewtonRun(const NewtonSystem& system, const NewtonOptions& options, LinearFactorisation& f,
+            Vec& x, NewtonResult& result, double residual_scale)
+      : system_(system),
+        options_(options),
+        f_(f),
+        x_(x),
+        result_(result),
+        residual_scale_(residual_scale),
+        relative_tolerance_(std::max(options.tolerance, kRoundoffFloor)),
+        scale_(residual_scale),
+        modified_(options.linear.modified_newton) {}
+
+  // Evaluates R(x₀), fixes the stopping threshold (with NewtonSystem::scale_after_first_residual),
+  // the merit's unit and value, the linear solver kind, and whether the first direction may come
+  // from the factorisation a previous solve left (modified Newton). False (result failed: "nan",
+  // "objective_overflow") when x₀ is already unusable; throws on a wrongly sized R or SPD shift.
+  bool start() {
+    result_.threshold = std::max(relative_tolerance_ * residual_scale_, kSubnormalResidual);
+    f_.factorizations_counter = &result_.factorizations;
+    f_.amg_setups_counter = &result_.amg_setups;
+    f_.cg_iterations_counter = &result_.cg_iterations;
+    f_.amg_refresh_growth = options_.linear.amg_refresh_growth;
+
+    evaluate(x_, residual_);
+    if (system_.scale_after_first_residual) {
+      scale_ = residual_scale_ + system_.scale_after_first_residual();
+      result_.threshold = std::max(relative_tolerance_ * scale_, kSubnormalResidual);
     }
-  };
-  // Merit of a finite residual: the objective when the system has one, else ½‖R‖² in units of
-  // the power of two nearest the residual scale (merit_unit), so that it neither underflows for a
-  // state of size 1e-300 nor overflows for 1e+150; merits and slopes are only compared with each
-  // other, and scaling by 2ᵏ keeps every comparison bit for bit.
-  double merit_unit = 1.0;
-  auto merit_of = [&](const Vec& at, const Vec& r) {
-    if (!system.objective) return 0.5 * (merit_unit * r).squaredNorm();
-    profile_totals().objectives.fetch_add(1, std::memory_order_relaxed);
-    const PhaseTimer timer(profile_totals().objective_ns);
-    return system.objective(at);
-  };
-  auto fail = [&](const char* reason) {
-    result.reason = reason;
-    f.keep_factor = false;
-    return result;
-  };
+    merit_unit_ = power_of_two_unit(scale_);
+    result_.residual_norm = robust_norm(residual_);
+    if (options_.record_history) result_.residual_history.push_back(result_.residual_norm);
+    if (!all_finite(residual_)) return fail_with("nan");
+    merit_ = merit_of(x_, residual_);
+    // An objective is an energy, quadratic in the state: it overflows for a state above ~1e154
+    // where the residual (linear in it) is still finite. Say so rather than "nan".
+    if (system_.objective && std::isinf(merit_)) return fail_with("objective_overflow");
+    if (!std::isfinite(merit_)) return fail_with("nan");
 
-  evaluate(x, residual);
-  if (system.scale_after_first_residual) {
-    scale = residual_scale + system.scale_after_first_residual();
-    result.threshold = std::max(relative_tolerance * scale, kSubnormalResidual);
+    safeguard_ = system_.symmetric && system_.objective && system_.spd_shift.size() > 0;
+    if (safeguard_ &&
+        (system_.spd_shift.rows() != x_.size() || system_.spd_shift.cols() != x_.size())) {
+      throw std::logic_error(fmt::format("Newton SPD shift is {}x{} for {} unknowns",
+                                         system_.spd_shift.rows(), system_.spd_shift.cols(),
+                                         x_.size()));
+    }
+    f_.kind = resolve_linear_solver(options_.linear.kind, x_.size());
+    // Modified Newton: the direction comes from a factorisation of an earlier Jacobian (of this
+    // solve, or of the last one when it ended contracting fast).
+    reuse_factor_ = modified_ && f_.keep_factor && f_.has_factor && f_.rows == x_.size() &&
+                    f_.pattern_symmetric == system_.symmetric;
+    // The threshold's inner-term part comes with a Jacobian evaluation; a solve that starts on
+    // the held matrix takes it from the iterate that matrix was evaluated at (its Hessian is the
+    // one held), so reusing a matrix does not tighten the stopping test below the round-off of R.
+    if (reuse_factor_ && system_.inner_term_scale && std::isfinite(f_.held_inner_term_scale)) {
+      result_.threshold =
+          std::max({relative_tolerance_ * scale_,
+                    kRoundoffFloor * (scale_ + f_.held_inner_term_scale), kSubnormalResidual});
+    }
+    return true;
   }
-  merit_unit = power_of_two_unit(scale);
-  result.residual_norm = robust_norm(residual);
-  if (options_.record_history) result.residual_history.push_back(result.residual_norm);
-  if (!all_finite(residual)) return fail("nan");
-  double merit = merit_of(x, residual);
-  // An objective is an energy, quadratic in the state: it overflows for a state above ~1e154
-  // where the residual (linear in it) is still finite. Say so rather than "nan".
-  if (system.objective && std::isinf(merit)) return fail("objective_overflow");
-  if (!std::isfinite(merit)) return fail("nan");
 
-  const bool safeguard = system.symmetric && system.objective && system.spd_shift.size() > 0;
-  if (safeguard && (system.spd_shift.rows() != x.size() || system.spd_shift.cols() != x.size())) {
-    throw std::logic_error(fmt::format("Newton SPD shift is {}x{} for {} unknowns",
-                                       system.spd_shift.rows(), system.spd_shift.cols(), x.size()));
+  // Called once ‖R‖ ≤ threshold: marks the result converged, lets a modified-Newton factor
+  // outlive the solve, and with NewtonOptions::polish takes one more correction from the held
+  // factorisation, kept only if it lowers ‖R‖ (never after zero iterations: no factor is of
+  // this system then).
+  void polish() {
+    result_.converged = true;
+    f_.keep_factor = reuse_factor_;
+    if (!(options_.polish && result_.iterations > 0 && f_.has_factor)) return;
+    if (!solve_held(-residual_, direction_)) return;
+    trial_ = x_ + direction_;
+    evaluate(trial_, trial_residual_);
+    const double polished_norm = robust_norm(trial_residual_);
+    if (all_finite(trial_residual_) && polished_norm < result_.residual_norm) {
+      x_.swap(trial_);
+      result_.residual_norm = polished_norm;
+      result_.polished = true;
+      if (options_.record_history) result_.residual_history.push_back(polished_norm);
+    }
   }
 
-  Vec direction, trial, trial_residual;
-  f.kind = resolve_linear_solver(options_.linear.kind, x.size());
-  // Modified Newton applies to CG as well: CG then iterates on the held Newton matrix (of an
-  // earlier iterate or step), so the Hessian is not reassembled while the residual contracts fast.
-  const bool modified = options_.linear.modified_newton;
-  // Inexact Newton: the CG iteration stops at forcing·‖R‖ (forcing terms: kFirstForcing, then
-  // Eisenstat–Walker's, updated after every accepted step below) and below the threshold (the
-  // last correction does not leave an error the stopping test would see). The stopping test on R
-  // itself is unchanged, so it alone decides convergence. Direct solvers ignore the target.
-  double forcing = kFirstForcing;
-  auto set_cg_target = [&] {
-    f.cg_target = std::max(0.1 * result.threshold, forcing * result.residual_norm);
-  };
-  // Solves J d = −R with the held factorisation (or CG on the held matrix).
-  auto solve_held = [&](const Vec& rhs, Vec& out) {
-    set_cg_target();
-    bool negative_curvature = false;
-    return f.solve(system.symmetric, rhs, out, negative_curvature) && all_finite(out);
-  };
-  // Factorises f.jacobian and solves for the Newton direction. The SPD safeguard shifts J when
-  // the solver finds it not positive definite (a non-positive LDLT pivot, CHOLMOD's
-  // NumericalIssue, CG's curvature test); without the safeguard the SPD-only solvers fall back to
-  // an LDLT of J, the plain Newton step.
-  auto newton_direction = [&]() -> bool {
-    ++result.linear_solves;
-    set_cg_target();
-    bool negative_curvature = false;
-    bool factorised = f.factorise(f.jacobian, system.symmetric, options_.reuse_symbolic,
-                                  result.symbolic_analyses, result.factorizations);
-    // Only the safeguard needs J positive definite; LDLT solves indefinite systems as well.
-    bool solved = false;
-    if (factorised && (!safeguard || f.positive_definite())) {
-      solved = f.solve(system.symmetric, -residual, direction, negative_curvature);
-    }
-    if (solved) return all_finite(direction);
-    if (safeguard) {
-      // J is not positive definite (or singular): shift it towards S until it is. J + μS has the
-      // pattern of J when S's pattern is contained in it (M diagonal, J with a full diagonal), so
-      // the symbolic factorisation is reused.
-      ++result.shifted_iterations;
-      const SparseMatrix unshifted = f.jacobian;
-      // Start one growth step below the last successful shift of this solve: consecutive
-      // iterates usually need a similar μ, and the schedule then costs one or two factorisations.
-      double mu =
-          std::max(options_.spd_shift_initial, result.last_shift / options_.spd_shift_growth);
-      for (int attempt = 0; attempt < options_.max_spd_shifts && !solved;
-           ++attempt, mu *= options_.spd_shift_growth) {
-        f.jacobian = unshifted + mu * system.spd_shift;
-        ++result.shift_factorisations;
-        if (!(f.factorise(f.jacobian, true, options_.reuse_symbolic, result.symbolic_analyses,
-                          result.factorizations) &&
-              f.positive_definite())) {
-          continue;
-        }
-        solved = f.solve(true, -residual, direction, negative_curvature);
-        if (solved) result.last_shift = mu;
-        if (!solved && !negative_curvature) break;  // CG did not converge: shifting won't help
-      }
-      if (solved) return all_finite(direction);
-      f.has_factor = false;
-      return false;
-    }
-    if (system.symmetric && !safeguard && f.kind != LinearSolverKind::kLdlt &&
-        f.kind != LinearSolverKind::kLdltMetis && f.factorise_indefinite(result.factorizations)) {
-      solved = f.solve(true, -residual, direction, negative_curvature);
-      return solved && all_finite(direction);
-    }
-    f.has_factor = false;
-    return false;
-  };
-  // Modified Newton: the direction comes from a factorisation of an earlier Jacobian (of this
-  // solve, or of the last one when it ended contracting fast).
-  bool reuse_factor = modified && f.keep_factor && f.has_factor && f.rows == x.size() &&
-                      f.pattern_symmetric == system.symmetric;
-  // The threshold's inner-term part comes with a Jacobian evaluation; a solve that starts on the
-  // held matrix takes it from the iterate that matrix was evaluated at (its Hessian is the one
-  // held), so reusing a matrix does not tighten the stopping test below the round-off of R.
-  if (reuse_factor && system.inner_term_scale && std::isfinite(f.held_inner_term_scale)) {
-    result.threshold =
-        std::max({relative_tolerance * scale, kRoundoffFloor * (scale + f.held_inner_term_scale),
-                  kSubnormalResidual});
+  // Failure reporting: the reason, and no factor kept for the next solve. The result to return.
+  NewtonResult fail(const char* reason) {
+    fail_with(reason);
+    return result_;
   }
-  while (true) {
-    if (result.residual_norm <= result.threshold) {
-      result.converged = true;
-      f.keep_factor = reuse_factor;
-      if (options_.polish && result.iterations > 0 && f.has_factor) {
-        if (solve_held(-residual, direction)) {
-          trial = x + direction;
-          evaluate(trial, trial_residual);
-          const double polished_norm = robust_norm(trial_residual);
-          if (all_finite(trial_residual) && polished_norm < result.residual_norm) {
-            x.swap(trial);
-            result.residual_norm = polished_norm;
-            result.polished = true;
-            if (options_.record_history) result.residual_history.push_back(polished_norm);
-          }
-        }
-      }
-      return result;
-    }
-    if (result.iterations >= options_.max_iterations) return fail("newton_max_iter");
 
-    bool stale = false;
-    if (reuse_factor) {
-      ++result.linear_solves;
-      stale = solve_held(-residual, direction);
-      reuse_factor = stale;
+  // One Newton iteration from an unconverged x below the iteration cap: a direction (held or
+  // fresh), the round-off stop, the descent check and the line search. True: go on with the
+  // loop (an accepted step, or a stale direction to redo with a fresh Jacobian); false: the
+  // result is final (failed, or converged at round-off).
+  bool iterate() {
+    stale_ = false;
+    if (reuse_factor_) {
+      ++result_.linear_solves;
+      stale_ = solve_held(-residual_, direction_);
+      reuse_factor_ = stale_;
     }
-    if (!stale) {
-      {
-        profile_totals().jacobians.fetch_add(1, std::memory_order_relaxed);
-        const PhaseTimer timer(profile_totals().jacobian_ns);
-        system.jacobian(x, f.jacobian);
-      }
-      if (f.jacobian.rows() != x.size() || f.jacobian.cols() != x.size()) {
-        throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
-                                           f.jacobian.rows(), f.jacobian.cols(), x.size()));
-      }
-      if (!all_finite(f.jacobian)) return fail("nan");
-      if (system.inner_term_scale) {
-        const double inner = system.inner_term_scale();
-        f.held_inner_term_scale = inner;
-        if (std::isfinite(inner)) {
-          result.threshold = std::max(
-              {relative_tolerance * scale, kRoundoffFloor * (scale + inner), kSubnormalResidual});
-        }
-      }
+    if (!stale_) {
+      if (!assemble()) return fail_with("nan");
       // A nearly singular matrix factorises without a zero pivot but yields inf/NaN directions.
-      if (!newton_direction()) return fail("linear_solve_failed");
+      if (!newton_direction()) return fail_with("linear_solve_failed");
     }
-    ++result.iterations;
-
-    // Round-off floor in x: a correction below kRoundoffFloor·‖x‖ changes x by no more than its
-    // own rounding, so the residual left is the rounding of R's terms — which can exceed
-    // tolerance·residual_scale when a term's inner magnitude (h·K·q of a stiff spring whose
-    // elongation is small) is far above its value. Take the correction and stop.
-    if (robust_norm(direction) <= std::max(kRoundoffFloor * robust_norm(x), kSubnormalResidual)) {
-      trial = x + direction;
-      evaluate(trial, trial_residual);
-      if (all_finite(trial_residual)) {
-        x.swap(trial);
-        residual.swap(trial_residual);
-        result.residual_norm = robust_norm(residual);
-        if (options_.record_history) result.residual_history.push_back(result.residual_norm);
-        result.converged = true;
-        result.at_roundoff = true;
-        return result;
-      }
-    }
+    ++result_.iterations;
+    if (roundoff_step()) return false;
 
     // Directional derivative of the merit along the step. For ½‖R‖² it is Rᵀ J d = −‖R‖² for
     // the exact Newton step, whatever J is, so the step is always a descent direction.
     const double slope =
-        system.objective ? residual.dot(direction) : -(merit_unit * residual).squaredNorm();
-    if (system.objective && options_.line_search && !(slope < 0.0)) {
-      if (stale) {  // an old Jacobian's direction: retry this iteration with the current one
-        --result.iterations;
-        reuse_factor = false;
-        continue;
-      }
+        system_.objective ? residual_.dot(direction_) : -(merit_unit_ * residual_).squaredNorm();
+    if (system_.objective && options_.line_search && !(slope < 0.0)) {
+      if (stale_) return redo_with_fresh_jacobian();
       // R·d = 0 with R and d nonzero: the product underflowed (a state below ~1e-160, whose
       // energy is below the smallest double), not a non-descent direction.
-      if (slope == 0.0 && result.residual_norm > 0.0 && robust_norm(direction) > 0.0) {
-        return fail("objective_underflow");
+      if (slope == 0.0 && result_.residual_norm > 0.0 && robust_norm(direction_) > 0.0) {
+        return fail_with("objective_underflow");
       }
-      return fail("not_descent");
+      return fail_with("not_descent");
     }
 
-    double step = 1.0;
-    bool accepted = false;
     bool any_finite = false;
-    double trial_merit = 0.0;
-    for (int backtrack = 0; backtrack <= options_.max_backtracks; ++backtrack, step *= 0.5) {
-      trial = x + step * direction;
-      if (trial == x) break;  // the step is below x's resolution: no progress is possible
-      evaluate(trial, trial_residual);
-      if (!all_finite(trial_residual)) {
+    const bool accepted = line_search(slope, any_finite);
+    if (!accepted && stale_) return redo_with_fresh_jacobian();
+    if (!accepted) return fail_with(any_finite ? "line_search_failed" : "nan");
+    accept_step();
+    return true;
+  }
+
+ private:
+  bool fail_with(const char* reason) {
+    result_.reason = reason;
+    f_.keep_factor = false;
+    return false;
+  }
+
+  // R at `at` into r (counted, timed; throws when R has the wrong size).
+  void evaluate(const Vec& at, Vec& r) {
+    ++result_.residual_evals;
+    const PhaseTimer timer(profile_totals().residual_ns);
+    system_.residual(at, r);
+    if (r.size() != at.size()) {
+      throw std::logic_error(
+          fmt::format("Newton residual has size {} for {} unknowns", r.size(), at.size()));
+    }
+  }
+
+  // Merit of a finite residual: the objective when the system has one, else ½‖R‖² in units of
+  // the power of two nearest the residual scale (merit_unit_), so that it neither underflows for
+  // a state of size 1e-300 nor overflows for 1e+150; merits and slopes are only compared with
+  // each other, and scaling by 2ᵏ keeps every comparison bit for bit.
+  double merit_of(const Vec& at, const Vec& r) {
+    if (!system_.objective) return 0.5 * (merit_unit_ * r).squaredNorm();
+    profile_totals().objectives.fetch_add(1, std::memory_order_relaxed);
+    const PhaseTimer timer(profile_totals().objective_ns);
+    return system_.objective(at);
+  }
+
+  // Inexact Newton: the CG iteration stops at forcing·‖R‖ (forcing terms: kFirstForcing, then
+  // Eisenstat–Walker's, updated in accept_step()) and below the threshold (the last correction
+  // does not leave an error the stopping test would see). The stopping test on R itself is
+  // unchanged, so it alone decides convergence. Direct solvers ignore the target.
+  void set_cg_target() {
+    f_.cg_target = std::max(0.1 * result_.threshold, forcing_ * result_.residual_norm);
+  }
+
+  // Solves J d = −R with the held factorisation (or CG on the held matrix).
+  bool solve_held(const Vec& rhs, Vec& out) {
+    set_cg_target();
+    bool negative_curvature = false;
+    return f_.solve(system_.symmetric, rhs, out, negative_curvature) && all_finite(out);
+  }
+
+  // Assembly: J(x) into f_.jacobian (timed; throws on a wrongly sized J), and the threshold's
+  // inner-term part at this iterate (NewtonSystem::inner_term_scale). False: J is not finite.
+  bool assemble() {
+    {
+      profile_totals().jacobians.fetch_add(1, std::memory_order_relaxed);
+      const PhaseTimer timer(profile_totals().jacobian_ns);
+      system_.jacobian(x_, f_.jacobian);
+    }
+    if (f_.jacobian.rows() != x_.size() || f_.jacobian.cols() != x_.size()) {
+      throw std::logic_error(fmt::format("Newton Jacobian is {}x{} for {} unknowns",
+                                         f_.jacobian.rows(), f_.jacobian.cols(), x_.size()));
+    }
+    if (!all_finite(f_.jacobian)) return false;
+    if (system_.inner_term_scale) {
+      const double inner = system_.inner_term_scale();
+      f_.held_inner_term_scale = inner;
+      if (std::isfinite(inner)) {
+        result_.threshold = std::max(
+            {relative_tolerance_ * scale_, kRoundoffFloor * (scale_ + inner), kSubnormalResidual});
+      }
+    }
+    return true;
+  }
+
+  // Factorisation and linear solve: factorises f_.jacobian with the resolved LinearSolverKind
+  // (SparseLU when not symmetric) and solves J d = −R into direction_. When the solver finds J
+  // not positive definite (a non-positive LDLT pivot, CHOLMOD's NumericalIssue, CG's curvature
+  // test), the SPD safeguard shifts it (shifted_direction); without the safeguard the SPD-only
+  // solvers fall back to an LDLT of J, the plain Newton step. False: no finite direction.
+  bool newton_direction() {
+    ++result_.linear_solves;
+    set_cg_target();
+    bool negative_curvature = false;
+    const bool factorised = f_.factorise(f_.jacobian, system_.symmetric, options_.reuse_symbolic,
+                                         result_.symbolic_analyses, result_.factorizations);
+    // Only the safeguard needs J positive definite; LDLT solves indefinite systems as well.
+    bool solved = false;
+    if (factorised && (!safeguard_ || f_.positive_definite())) {
+      solved = f_.solve(system_.symmetric, -residual_, direction_, negative_curvature);
+    }
+    if (solved) return all_finite(direction_);
+    if (safeguard_) return shifted_direction();
+    if (system_.symmetric && !safeguard_ && f_.kind != LinearSolverKind::kLdlt &&
+        f_.kind != LinearSolverKind::kLdltMetis &&
+        f_.factorise_indefinite(result_.factorizations)) {
+      solved = f_.solve(true, -residual_, direction_, negative_curvature);
+      return solved && all_finite(direction_);
+    }
+    f_.has_factor = false;
+    return false;
+  }
+
+  // The SPD safeguard (NewtonSystem::spd_shift): J is not positive definite (or singular), so
+  // J + μS is factorised with μ growing geometrically until it is and its solve succeeds. J + μS
+  // has the pattern of J when S's pattern is contained in it (M diagonal, J with a full
+  // diagonal), so the symbolic factorisation is reused. False: no shift in the schedule worked.
+  bool shifted_direction() {
+    ++result_.shifted_iterations;
+    const SparseMatrix unshifted = f_.jacobian;
+    // Start one growth step below the last successful shift of this solve: consecutive
+    // iterates usually need a similar μ, and the schedule then costs one or two factorisations.
+    double mu =
+        std::max(options_.spd_shift_initial, result_.last_shift / options_.spd_shift_growth);
+    bool solved = false;
+    bool negative_curvature = false;
+    for (int attempt = 0; attempt < options_.max_spd_shifts && !solved;
+         ++attempt, mu *= options_.spd_shift_growth) {
+      f_.jacobian = unshifted + mu * system_.spd_shift;
+      ++result_.shift_factorisations;
+      if (!(f_.factorise(f_.jacobian, true, options_.reuse_symbolic, result_.symbolic_analyses,
+                         result_.factorizations) &&
+            f_.positive_definite())) {
+        continue;
+      }
+      solved = f_.solve(true, -residual_, direction_, negative_curvature);
+      if (solved) result_.last_shift = mu;
+      if (!solved && !negative_curvature) break;  // CG did not converge: shifting won't help
+    }
+    if (solved) return all_finite(direction_);
+    f_.has_factor = false;
+    return false;
+  }
+
+  // Round-off floor in x: a correction below kRoundoffFloor·‖x‖ changes x by no more than its
+  // own rounding, so the residual left is the rounding of R's terms — which can exceed
+  // tolerance·residual_scale when a term's inner magnitude (h·K·q of a stiff spring whose
+  // elongation is small) is far above its value. True: the correction was taken and the solve
+  // converged (at_roundoff); false: go on (also when R at x + d is not finite).
+  bool roundoff_step() {
+    if (robust_norm(direction_) > std::max(kRoundoffFloor * robust_norm(x_), kSubnormalResidual)) {
+      return false;
+    }
+    trial_ = x_ + direction_;
+    evaluate(trial_, trial_residual_);
+    if (!all_finite(trial_residual_)) return false;
+    x_.swap(trial_);
+    residual_.swap(trial_residual_);
+    result_.residual_norm = robust_norm(residual_);
+    if (options_.record_history) result_.residual_history.push_back(result_.residual_norm);
+    result_.converged = true;
+    result_.at_roundoff = true;
+    return true;
+  }
+
+  // A direction from an old Jacobian failed (no descent, no acceptable step): this iteration
+  // does not count and is redone with the current Jacobian.
+  bool redo_with_fresh_jacobian() {
+    --result_.iterations;
+    reuse_factor_ = false;
+    return true;
+  }
+
+  // Line search: backtracking from the full step, halving up to max_backtracks times, on the
+  // merit (Armijo, c₁ = options.armijo) with the objective form's round-off acceptances. Leaves
+  // the accepted trial point in trial_, trial_residual_, trial_merit_ and its length in step_.
+  // any_finite: some trial had a finite residual and merit (else the failure is "nan").
+  bool line_search(double slope, bool& any_finite) {
+    step_ = 1.0;
+    trial_merit_ = 0.0;
+    for (int backtrack = 0; backtrack <= options_.max_backtracks; ++backtrack, step_ *= 0.5) {
+      trial_ = x_ + step_ * direction_;
+      if (trial_ == x_) break;  // the step is below x's resolution: no progress is possible
+      evaluate(trial_, trial_residual_);
+      if (!all_finite(trial_residual_)) {
         if (!options_.line_search) break;
         continue;  // the step left the domain of R (e.g. an inverted element): shorten it
       }
-      trial_merit = merit_of(trial, trial_residual);
-      if (!std::isfinite(trial_merit)) {
+      trial_merit_ = merit_of(trial_, trial_residual_);
+      if (!std::isfinite(trial_merit_)) {
         if (!options_.line_search) break;
         continue;
       }
       any_finite = true;
       // Without a line search a full step is taken whatever it does to R; from an old Jacobian
       // only if it reduces ‖R‖ (otherwise the iteration is redone with the current one).
-      if (stale && !options_.line_search && !(robust_norm(trial_residual) < result.residual_norm))
+      if (stale_ && !options_.line_search &&
+          !(robust_norm(trial_residual_) < result_.residual_norm))
         break;
-      if (!options_.line_search || trial_merit <= merit + options_.armijo * step * slope) {
-        accepted = true;
-        break;
+      if (!options_.line_search || trial_merit_ <= merit_ + options_.armijo * step_ * slope) {
+        return true;
       }
-      // Close to the root an objective's decrease (~‖R‖²) drops below its round-off
-      // (~ε|E|) long before ‖R‖ reaches the tolerance; the residual still measures progress.
-      const double merit_size = std::max(std::abs(merit), system.objective_scale);
-      if (system.objective && robust_norm(trial_residual) < result.residual_norm &&
-          trial_merit <= merit + 16 * std::numeric_limits<double>::epsilon() * merit_size) {
-        accepted = true;
-        break;
-      }
-      // The rounding of E can exceed 16ε·objective_scale by far when V sums terms that cancel
-      // (an elastic energy density of a rotated element: μ(tr H + ½|H|²) − μ ln J with H = R − I
-      // of size 1 and W ~ strain²), and then hides a decrease of E that the gradient still
-      // resolves. Armijo in derivative form (the approximate Wolfe test, kApproximateArmijoSlack).
-      if (system.objective && robust_norm(trial_residual) < result.residual_norm &&
-          trial_residual.dot(direction) <= (1 - 2 * options_.armijo) * -slope &&
-          trial_merit <= merit + kApproximateArmijoSlack * merit_size) {
-        accepted = true;
-        break;
-      }
+      if (accepted_at_objective_roundoff(slope)) return true;
     }
-    if (!accepted && stale) {
-      --result.iterations;
-      reuse_factor = false;
-      continue;
-    }
-    if (!accepted) return fail(any_finite ? "line_search_failed" : "nan");
+    return false;
+  }
 
-    x.swap(trial);
-    residual.swap(trial_residual);
-    merit = trial_merit;
-    const double previous_norm = result.residual_norm;
-    result.residual_norm = robust_norm(residual);
-    if (f.is_cg() && previous_norm > 0.0) {
+  // The objective form's two acceptances of a trial whose Armijo decrease is lost in E's
+  // rounding, both only when ‖R‖ decreased.
+  bool accepted_at_objective_roundoff(double slope) const {
+    // Close to the root an objective's decrease (~‖R‖²) drops below its round-off
+    // (~ε|E|) long before ‖R‖ reaches the tolerance; the residual still measures progress.
+    const double merit_size = std::max(std::abs(merit_), system_.objective_scale);
+    if (system_.objective && robust_norm(trial_residual_) < result_.residual_norm &&
+        trial_merit_ <= merit_ + 16 * std::numeric_limits<double>::epsilon() * merit_size) {
+      return true;
+    }
+    // The rounding of E can exceed 16ε·objective_scale by far when V sums terms that cancel
+    // (an elastic energy density of a rotated element: μ(tr H + ½|H|²) − μ ln J with H = R − I
+    // of size 1 and W ~ strain²), and then hides a decrease of E that the gradient still
+    // resolves. Armijo in derivative form (the approximate Wolfe test, kApproximateArmijoSlack).
+    return system_.objective && robust_norm(trial_residual_) < result_.residual_norm &&
+           trial_residual_.dot(direction_) <= (1 - 2 * options_.armijo) * -slope &&
+           trial_merit_ <= merit_ + kApproximateArmijoSlack * merit_size;
+  }
+
+  // Step acceptance: the line search's trial becomes x; the CG forcing term and the
+  // modified-Newton reuse decision are updated from the residual it reached.
+  void accept_step() {
+    x_.swap(trial_);
+    residual_.swap(trial_residual_);
+    merit_ = trial_merit_;
+    const double previous_norm = result_.residual_norm;
+    result_.residual_norm = robust_norm(residual_);
+    if (f_.is_cg() && previous_norm > 0.0) {
       // Eisenstat–Walker choice 1: how far the linear model R + J·s of the step taken missed the
       // new residual. For a damped step s = αd, ‖R + αJd‖ ≤ (1 − α)‖R‖ + α‖R + Jd‖.
-      const double model = (1.0 - step) * previous_norm + step * f.cg_residual;
-      double next = std::abs(result.residual_norm - model) / previous_norm;
-      const double safeguard = std::pow(forcing, kForcingSafeguardExponent);
+      const double model = (1.0 - step_) * previous_norm + step_ * f_.cg_residual;
+      double next = std::abs(result_.residual_norm - model) / previous_norm;
+      const double safeguard = std::pow(forcing_, kForcingSafeguardExponent);
       if (safeguard > 0.1) next = std::max(next, safeguard);
-      forcing = std::min(next, kMaxForcing);
+      forcing_ = std::min(next, kMaxForcing);
     }
-    reuse_factor = modified && f.has_factor && step == 1.0 &&
-                   result.residual_norm <= kModifiedNewtonContraction * previous_norm;
-    if (options_.record_history) result.residual_history.push_back(result.residual_norm);
+    reuse_factor_ = modified_ && f_.has_factor && step_ == 1.0 &&
+                    result_.residual_norm <= kModifiedNewtonContraction * previous_norm;
+    if (options_.record_history) result_.residual_history.push_back(result_.residual_norm);
+  }
+
+  const NewtonSystem& system_;
+  const NewtonOptions& options_;
+  LinearFactorisation& f_;
+  Vec& x_;
+  NewtonResult& result_;
+  const double residual_scale_;
+  const double relative_tolerance_;
+  double scale_;  // residual_scale plus scale_after_first_residual
+  double merit_unit_ = 1.0;
+  double merit_ = 0.0;      // the merit at x_
+  bool safeguard_ = false;  // the SPD shift applies (symmetric, objective, spd_shift given)
+  const bool modified_;
+  bool reuse_factor_ = false;  // the next direction comes from the held factorisation
+  bool stale_ = false;         // this iteration's direction came from an old Jacobian
+  double forcing_ = kFirstForcing;
+  double step_ = 1.0;  // the accepted step length of the last line search
+  double trial_merit_ = 0.0;
+  Vec residual_, direction_, trial_, trial_residual_;
+};
+
+}  // namespace
+
+// The phases are NewtonRun's (above); this loop is the whole algorithm.
+NewtonResult NewtonSolver::solve(const NewtonSystem& system, Vec& x, double residual_scale) {
+  NewtonResult result;
+  const SolveProfile profile(result);
+  NewtonRun run(system, options_, *factorisation_, x, result, residual_scale);
+  if (!run.start()) return result;
+  while (true) {
+    if (result.residual_norm <= result.threshold) {
+      run.polish();
+      return result;
+    }
+    if (result.iterations >= options_.max_iterations) return run.fail("newton_max_iter");
+    if (!run.iterate()) return result;
   }
 }
 
