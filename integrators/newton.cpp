@@ -1,5 +1,8 @@
 // Damped sparse Newton solver (see newton.hpp); line search after Nocedal & Wright, "Numerical
 // Optimization", 2nd ed., Algorithm 3.1 (backtracking Armijo) and §11.1 (merit ½‖R‖²).
+// Layout: LinearFactorisation (the factorisations of every linear_solver kind, kept across
+// solves), then NewtonRun (one solve's phases, each with its contract) and NewtonSolver::solve,
+// the loop over them. The dense loop of the general-Lagrangian steps is integrators/dense_newton.
 #include "integrators/newton.hpp"
 
 #include <fmt/format.h>

@@ -1,6 +1,6 @@
-// Sparse Newton solver shared by the implicit methods (implicit Euler, Newmark, discrete-Lagrangian
-// VIs, the Hamilton–Pontryagin minimiser of docs/METHOD.md §4, Gauss collocation): damped Newton
-// with Armijo backtracking (Nocedal & Wright, "Numerical Optimization", 2nd ed., §3.1 and §11.1).
+// Sparse Newton solver of the implicit methods (implicit Euler, Newmark, DEL, HP, Gauss...): damped
+// Newton with Armijo backtracking (Nocedal & Wright, 2nd ed., §3.1, §11.1), solve() a loop over
+// named phases (newton.cpp); the few-dof general-Lagrangian steps use dense_newton.hpp instead.
 #pragma once
 
 #include <functional>
