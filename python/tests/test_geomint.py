@@ -25,10 +25,18 @@ def cli(*args):
     return subprocess.run([GEOMINT, *args], capture_output=True, text=True, check=False)
 
 
+def number_or_text(text):
+    """The CLI's cell parsed here, independently of the package: float() of the text."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def cli_rows(text):
     lines = [line for line in text.splitlines(keepends=True) if not line.startswith("#")]
     return [
-        geomint.parse_row({key: value for key, value in row.items() if value != ""})
+        {key: number_or_text(value) for key, value in row.items() if value != ""}
         for row in csv.DictReader(io.StringIO("".join(lines)))
     ]
 
