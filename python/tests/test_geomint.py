@@ -86,17 +86,24 @@ def cli_columns(text):
     return header.split(",")
 
 
+def listed_names(what, known):
+    """The registry names `geomint list WHAT` prints first on its lines, in its order."""
+    lines = cli("list", what).stdout.splitlines()
+    return [line.split()[0] for line in lines if line.split() and line.split()[0] in known]
+
+
 def test_registries_match_geomint_list():
-    listed = cli("list", "methods").stdout.splitlines()[1:]
-    names = [line.split()[0] for line in listed if line.strip()]
-    assert [entry["name"] for entry in geomint.methods()] == names
-    listed = cli("list", "problems").stdout.splitlines()[1:]
-    rows = [line.split() for line in listed if line.strip()]
+    methods = [entry["name"] for entry in geomint.methods()]
+    assert listed_names("methods", set(methods)) == methods
     problems = geomint.problems()
-    assert [entry["name"] for entry in problems] == [row[0] for row in rows]
-    assert [str(entry["dof"]) for entry in problems] == [row[1] for row in rows]
+    names = [entry["name"] for entry in problems]
+    assert listed_names("problems", set(names)) == names
+    for entry in problems:
+        problem = geomint.Problem(entry["name"])
+        assert (problem.dof, problem.capabilities) == (entry["dof"], entry["capabilities"])
     verlet = next(entry for entry in geomint.methods() if entry["name"] == "stormer_verlet")
     assert verlet["order"] == 2 and "symplectic" in verlet["flags"]
+    assert [parameter["key"] for parameter in verlet["parameters"]] == ["compensated"]
 
 
 def test_problem_api_agrees_with_the_cli_series():
