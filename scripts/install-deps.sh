@@ -14,6 +14,7 @@ PACKAGES=(
   clang libclang-rt-14-dev python3 ccache
   libxml2-utils tidy chromium python3-yaml
   libcmark-gfm-dev libcmark-gfm-extensions-dev
+  pybind11-dev python3-numpy python3-pandas python3-pytest
 )
 if [ "${1:-}" = cluster ]; then
   shift

@@ -23,6 +23,18 @@ cmake -S "$source_dir/examples/external_method" -B "$work/build" -DCMAKE_BUILD_T
 cmake --build "$work/build" -j "$jobs" > "$work/build.log" ||
   { cat "$work/build.log"; echo "test-external: the example did not build" >&2; exit 1; }
 "$work/prefix/bin/geomint" --version
+# The Python package (docs/PYTHON.md), when the build has it: imported from the prefix's
+# site-packages by Debian's python3, outside the source and build trees, and run once.
+python_dir=$(sed -n 's/^GEOMINT_PYTHON_INSTALL_DIR:STRING=//p' "$build_dir/CMakeCache.txt")
+if [[ -n "$python_dir" ]]; then
+  (cd "$work" && PYTHONPATH="$work/prefix/$python_dir" /usr/bin/python3 -c '
+import geomint, sys
+assert geomint.__file__.startswith(sys.argv[1]), geomint.__file__
+run = geomint.run("pendulum", "stormer_verlet", dt=0.1, t_end=1.0)
+assert run.status == "ok", run.row
+print("test-external: python package geomint from", sys.argv[1], "ran", run)
+' "$work/prefix") || { echo "test-external: the installed Python package failed" >&2; exit 1; }
+fi
 (cd "$work/build" && ctest --output-on-failure -j "$jobs") ||
   { echo "test-external: the example's tests failed" >&2; exit 1; }
 echo "test-external: examples/external_method built and passed against $work/prefix"

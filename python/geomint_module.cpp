@@ -1,0 +1,251 @@
+// The compiled half of the Python package geomint (docs/PYTHON.md): the registries, the Problem
+// interface on numpy arrays, and run_one / order_study returning the CLI's formatted row cells, so
+// that python/geomint/__init__.py parses exactly the text `geomint run` would have written.
+#include <fmt/format.h>
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "harness/order.hpp"
+#include "harness/record.hpp"
+#include "harness/run.hpp"
+#include "harness/run_spec.hpp"
+#include "integrators/integrator.hpp"
+#include "problems/problem.hpp"
+#include "problems/spec.hpp"
+
+namespace py = pybind11;
+
+namespace geomint {
+namespace {
+
+py::list parameter_docs(const Params& params) {
+  py::list parameters;
+  for (const ParamDoc& doc : params.docs()) {
+    py::dict parameter;
+    parameter["key"] = doc.key;
+    parameter["default"] = doc.default_value;
+    parameter["help"] = doc.help;
+    parameters.append(parameter);
+  }
+  return parameters;
+}
+
+// The data `geomint list methods` prints (harness/cli/list.cpp), read from the same sources: each
+// entry's default configuration.
+py::list method_entries() {
+  py::list entries;
+  for (const IntegratorEntry& entry : integrator_registry()) {
+    Params params(Spec{entry.name, {}}, entry.name);
+    const MethodInfo info = entry.factory(params)->info();
+    py::dict item;
+    item["name"] = entry.name;
+    item["summary"] = entry.summary;
+    item["order"] = info.order;
+    item["flags"] = flag_names(info.flags);
+    item["family"] = method_family(info);
+    item["parameters"] = parameter_docs(params);
+    item["builtin"] = entry.builtin;
+    entries.append(item);
+  }
+  return entries;
+}
+
+// The data `geomint list problems` prints: each entry's default instance.
+py::list problem_entries() {
+  py::list entries;
+  for (const ProblemEntry& entry : problem_registry()) {
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto problem = entry.factory(params);
+    py::dict item;
+    item["name"] = entry.name;
+    item["summary"] = entry.summary;
+    item["dof"] = problem->dof();
+    item["kind"] = std::string(kind_name(problem->kind()));
+    item["capabilities"] = capability_names(problem->capabilities());
+    item["parameters"] = parameter_docs(params);
+    item["builtin"] = entry.builtin;
+    entries.append(item);
+  }
+  return entries;
+}
+
+// A ValueError, as an InputError would be, for a query the problem does not offer (the C++ API
+// throws std::logic_error there, which would surface as a RuntimeError).
+void require(const Problem& problem, Capability capability, const char* what) {
+  if (!problem.has(capability)) {
+    throw InputError(fmt::format("problem '{}' has no {}", problem.spec(), what));
+  }
+}
+
+// Problem wrapper: one parsed problem object, shared with the runs started from it.
+class PyProblem {
+ public:
+  explicit PyProblem(const std::string& spec) : problem_(parse_problem(spec)) {}
+  const Problem& get() const { return *problem_; }
+  const std::shared_ptr<const Problem>& shared() const { return problem_; }
+
+  py::tuple initial_state() const {
+    const State state = problem_->initial_state();
+    return py::make_tuple(state.q, state.p);
+  }
+  py::tuple exact(double t) const {
+    require(*problem_, kExact, "exact solution");
+    const State state = problem_->exact(t);
+    return py::make_tuple(state.q, state.p);
+  }
+  Vec grad_potential(const Vec& q) const {
+    if (problem_->kind() != ProblemKind::kSeparable) {
+      throw InputError(
+          fmt::format("problem '{}' is of kind {}: grad_potential needs a separable "
+                      "problem (L = ½vᵀMv − V(q))",
+                      problem_->spec(), kind_name(problem_->kind())));
+    }
+    check_size(q, "q");
+    Vec g;
+    problem_->gradient(q, g);
+    return g;
+  }
+  double energy(const Vec& q, const Vec& p) const {
+    check_size(q, "q");
+    if (!problem_->has(kFirstOrderOnly)) check_size(p, "p");
+    return problem_->energy(q, p);
+  }
+  // The conserved quantities the problem declares, by the series columns' names.
+  py::dict invariants(const Vec& q, const Vec& p) const {
+    check_size(q, "q");
+    if (!problem_->has(kFirstOrderOnly)) check_size(p, "p");
+    py::dict values;
+    if (!problem_->has(kFirstOrderOnly)) values["energy"] = problem_->energy(q, p);
+    if (problem_->has(kLinearMomentum)) {
+      values["linear_momentum"] = Vec(problem_->linear_momentum(q, p));
+    }
+    if (problem_->has(kAngularMomentum)) {
+      values["angular_momentum"] = Vec(problem_->angular_momentum(q, p));
+    }
+    if (problem_->has(kCasimir)) values["casimir"] = problem_->casimir(q, p);
+    return values;
+  }
+  double period() const {
+    require(*problem_, kPeriod, "period");
+    return problem_->period();
+  }
+
+ private:
+  void check_size(const Vec& v, const char* name) const {
+    if (v.size() != problem_->dof()) {
+      throw InputError(fmt::format("{} has {} entries; problem '{}' has dof = {}", name, v.size(),
+                                   problem_->spec(), problem_->dof()));
+    }
+  }
+  std::shared_ptr<const Problem> problem_;
+};
+
+// A record's cells as `geomint run` writes them (to_row: the one formatter of every table).
+py::dict cells(const RunRecord& record) {
+  py::dict row;
+  for (const auto& [column, cell] : to_row(record)) row[py::str(column)] = cell;
+  return row;
+}
+
+py::dict run(const PyProblem& problem, const std::string& method_spec, const RunConfig& config) {
+  RunSpec spec{problem.shared(), MethodFactory(method_spec), config};
+  RunResult result;
+  {
+    // A run may take minutes; other Python threads go on meanwhile.
+    py::gil_scoped_release release;
+    result = run_one(spec);
+  }
+  py::dict out;
+  out["row"] = cells(result.record);
+  out["columns"] = record_columns({result.record});
+  out["ok"] = result.ok;
+  out["final_q"] = result.final_state.q;
+  out["final_p"] = result.final_state.p;
+  return out;
+}
+
+py::dict order(const PyProblem& problem, const std::string& method_spec, double dt0, int levels,
+               double t_end, double diverge_factor) {
+  const MethodFactory method(method_spec);
+  OrderStudy study;
+  {
+    py::gil_scoped_release release;
+    study = order_study(problem.shared(), method, dt0, levels, t_end, diverge_factor);
+  }
+  std::vector<RunRecord> records;
+  py::list rows;
+  for (const RunResult& level : study.runs) {
+    records.push_back(level.record);
+    rows.append(cells(level.record));
+  }
+  py::dict out;
+  out["rows"] = rows;
+  out["columns"] = record_columns(records);
+  py::dict summary;
+  for (const auto& [column, cell] : to_row(study.record)) summary[py::str(column)] = cell;
+  out["summary"] = summary;
+  out["summary_columns"] = columns_of(order_schema(), std::vector<OrderRecord>{study.record});
+  out["note"] = study.fit.note;
+  return out;
+}
+
+}  // namespace
+}  // namespace geomint
+
+PYBIND11_MODULE(_geomint, module) {
+  using namespace geomint;
+  module.doc() = "geomint's C++ core (use the package geomint, docs/PYTHON.md)";
+  py::register_exception<InputError>(module, "InputError", PyExc_ValueError);
+
+  module.def("methods", &method_entries);
+  module.def("problems", &problem_entries);
+
+  py::class_<PyProblem>(module, "Problem")
+      .def(py::init<const std::string&>(), py::arg("spec"))
+      .def_property_readonly("spec", [](const PyProblem& p) { return p.get().spec(); })
+      .def_property_readonly("name", [](const PyProblem& p) { return p.get().name(); })
+      .def_property_readonly("dof", [](const PyProblem& p) { return p.get().dof(); })
+      .def_property_readonly(
+          "kind", [](const PyProblem& p) { return std::string(kind_name(p.get().kind())); })
+      .def_property_readonly(
+          "capabilities",
+          [](const PyProblem& p) { return capability_names(p.get().capabilities()); })
+      .def_property_readonly("default_dt", [](const PyProblem& p) { return p.get().default_dt(); })
+      .def_property_readonly("default_t_end",
+                             [](const PyProblem& p) { return p.get().default_t_end(); })
+      .def("initial_state", &PyProblem::initial_state)
+      .def("exact", &PyProblem::exact, py::arg("t"))
+      .def("energy", &PyProblem::energy, py::arg("q"), py::arg("p"))
+      .def("grad_potential", &PyProblem::grad_potential, py::arg("q"))
+      .def("invariants", &PyProblem::invariants, py::arg("q"), py::arg("p"))
+      .def("period", &PyProblem::period);
+
+  py::class_<RunConfig>(module, "RunConfig")
+      .def(py::init<>())
+      .def_readwrite("dt", &RunConfig::dt)
+      .def_readwrite("t_end", &RunConfig::t_end)
+      .def_readwrite("series_path", &RunConfig::series_path)
+      .def_readwrite("series_every", &RunConfig::series_every)
+      .def_readwrite("series_state", &RunConfig::series_state)
+      .def_readwrite("series_section", &RunConfig::series_section)
+      .def_readwrite("timing_repeats", &RunConfig::timing_repeats)
+      .def_readwrite("timing_budget_s", &RunConfig::timing_budget_s)
+      .def_readwrite("diverge_factor", &RunConfig::diverge_factor)
+      .def_readwrite("wall_budget_s", &RunConfig::wall_budget_s)
+      .def_readwrite("max_steps", &RunConfig::max_steps)
+      .def_readwrite("command_line", &RunConfig::command_line)
+      .def_readwrite("reference_dir", &RunConfig::reference_dir)
+      .def_readwrite("extra_metrics", &RunConfig::extra_metrics);
+
+  module.def("run", &run, py::arg("problem"), py::arg("method"), py::arg("config"));
+  module.def("order", &order, py::arg("problem"), py::arg("method"), py::arg("dt0"),
+             py::arg("levels"), py::arg("t_end"), py::arg("diverge_factor"));
+  module.attr("default_diverge_factor") = kDefaultDivergeFactor;
+  module.attr("default_max_steps") = kDefaultMaxSteps;
+}
