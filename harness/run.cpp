@@ -66,7 +66,7 @@ class SeriesWriter {
       }
     }
     for (const auto& [key, value] : provenance(config.command_line)) {
-      out_ << fmt::format("# {}: {}\n", key, value);
+      out_ << provenance_line(key, value);
     }
     out_ << fmt::format("# problem: {}\n# method: {}\n# dt: {}\n", problem.spec(), method_spec,
                         format_number(config.dt));

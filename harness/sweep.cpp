@@ -756,7 +756,7 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
   if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
   lines.emplace_back("variant", options.variant);
   std::string header;
-  for (const auto& [key, value] : lines) header += fmt::format("# {}: {}\n", key, value);
+  for (const auto& [key, value] : lines) header += provenance_line(key, value);
   for (const char* name : {"order.csv", "order_points.csv", "stability.csv"}) {
     const fs::path path = out / name;
     if (!fs::exists(path)) continue;

@@ -28,6 +28,7 @@
 
 #include "harness/blas.hpp"
 #include "harness/metrics.hpp"
+#include "harness/text_escape.hpp"
 #include "problems/parallel.hpp"
 #include "problems/spec.hpp"
 
@@ -256,10 +257,19 @@ CsvTable read_csv_file(const std::string& path) {
   return parse_csv_table(text, path);
 }
 
+std::string provenance_line(const std::string& key, const std::string& value) {
+  const auto one_line = [](std::string text) {
+    std::replace_if(
+        text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    return text;
+  };
+  return fmt::format("# {}: {}\n", one_line(key), one_line(value));
+}
+
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
                    const std::vector<std::pair<std::string, std::string>>& provenance_lines) {
   std::string out;
-  for (const auto& [key, value] : provenance_lines) out += fmt::format("# {}: {}\n", key, value);
+  for (const auto& [key, value] : provenance_lines) out += provenance_line(key, value);
   out += fmt::format("{}\n", fmt::join(columns, ","));
   for (const auto& row : rows) {
     std::string line;
@@ -271,6 +281,101 @@ std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>&
     out += line + "\n";
   }
   return out;
+}
+
+namespace {
+
+// RFC 8259's number grammar: -?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]+)?
+bool is_json_number(const std::string& text) {
+  const auto digit = [&](size_t at) {
+    return at < text.size() && text[at] >= '0' && text[at] <= '9';
+  };
+  size_t at = 0;
+  if (at < text.size() && text[at] == '-') ++at;
+  if (!digit(at)) return false;
+  if (text[at] == '0') {
+    ++at;
+  } else {
+    while (digit(at)) ++at;
+  }
+  if (at < text.size() && text[at] == '.') {
+    if (!digit(++at)) return false;
+    while (digit(at)) ++at;
+  }
+  if (at < text.size() && (text[at] == 'e' || text[at] == 'E')) {
+    ++at;
+    if (at < text.size() && (text[at] == '+' || text[at] == '-')) ++at;
+    if (!digit(at)) return false;
+    while (digit(at)) ++at;
+  }
+  return at == text.size();
+}
+
+// How the CSV writers spell a non-finite double (std::to_chars, fmt); JSON has no literal for it.
+bool is_non_finite_word(const std::string& text) {
+  return text == "nan" || text == "-nan" || text == "inf" || text == "-inf";
+}
+
+std::string json_string(const std::string& text) { return "\"" + json_escaped(text) + "\""; }
+
+}  // namespace
+
+std::string to_json(const CsvTable& table) {
+  // A number column: a finite number somewhere and nothing but numbers and non-finite words
+  // (a status "nan" alone is text).
+  std::vector<bool> numeric(table.columns.size(), false);
+  for (size_t i = 0; i < table.columns.size(); ++i) {
+    bool finite_seen = false, other_seen = false;
+    for (const auto& row : table.rows) {
+      const auto cell = row.find(table.columns[i]);
+      if (cell == row.end()) continue;
+      finite_seen = finite_seen || is_json_number(cell->second);
+      other_seen =
+          other_seen || (!is_json_number(cell->second) && !is_non_finite_word(cell->second));
+    }
+    numeric[i] = finite_seen && !other_seen;
+  }
+  std::string out = "{\n  \"provenance\": {";
+  std::set<std::string> keys;
+  for (const auto& [key, value] : table.provenance) {
+    if (!keys.insert(key).second) continue;  // the first value wins, as in CsvTable::value
+    out += fmt::format("{}\n    {}: {}", keys.size() > 1 ? "," : "", json_string(key),
+                       json_string(value));
+  }
+  out += keys.empty() ? "},\n" : "\n  },\n";
+  out += "  \"columns\": [";
+  for (size_t i = 0; i < table.columns.size(); ++i) {
+    out += (i ? ", " : "") + json_string(table.columns[i]);
+  }
+  out += "],\n  \"types\": {";
+  for (size_t i = 0; i < table.columns.size(); ++i) {
+    out += fmt::format("{}{}: \"{}\"", i ? ", " : "", json_string(table.columns[i]),
+                       numeric[i] ? "number" : "string");
+  }
+  out += "},\n  \"rows\": [";
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    const Row& row = table.rows[r];
+    out += r ? ",\n    {" : "\n    {";
+    for (size_t i = 0; i < table.columns.size(); ++i) {
+      const auto cell = row.find(table.columns[i]);
+      std::string value = "null";
+      if (cell != row.end()) {
+        value =
+            numeric[i] && is_json_number(cell->second) ? cell->second : json_string(cell->second);
+      }
+      out += fmt::format("{}{}: {}", i ? ", " : "", json_string(table.columns[i]), value);
+    }
+    out += "}";
+  }
+  out += table.rows.empty() ? "]\n}\n" : "\n  ]\n}\n";
+  return out;
+}
+
+TableFormat parse_table_format(const std::string& text, const std::string& option) {
+  if (text == "csv") return TableFormat::kCsv;
+  if (text == "json") return TableFormat::kJson;
+  throw InputError(
+      fmt::format("{}: '{}' is not a table format (allowed: csv, json)", option, text));
 }
 
 std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::string>& columns,

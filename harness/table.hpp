@@ -22,6 +22,11 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
 std::vector<std::string> column_union(const std::vector<Row>& rows,
                                       const std::vector<std::string>& preferred);
 
+// "# key: value\n", the provenance line of every CSV writer: a newline or carriage return in
+// `key` or `value` (a path in the command line) becomes a space, as in a cell, since it would end
+// the line and make the rest of the value the table's header.
+std::string provenance_line(const std::string& key, const std::string& value);
+
 // CSV text (header + rows); values containing ',' or '"' are quoted.
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
                    const std::vector<std::pair<std::string, std::string>>& provenance_lines);
@@ -52,6 +57,24 @@ CsvTable parse_csv_table(const std::string& text, const std::string& source);
 // (gate, merge, --markdown-only, --timing-only, shards). InputError naming the file when it
 // cannot be read or is damaged (see parse_csv).
 CsvTable read_csv_file(const std::string& path);
+
+// The JSON of a table as read back from its CSV (docs/USAGE.md "JSON tables", the schema
+// docs/schema/table.schema.json): {"provenance": {key: value}, "columns": [names in CSV order],
+// "types": {column: "number" or "string"}, "rows": [{column: cell}]}. A column is "number" when
+// it holds a JSON number literal and every other non-empty cell is one or nan/-nan/inf/-inf (a
+// status "nan" alone stays text); its cells are then the CSV's
+// digits as JSON numbers (so they parse to the same doubles) and its non-finite cells the strings
+// "nan", "-nan", "inf", "-inf". Every row has every column; an empty cell is null. Strings are
+// valid UTF-8 (invalid bytes → U+FFFD) with control characters escaped. A provenance key given
+// twice keeps its first value, as CsvTable::value does.
+std::string to_json(const CsvTable& table);
+
+// The formats `run`, `order` and `sweep` write their tables in (--format).
+enum class TableFormat { kCsv, kJson };
+
+// "csv" or "json"; anything else is an InputError naming `option`, the value and the allowed
+// values.
+TableFormat parse_table_format(const std::string& text, const std::string& option);
 
 // Markdown pipe table; numbers are shortened to `digits` significant digits for reading.
 std::string to_markdown(const std::vector<Row>& rows, const std::vector<std::string>& columns,

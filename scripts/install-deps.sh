@@ -12,7 +12,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev libhypre-dev
   clang libclang-rt-14-dev python3 ccache
-  libxml2-utils tidy chromium python3-yaml
+  libxml2-utils tidy chromium python3-yaml python3-jsonschema
   libcmark-gfm-dev libcmark-gfm-extensions-dev
   pybind11-dev python3-numpy python3-pandas python3-pytest
 )

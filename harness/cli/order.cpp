@@ -19,6 +19,7 @@ namespace {
 
 struct OrderOptions {
   std::string problem_spec, method_spec, out_path, initial_path;
+  std::string format = "csv";
   double dt0 = 0, t_end = 0;
   long levels = 6;
   double diverge_factor = kDefaultDivergeFactor;
@@ -38,6 +39,18 @@ int run_order(OrderOptions options, const Context& context) {
       errors.emplace_back(error.what());
     }
   }
+  TableFormat format = TableFormat::kCsv;
+  try {
+    format = parse_table_format(options.format, "--format");
+    // stdout carries the fitted order alone (scripts read it); the table goes to --out only.
+    if (format == TableFormat::kJson && options.out_path.empty()) {
+      errors.emplace_back(
+          "--format json applies to the --out table of the ladder runs; give --out FILE (stdout "
+          "holds only the fitted order)");
+    }
+  } catch (const InputError& error) {
+    errors.emplace_back(error.what());
+  }
   throw_input_errors(errors);
   const OrderStudy study =
       order_study(problem, method, options.dt0, static_cast<int>(options.levels), options.t_end,
@@ -52,7 +65,10 @@ int run_order(OrderOptions options, const Context& context) {
   if (!options.out_path.empty()) {
     std::vector<RunRecord> records;
     for (const auto& run_result : study.runs) records.push_back(run_result.record);
-    write_file_atomic(options.out_path, records_to_csv(records, provenance(context.command_line)));
+    std::string table = records_to_csv(records, provenance(context.command_line));
+    // The JSON is the CSV read back, so both hold the same cells to the digit.
+    if (format == TableFormat::kJson) table = to_json(parse_csv_table(table, "the ladder runs"));
+    write_file_atomic(options.out_path, table);
   }
   if (!std::isfinite(study.fit.order)) {
     fmt::print(stderr, "{}: no order fit: {}\n", context.program, study.fit.note);
@@ -83,7 +99,10 @@ Verb add_order(CLI::App& app) {
       "--levels", options->levels,
       fmt::format("number of ladder levels ({}..{})", kMinOrderLevels, kMaxOrderLevels));
   command->add_option("--t-end", options->t_end, "horizon")->required();
-  command->add_option("--out", options->out_path, "write the ladder runs as CSV");
+  command->add_option("--out", options->out_path, "write the ladder runs as a table");
+  command->add_option("--format", options->format,
+                      "csv (default) or json (docs/schema/table.schema.json): the format of the "
+                      "--out table");
   command->add_option("--diverge-factor", options->diverge_factor, diverge_factor_help());
   command->add_option("--initial", options->initial_path, kInitialStateHelp);
   return {"order", command,

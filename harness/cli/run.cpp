@@ -18,6 +18,7 @@ namespace {
 
 struct RunOptions {
   std::string problem_spec, method_spec, out_path, series_path, initial_path;
+  std::string format = "csv";
   double dt = 0, t_end = 0;
   bool dt_given = false, t_end_given = false;
   long every = 1;
@@ -53,6 +54,12 @@ int run_run(RunOptions options, const Context& context) {
   config.extra_metrics = options.extra_metrics;
   config.command_line = context.command_line;
   // Outputs are checked before anything is computed.
+  TableFormat format = TableFormat::kCsv;
+  try {
+    format = parse_table_format(options.format, "--format");
+  } catch (const InputError& error) {
+    errors.emplace_back(error.what());
+  }
   const std::string& out_path = options.out_path;
   if (!out_path.empty()) {
     try {
@@ -71,11 +78,13 @@ int run_run(RunOptions options, const Context& context) {
   for (std::string& error : spec.validate()) errors.push_back(std::move(error));
   throw_input_errors(errors);
   const RunResult result = run_one(spec);
-  const std::string csv = records_to_csv({result.record}, provenance(context.command_line));
+  std::string table = records_to_csv({result.record}, provenance(context.command_line));
+  // The JSON is the CSV read back, so both hold the same cells to the digit.
+  if (format == TableFormat::kJson) table = to_json(parse_csv_table(table, "the summary"));
   if (out_path.empty()) {
-    std::cout << csv;
+    std::cout << table;
   } else {
-    write_file_atomic(out_path, csv);
+    write_file_atomic(out_path, table);
   }
   if (!result.ok) {
     fmt::print(stderr, "{}: run failed: {}: {}\n", context.program, result.record.status,
@@ -88,14 +97,19 @@ int run_run(RunOptions options, const Context& context) {
 
 Verb add_run(CLI::App& app) {
   auto options = std::make_shared<RunOptions>();
-  auto* command = app.add_subcommand("run", "Run one problem with one method and print a CSV row");
+  auto* command =
+      app.add_subcommand("run", "Run one problem with one method and print a CSV row");
   command->add_option("--problem", options->problem_spec, "problem spec, e.g. pendulum:theta0=1.5")
       ->required();
   command->add_option("--method", options->method_spec, "method spec, e.g. stormer_verlet")
       ->required();
   command->add_option("--dt", options->dt, "step size (> 0); default: the problem's");
   command->add_option("--t-end", options->t_end, "horizon (> 0); default: the problem's");
-  command->add_option("--out", options->out_path, "write the summary CSV here instead of stdout");
+  command->add_option("--out", options->out_path, "write the summary here instead of stdout");
+  command->add_option("--format", options->format,
+                      "csv (default) or json: the summary table as CSV with '# key: value' "
+                      "provenance lines, or as JSON (docs/schema/table.schema.json); the "
+                      "--series file stays CSV");
   command->add_option("--series", options->series_path, "write a time series CSV here");
   command->add_option("--every", options->every,
                       "series: every N-th step point (the last is always written)");

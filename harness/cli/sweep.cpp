@@ -12,12 +12,14 @@
 #include "harness/paths.hpp"
 #include "harness/scene.hpp"
 #include "harness/shard.hpp"
+#include "harness/table.hpp"
 
 namespace geomint::cli {
 namespace {
 
 struct SweepCliOptions {
   std::string scene_path, out;
+  std::string format = "csv";
   int jobs = 1;
   bool quick = false, markdown_only = false, no_timing = false, timing_only = false;
   std::string shard_text;
@@ -26,7 +28,28 @@ struct SweepCliOptions {
   double progress_interval = 10;
 };
 
+// The scene tables --format json writes beside their CSVs.
+constexpr const char* kJsonTables[] = {"summary", "order", "order_points", "stability"};
+
+// summary.json, order.json, ... beside each of those CSVs in `out_dir`, each the CSV as written
+// read back (so both hold the same cells) and each written atomically; series files stay CSV.
+void write_json_tables(const std::string& out_dir) {
+  for (const char* table : kJsonTables) {
+    const auto csv = std::filesystem::path(out_dir) / (std::string(table) + ".csv");
+    if (!std::filesystem::is_regular_file(csv)) continue;
+    const auto json = std::filesystem::path(out_dir) / (std::string(table) + ".json");
+    write_file_atomic(json.string(), to_json(read_csv_file(csv.string())));
+  }
+}
+
 int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
+  const bool json = parse_table_format(cli.format, "--format") == TableFormat::kJson;
+  const bool sharded = !cli.shard_text.empty() || cli.shard_from_env;
+  if (json && sharded) {
+    throw InputError(
+        "--format json: a shard's tables stay CSV for `geomint merge`; after the merge, "
+        "`geomint sweep SCENE --markdown-only --format json` writes the JSON tables");
+  }
   const Scene scene = load_scene(cli.scene_path, cli.quick);
   SweepOptions options;
   options.jobs = cli.jobs;
@@ -50,11 +73,16 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   };
   if (cli.markdown_only || cli.timing_only) check_output_file(out_file("table.md"), out_option);
   if (cli.timing_only) check_output_file(out_file("summary.csv"), out_option);
+  if (json) {
+    for (const char* table : kJsonTables) {
+      check_output_file(out_file((std::string(table) + ".json").c_str()), out_option);
+    }
+  }
   if (cli.markdown_only) {
     rewrite_scene_markdown(scene, options);
+    if (json) write_json_tables(options.out_dir);
     return kExitOk;
   }
-  const bool sharded = !cli.shard_text.empty() || cli.shard_from_env;
   if (cli.timing_only) {
     if (cli.no_timing || sharded) {
       throw InputError(
@@ -62,6 +90,7 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
           "--shard and --shard-from-env");
     }
     run_timing_only(scene, options);
+    if (json) write_json_tables(options.out_dir);
     inform(context, fmt::format("{}: timing passes of '{}' written into {}", context.program,
                                 scene.title, options.out_dir));
     return kExitOk;
@@ -98,6 +127,7 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     throw InputError("--shards N goes with --shard-from-env");
   }
   const int failed = run_sweep(scene, options);
+  if (json) write_json_tables(options.out_dir);
   inform(context, fmt::format("{}: sweep '{}' done: {} failed run(s) reported as rows in {}",
                               context.program, scene.title, failed, options.out_dir));
   return kExitOk;
@@ -115,6 +145,10 @@ Verb add_sweep(CLI::App& app) {
                     "run nothing: rewrite table.md from the CSVs already in the output folder");
   command->add_option("--out", options->out,
                       "output folder (default: the scene's folder; with --quick: <folder>/quick)");
+  command->add_option("--format", options->format,
+                      "csv (default) or json: json also writes summary.json, order.json, "
+                      "order_points.json and stability.json beside the CSVs (the same cells; "
+                      "docs/schema/table.schema.json); series files stay CSV");
   command->add_flag("--no-timing", options->no_timing,
                     "accuracy runs only: no timing passes, no wall_s");
   command->add_option("--shard", options->shard_text,
