@@ -56,6 +56,7 @@ int run_merge(const MergeCliOptions& cli, const Context& context) {
     fmt::print(stderr, "{}: merge: {}\n", context.program, refused.what());
     return kExitFailed;
   }
+  remove_stale_json_tables(cli.dir, context);
   inform(context, fmt::format("{}: merged the shards of '{}' into {}", context.program, scene.title,
                               cli.dir));
   return kExitOk;

@@ -42,6 +42,22 @@ void write_json_tables(const std::string& out_dir) {
   }
 }
 
+}  // namespace
+
+// A CSV rewritten without --format json leaves an earlier run's JSON beside it holding other
+// numbers: remove it, so that a folder's JSON tables are always its CSVs'.
+void remove_stale_json_tables(const std::string& out_dir, const Context& context) {
+  for (const char* table : kJsonTables) {
+    const auto json = std::filesystem::path(out_dir) / (std::string(table) + ".json");
+    if (!std::filesystem::is_regular_file(json)) continue;
+    std::filesystem::remove(json);
+    inform(context, fmt::format("{}: removed {}: its CSV was rewritten without --format json",
+                                context.program, json.string()));
+  }
+}
+
+namespace {
+
 int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
   const bool json = parse_table_format(cli.format, "--format") == TableFormat::kJson;
   const bool sharded = !cli.shard_text.empty() || cli.shard_from_env;
@@ -90,7 +106,11 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
           "--shard and --shard-from-env");
     }
     run_timing_only(scene, options);
-    if (json) write_json_tables(options.out_dir);
+    if (json) {
+      write_json_tables(options.out_dir);
+    } else {
+      remove_stale_json_tables(options.out_dir, context);
+    }
     inform(context, fmt::format("{}: timing passes of '{}' written into {}", context.program,
                                 scene.title, options.out_dir));
     return kExitOk;
@@ -127,7 +147,11 @@ int run_sweep_verb(const SweepCliOptions& cli, const Context& context) {
     throw InputError("--shards N goes with --shard-from-env");
   }
   const int failed = run_sweep(scene, options);
-  if (json) write_json_tables(options.out_dir);
+  if (json) {
+    write_json_tables(options.out_dir);
+  } else if (!sharded) {
+    remove_stale_json_tables(options.out_dir, context);
+  }
   inform(context, fmt::format("{}: sweep '{}' done: {} failed run(s) reported as rows in {}",
                               context.program, scene.title, failed, options.out_dir));
   return kExitOk;

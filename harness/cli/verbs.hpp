@@ -13,6 +13,10 @@ namespace geomint::cli {
 // bound to `quiet` (harness/cli/app.cpp).
 std::vector<Verb> add_verbs(CLI::App& app, bool& quiet);
 
+// Removes summary.json, order.json, ... of `out_dir` (harness/cli/sweep.cpp): called when a sweep
+// or merge rewrote the CSVs without --format json, so no JSON table outlives its CSV.
+void remove_stale_json_tables(const std::string& out_dir, const Context& context);
+
 #define GEOMINT_VERB(verb) Verb add_##verb(CLI::App& app);
 #include "harness/cli/verbs.def"
 #undef GEOMINT_VERB

@@ -174,6 +174,12 @@ def check_sweep(work):
         with open(os.path.join(both, table + ".csv"), "rb") as c, \
                 open(os.path.join(both, table + ".json"), "rb") as j:
             compare(c.read(), j.read(), f"sweep --markdown-only {table}")
+    # A later sweep without --format json rewrites the CSVs: no JSON of the earlier one may stay.
+    geomint("sweep", scene, "--out", both, "--no-timing")
+    stale = [table + ".json" for table in tables
+             if os.path.exists(os.path.join(both, table + ".json"))]
+    if stale:
+        fail(f"sweep without --format json left the earlier JSON tables: {stale}")
     leftovers = [name for name in os.listdir(both) if name.endswith(".tmp")]
     if leftovers:
         fail(f"temporaries left: {leftovers}")
