@@ -3,8 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 
 #include "problems/spec.hpp"
 
@@ -12,10 +14,24 @@ namespace geomint {
 
 toml::table parse_toml_file(const std::string& path, const std::string& kind,
                             const std::string& example) {
+  // toml++ says only "File could not be opened": say which of the usual reasons it is.
+  namespace fs = std::filesystem;
   std::error_code filesystem_error;
-  if (std::filesystem::is_directory(path, filesystem_error)) {
+  const fs::file_status status = fs::status(path, filesystem_error);
+  if (status.type() == fs::file_type::not_found) {
+    throw InputError(fmt::format("{} '{}' does not exist (expected e.g. {})", kind, path, example));
+  }
+  if (filesystem_error) {
+    throw InputError(
+        fmt::format("{} '{}' cannot be accessed: {}", kind, path, filesystem_error.message()));
+  }
+  if (fs::is_directory(status)) {
     throw InputError(
         fmt::format("{} '{}' is a directory, not a file (expected e.g. {})", kind, path, example));
+  }
+  if (!std::ifstream(path)) {
+    throw InputError(fmt::format("{} '{}' cannot be read: {}", kind, path,
+                                 std::error_code(errno, std::generic_category()).message()));
   }
   try {
     return toml::parse_file(path);

@@ -9,11 +9,8 @@ namespace geomint {
 
 AdaptiveSettings read_adaptive_settings(Params& params, const std::string& max_steps_help) {
   AdaptiveSettings settings;
-  settings.rtol = params.real(
-      "rtol", settings.rtol, "relative tolerance", [](double v) { return v > 0 && v < 1; },
-      "in (0, 1)");
-  settings.atol = params.real(
-      "atol", settings.atol, "absolute tolerance", [](double v) { return v >= 0; }, ">= 0");
+  settings.rtol = params.real("rtol", settings.rtol, "relative tolerance", Range::open(0, 1));
+  settings.atol = params.real("atol", settings.atol, "absolute tolerance", Range::at_least(0));
   settings.max_steps =
       params.integer("max_steps", settings.max_steps, max_steps_help, 1, 1000000000000L);
   return settings;

@@ -309,10 +309,9 @@ std::unique_ptr<Integrator> make_del(Params& params) {
   if (rule == "alpha" || rule == "symmetric_alpha") {
     // rule=alpha defaults to the midpoint (the paper's α = ½); symmetric_alpha to ¼, since its
     // α = ½ is the midpoint again and α ∈ {0, 1} the trapezoid.
-    const double alpha = params.real(
-        "alpha", rule == "alpha" ? 0.5 : 0.25,
-        "quadrature node in [0, 1] (rule=alpha, symmetric_alpha only)",
-        [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+    const double alpha = params.real("alpha", rule == "alpha" ? 0.5 : 0.25,
+                                     "quadrature node in [0, 1] (rule=alpha, symmetric_alpha only)",
+                                     Range::closed(0, 1));
     if (rule == "alpha") {
       nodes = {{alpha, 1.0}};
     } else if (alpha == 0.5) {

@@ -479,9 +479,9 @@ class HamiltonPontryagin final : public Integrator,
 }  // namespace
 
 std::unique_ptr<Integrator> make_hp(Params& params) {
-  const double alpha = params.real(
-      "alpha", 0.5, "position of the potential's node q_k + alpha h v, in [0, 1]",
-      [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+  const double alpha =
+      params.real("alpha", 0.5, "position of the potential's node q_k + alpha h v, in [0, 1]",
+                  Range::closed(0, 1));
   const std::string solver = params.choice(
       "solver", "minimize", {"minimize", "newton"},
       "minimise E_k with line search and SPD safeguard, or plain Newton on the residual");

@@ -59,8 +59,8 @@ const IntegratorEntry& find_method(const Spec& spec) {
     if (entry.name == spec.name) return entry;
     names.push_back(entry.name);
   }
-  throw InputError(
-      fmt::format("unknown method '{}' (valid: {})", spec.name, fmt::join(names, ", ")));
+  throw InputError(fmt::format("unknown method '{}'{} (valid: {})", spec.name,
+                               did_you_mean(spec.name, names), fmt::join(names, ", ")));
 }
 }  // namespace
 

@@ -257,12 +257,12 @@ class Newmark final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_newmark(Params& params) {
-  const double beta = params.real(
-      "beta", 0.25, "position weight beta (0: explicit; 1/4: average acceleration)",
-      [](double x) { return x >= 0.0 && x <= 0.5; }, "in [0, 0.5]");
-  const double gamma = params.real(
-      "gamma", 0.5, "velocity weight gamma (1/2: second order, no numerical damping)",
-      [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+  const double beta =
+      params.real("beta", 0.25, "position weight beta (0: explicit; 1/4: average acceleration)",
+                  Range::closed(0, 0.5));
+  const double gamma =
+      params.real("gamma", 0.5, "velocity weight gamma (1/2: second order, no numerical damping)",
+                  Range::closed(0, 1));
   const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
   Newmark::Alpha plain;
   plain.second_order = gamma == 0.5;
@@ -272,10 +272,10 @@ std::unique_ptr<Integrator> make_newmark(Params& params) {
 // HHT-α in Chung & Hulbert's notation: α_m = 0, α_f = −α, β = (1−α)²/4, γ = ½ − α; the
 // high-frequency spectral radius is ρ∞ = (1+α)/(1−α).
 std::unique_ptr<Integrator> make_hht(Params& params) {
-  const double alpha = params.real(
-      "alpha", -0.05,
-      "HHT alpha in [-1/3, 0] (0: trapezoidal Newmark; rho_inf = (1+alpha)/(1-alpha))",
-      [](double x) { return x >= -1.0 / 3.0 && x <= 0.0; }, "in [-1/3, 0]");
+  const double alpha =
+      params.real("alpha", -0.05,
+                  "HHT alpha in [-1/3, 0] (0: trapezoidal Newmark; rho_inf = (1+alpha)/(1-alpha))",
+                  Range::closed(-1.0 / 3.0, 0));
   const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
   Newmark::Alpha hht;
   hht.name = "hht";
@@ -290,7 +290,7 @@ std::unique_ptr<Integrator> make_hht(Params& params) {
 std::unique_ptr<Integrator> make_generalized_alpha(Params& params) {
   const double rho = params.real(
       "rho_inf", 0.8, "spectral radius at h*omega -> infinity, in [0, 1] (1: trapezoidal Newmark)",
-      [](double x) { return x >= 0.0 && x <= 1.0; }, "in [0, 1]");
+      Range::closed(0, 1));
   const NewtonOptions newton = read_newton_options(params, "|p| + h|M a0|");
   Newmark::Alpha alpha;
   alpha.name = "generalized_alpha";

@@ -429,10 +429,10 @@ struct NewtonSolver::Factorisation : LinearFactorisation {};
 
 NewtonOptions read_newton_options(Params& params, const std::string& residual_scale) {
   NewtonOptions options;
-  options.tolerance = params.real(
-      "tol", options.tolerance,
-      fmt::format("Newton relative residual tolerance (scale {})", residual_scale),
-      [](double x) { return x > 0.0 && x < 1.0; }, "in (0, 1)");
+  options.tolerance =
+      params.real("tol", options.tolerance,
+                  fmt::format("Newton relative residual tolerance (scale {})", residual_scale),
+                  Range::open(0, 1));
   options.max_iterations = static_cast<int>(
       params.integer("max_iter", options.max_iterations,
                      "Newton iterations per step before the step fails", 1, 10000));

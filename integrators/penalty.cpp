@@ -123,7 +123,7 @@ class Penalty final : public Integrator {
 std::unique_ptr<Integrator> make_penalty(Params& params) {
   const double stiffness = params.real(
       "k", 1e4, "penalty stiffness k in k/2 |g(q)|^2 (the constraint error goes like 1/k)",
-      [](double k) { return k > 0; }, "> 0");
+      Range::above(0));
   // Any registered method that does not handle constraints itself, with its default parameters
   // (a spec with its own parameters would clash with this spec's commas).
   std::vector<std::string> bases;

@@ -166,8 +166,7 @@ std::unique_ptr<Integrator> make_rattle(Params& params) {
       "tol", 1e-14,
       "Newton stop for the position multipliers: max|g(q)| <= tol x |G|inf x |q|inf (relative "
       "to the state's scale)",
-      [](double x) { return x >= std::numeric_limits<double>::epsilon() && x < 1; },
-      "in [2.2e-16, 1)");
+      Range::closed_open(std::numeric_limits<double>::epsilon(), 1));
   const long max_iter =
       params.integer("max_iter", 50, "Newton iterations per step before rattle_max_iter", 1, 1000);
   const bool velocity_projection = params.flag("velocity_projection", true,

@@ -1005,7 +1005,7 @@ std::unique_ptr<Integrator> make_cvode(Params& params, bool bdf) {
   const double nonlin_conv_coef = params.real(
       "nonlin_conv_coef", 0.1,
       "Newton convergence test coefficient relative to the local error test (CVODE default 0.1)",
-      [](double v) { return v > 0 && v <= 1; }, "in (0, 1]");
+      Range::open_closed(0, 1));
   const long max_nonlin_iters = read_max_nonlin_iters(params, 3);
   return std::make_unique<Cvode>(
       bdf, settings, max_order, solver == "klu" ? LinearSolverKind::kKlu : LinearSolverKind::kDense,
@@ -1033,7 +1033,7 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
   const double nonlin_conv_coef = params.real(
       "nonlin_conv_coef", 0.33,
       "Newton convergence test coefficient relative to the local error test (IDA default 0.33)",
-      [](double v) { return v > 0 && v <= 1; }, "in (0, 1]");
+      Range::open_closed(0, 1));
   params.omit_default_from_canonical("nonlin_conv_coef");
   const bool multiplier_atol_given = params.given("multiplier_atol");
   const double multiplier_atol = params.real(
@@ -1041,7 +1041,7 @@ std::unique_ptr<Integrator> make_ida(Params& params) {
       "absolute tolerance of the multipliers (index 2 or 3), which only IDA's Newton "
       "convergence test weighs (default: atol, at index 2 capped where the multipliers' "
       "round-off, amplified by 1/h, would fail that test)",
-      [](double v) { return v >= 0; }, ">= 0");
+      Range::at_least(0));
   // Given, it stays in the canonical spec even at the value of atol: at index 2 it then differs
   // from the default.
   if (!multiplier_atol_given) params.omit_default_from_canonical("multiplier_atol");

@@ -150,7 +150,7 @@ std::unique_ptr<Integrator> make_tao(Params& params) {
       "coupling between the two copies of phase space, units 1/time (errors grow with it; too "
       "small lets the copies drift apart); 0: the problem's omega_max at the start, or "
       "20 where the problem has none",
-      [](double x) { return x >= 0.0; }, ">= 0");
+      Range::at_least(0));
   const std::string order =
       params.choice("order", "2", {"2", "4"}, "2 (Strang) or 4 (Yoshida's triple jump)");
   return std::make_unique<Tao>(omega, order == "4" ? 4 : 2);

@@ -150,15 +150,13 @@ class CarAxis final : public Problem, public HolonomicConstraints, public NonCon
 }  // namespace
 
 std::unique_ptr<Problem> make_car_axis(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
   CarAxisParameters p{};
-  p.eps = params.real("eps", 1e-2, "epsilon: the wheel mass is M eps^2 / 2", positive, "> 0");
-  p.big_mass = params.real("M", 10, "M (wheel mass M eps^2 / 2)", positive, "> 0");
-  p.length = params.real("L", 1, "axis length L", positive, "> 0");
-  p.rest_length = params.real("L0", 0.5, "rest length L0 of both springs", positive, "> 0");
-  p.amplitude = params.real(
-      "r", 0.1, "amplitude of the road excitation y_b = r sin(w t), below L",
-      [](double x) { return x >= 0; }, ">= 0");
+  p.eps = params.real("eps", 1e-2, "epsilon: the wheel mass is M eps^2 / 2", Range::above(0));
+  p.big_mass = params.real("M", 10, "M (wheel mass M eps^2 / 2)", Range::above(0));
+  p.length = params.real("L", 1, "axis length L", Range::above(0));
+  p.rest_length = params.real("L0", 0.5, "rest length L0 of both springs", Range::above(0));
+  p.amplitude = params.real("r", 0.1, "amplitude of the road excitation y_b = r sin(w t), below L",
+                            Range::at_least(0));
   p.frequency = params.real("w", 10, "angular frequency w of the road excitation");
   p.gravity = params.real("g", 1, "gravitational acceleration");
   if (!(p.amplitude < p.length)) {

@@ -114,17 +114,15 @@ class CartesianPendulum final : public Problem, public HolonomicConstraints {
 }  // namespace
 
 std::unique_ptr<Problem> make_cartesian_pendulum(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
-  const double theta0 = params.real(
-      "theta0", 0.5, "initial angle from the downward vertical (rad)",
-      [](double x) { return std::abs(x) <= 1e3; }, "|theta0| <= 1000");
+  const double theta0 = params.real("theta0", 0.5, "initial angle from the downward vertical (rad)",
+                                    Range::magnitude(1000));
   const double v0 = params.real(
       "v0", 0.0, "initial angular velocity (rad per time unit; released from rest by default)",
-      [](double x) { return std::abs(x) <= 1e6; }, "|v0| <= 1e6");
-  const double length = params.real("length", 1.0, "rod length L", positive, "> 0");
-  const double mass = params.real("mass", 1.0, "point mass m", positive, "> 0");
+      Range::magnitude(1e6));
+  const double length = params.real("length", 1.0, "rod length L", Range::above(0));
+  const double mass = params.real("mass", 1.0, "point mass m", Range::above(0));
   const double gravity =
-      params.real("gravity", 1.0, "gravitational acceleration g", positive, "> 0");
+      params.real("gravity", 1.0, "gravitational acceleration g", Range::above(0));
   return std::make_unique<CartesianPendulum>(theta0, v0, length, mass, gravity);
 }
 

@@ -168,18 +168,17 @@ class ChargedParticle final : public Problem,
 }  // namespace
 
 std::unique_ptr<Problem> make_charged_particle(Params& params) {
-  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
-  const auto nonzero = [](double x) { return x != 0 && std::isfinite(x); };
   ChargedParticleParameters p;
   p.bottle = params.choice("field", "uniform", {"uniform", "bottle"},
                            "uniform B along z, or a magnetic bottle B_z = B(1 + z²/length²) on "
                            "the axis") == "bottle";
-  p.mass = params.real("mass", 1.0, "particle mass m", positive, "> 0");
-  p.charge = params.real("charge", 1.0, "particle charge q (either sign)", nonzero, "!= 0");
-  p.field = params.real("B", 1.0, "magnetic field on the axis at z = 0 (along z)", nonzero, "!= 0");
+  p.mass = params.real("mass", 1.0, "particle mass m", Range::above(0));
+  p.charge = params.real("charge", 1.0, "particle charge q (either sign)", Range::non_zero());
+  p.field =
+      params.real("B", 1.0, "magnetic field on the axis at z = 0 (along z)", Range::non_zero());
   p.bottle_length =
       params.real("length", 1.0, "bottle: distance over which B_z grows by B (field=bottle only)",
-                  positive, "> 0");
+                  Range::above(0));
   p.electric[0] = params.real("Ex", 0.0, "uniform electric field, x component");
   p.electric[1] = params.real("Ey", 0.0, "uniform electric field, y component");
   p.electric[2] = params.real("Ez", 0.0, "uniform electric field, z component (along B)");

@@ -151,17 +151,15 @@ class DampedOscillator final : public Problem, public NonConservativeForce {
 }  // namespace
 
 std::unique_ptr<Problem> make_damped_oscillator(Params& params) {
-  const double omega = params.real(
-      "omega", 1.0, "undamped angular frequency", [](double x) { return x > 0; }, "> 0");
+  const double omega = params.real("omega", 1.0, "undamped angular frequency", Range::above(0));
   const double zeta = params.real(
-      "zeta", 0.05, "damping ratio (< 1 under-, 1 critically, > 1 overdamped)",
-      [](double x) { return x >= 0; }, ">= 0");
+      "zeta", 0.05, "damping ratio (< 1 under-, 1 critically, > 1 overdamped)", Range::at_least(0));
   const double q0 = params.real("q0", 1.0, "initial position");
   const double v0 = params.real("v0", 0.0, "initial velocity");
   const double drive_amplitude =
       params.real("drive", 0.0, "amplitude A of the driving force A cos(Ωt) (0: undriven)");
-  const double drive_omega = params.real(
-      "drive_omega", 1.0, "driving angular frequency Ω", [](double x) { return x >= 0; }, ">= 0");
+  const double drive_omega =
+      params.real("drive_omega", 1.0, "driving angular frequency Ω", Range::at_least(0));
   // The driving was added after undriven runs were committed: an undriven spec stays as it was.
   params.omit_default_from_canonical("drive");
   if (drive_amplitude == 0) params.omit_default_from_canonical("drive_omega");

@@ -86,23 +86,20 @@ class DoublePendulum final : public Problem, public LagrangianSystem {
 }  // namespace
 
 std::unique_ptr<Problem> make_double_pendulum(Params& params) {
-  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
-  const auto angle = [](double x) { return std::abs(x) <= 1e3; };
-  const auto rate = [](double x) { return std::abs(x) <= 1e6; };
-  const double m1 = params.real("m1", 1.0, "upper bob mass", positive, "> 0");
-  const double m2 = params.real("m2", 1.0, "lower bob mass", positive, "> 0");
-  const double l1 = params.real("l1", 1.0, "upper rod length", positive, "> 0");
-  const double l2 = params.real("l2", 1.0, "lower rod length", positive, "> 0");
-  const double g = params.real("g", 9.81, "gravitational acceleration", positive, "> 0");
+  const double m1 = params.real("m1", 1.0, "upper bob mass", Range::above(0));
+  const double m2 = params.real("m2", 1.0, "lower bob mass", Range::above(0));
+  const double l1 = params.real("l1", 1.0, "upper rod length", Range::above(0));
+  const double l2 = params.real("l2", 1.0, "lower rod length", Range::above(0));
+  const double g = params.real("g", 9.81, "gravitational acceleration", Range::above(0));
   Vec theta(2), omega(2);
-  theta[0] = params.real("theta1", 0.3, "upper rod angle from the downward vertical (rad)", angle,
-                         "|theta1| <= 1000");
-  theta[1] = params.real("theta2", -0.2, "lower rod angle from the downward vertical (rad)", angle,
-                         "|theta2| <= 1000");
+  theta[0] = params.real("theta1", 0.3, "upper rod angle from the downward vertical (rad)",
+                         Range::magnitude(1000));
+  theta[1] = params.real("theta2", -0.2, "lower rod angle from the downward vertical (rad)",
+                         Range::magnitude(1000));
   omega[0] =
-      params.real("omega1", 0.0, "initial rate of theta1 (rad per time)", rate, "|omega1| <= 1e6");
+      params.real("omega1", 0.0, "initial rate of theta1 (rad per time)", Range::magnitude(1e6));
   omega[1] =
-      params.real("omega2", 0.0, "initial rate of theta2 (rad per time)", rate, "|omega2| <= 1e6");
+      params.real("omega2", 0.0, "initial rate of theta2 (rad per time)", Range::magnitude(1e6));
   return std::make_unique<DoublePendulum>(m1, m2, l1, l2, g, theta, omega);
 }
 

@@ -855,8 +855,6 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
   // 10⁶ cells = 6·10⁶ tetrahedra, ~2 GB of element data and Hessian pattern (~136 B per element,
   // ~135 Hessian entries per node); the entry count stays well inside Eigen's int index.
   constexpr long kMaxCells = 1'000'000;
-  const auto positive = [](double x) { return x > 0; };
-  const auto non_negative = [](double x) { return x >= 0; };
   BarConfig config;
   config.nx = static_cast<int>(params.integer("nx", 8, "cells along the bar (x)", 1, kMaxCells));
   config.ny = static_cast<int>(params.integer("ny", 2, "cells across the width (y)", 1, kMaxCells));
@@ -867,17 +865,16 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
         fmt::format("problem 'elastic_bar': parameters nx={}, ny={}, nz={} give more than {} cells",
                     config.nx, config.ny, config.nz, kMaxCells));
   }
-  config.length = params.real("length", 1.0, "bar length (x)", positive, "> 0");
-  config.width = params.real("width", 0.2, "bar width (y)", positive, "> 0");
-  config.height = params.real("height", 0.2, "bar height (z)", positive, "> 0");
+  config.length = params.real("length", 1.0, "bar length (x)", Range::above(0));
+  config.width = params.real("width", 0.2, "bar width (y)", Range::above(0));
+  config.height = params.real("height", 0.2, "bar height (z)", Range::above(0));
   config.material = params.choice("material", "neohookean", {"stvk", "neohookean"},
                                   "hyperelastic energy W(F)") == "stvk"
                         ? Material::kStvk
                         : Material::kNeoHookean;
-  config.young = params.real("young", 1e5, "Young's modulus E", positive, "> 0");
-  config.poisson = params.real(
-      "poisson", 0.3, "Poisson's ratio", [](double x) { return x >= 0 && x < 0.5; }, "in [0, 0.5)");
-  config.density = params.real("density", 1000.0, "mass density rho", positive, "> 0");
+  config.young = params.real("young", 1e5, "Young's modulus E", Range::above(0));
+  config.poisson = params.real("poisson", 0.3, "Poisson's ratio", Range::closed_open(0, 0.5));
+  config.density = params.real("density", 1000.0, "mass density rho", Range::above(0));
   const std::string clamp = params.choice(
       "clamp", "left", {"left", "none", "constraint", "pin"},
       "left: nodes at x = 0 fixed (removed); none: free; constraint: nodes at x = 0 pinned by "
@@ -890,8 +887,7 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
   // for it is an error rather than a silent loss of the momentum checks.
   config.gravity = params.real(
       "gravity", config.face_held() ? 9.81 : 0.0,
-      "gravitational acceleration along -z (default 9.81 with a held face, 0 free or pinned)",
-      [](double x) { return std::isfinite(x); }, "finite");
+      "gravitational acceleration along -z (default 9.81 with a held face, 0 free or pinned)");
   if (config.clamp == Clamp::kNone && config.gravity != 0) {
     throw InputError(fmt::format(
         "problem 'elastic_bar': parameter gravity={} needs clamp=left (a free bar under gravity "
@@ -899,7 +895,7 @@ std::unique_ptr<Problem> make_elastic_bar(Params& params) {
         format_number(config.gravity)));
   }
   config.damping =
-      params.real("damping", 0.0, "strain-rate damping nu (time units)", non_negative, ">= 0");
+      params.real("damping", 0.0, "strain-rate damping nu (time units)", Range::at_least(0));
   const std::string init = params.choice("init", config.face_held() ? "rest" : "velocity",
                                          {"rest", "twist", "bend", "velocity"},
                                          "initial condition (default rest clamped, velocity free)");

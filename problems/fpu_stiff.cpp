@@ -135,8 +135,7 @@ class FpuStiff final : public Problem {
 std::unique_ptr<Problem> make_fpu_stiff(Params& params) {
   const int m = static_cast<int>(params.integer("m", 3, "number of stiff springs", 1, 100'000));
   const double omega = params.real(
-      "omega", 50.0, "stiff frequency (stiff spring constant omega^2/2)",
-      [](double x) { return x >= 1 && x <= 1e6; }, "in [1, 1e6]");
+      "omega", 50.0, "stiff frequency (stiff spring constant omega^2/2)", Range::closed(1, 1e6));
   return std::make_unique<FpuStiff>(m, omega);
 }
 

@@ -206,6 +206,14 @@ State read_initial_state(const Problem& problem, const std::string& path) {
         "each)",
         path, first.size(), problem.spec(), n));
   }
+  for (const Problem::PositiveCoordinate& coordinate : problem.positive_coordinates()) {
+    const double value = first[coordinate.index];
+    if (!(value > 0)) {
+      throw InputError(fmt::format(
+          "initial state: {}: row {}: q = {} is out of range for {} of problem '{}' (allowed: > 0)",
+          path, coordinate.index + 1, format_number(value), coordinate.name, problem.spec()));
+    }
+  }
   State state;
   state.t = problem.initial_state().t;
   state.q = Eigen::Map<const Vec>(first.data(), n);

@@ -31,9 +31,8 @@ class Harmonic final : public OscillatorBase {
 }  // namespace
 
 std::unique_ptr<Problem> make_harmonic(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
-  const double omega = params.real("omega", 1.0, "angular frequency", positive, "> 0");
-  const double mass = params.real("mass", 1.0, "mass m", positive, "> 0");
+  const double omega = params.real("omega", 1.0, "angular frequency", Range::above(0));
+  const double mass = params.real("mass", 1.0, "mass m", Range::above(0));
   const double q0 = params.real("q0", 1.0, "initial position");
   const double v0 = params.real("v0", 0.0, "initial velocity");
   return std::make_unique<Harmonic>(omega, mass, q0, v0);

@@ -57,10 +57,9 @@ std::unique_ptr<Problem> make_heavy_top(Params& params) {
   const RigidBodyParameters P = read_rigid_body_parameters(params);
   check_attitude_masses(P, "heavy_top");
   const Eigen::Matrix3d attitude = read_initial_attitude(params, "heavy_top");
-  const auto positive = [](double x) { return x > 0; };
-  const double mass = params.real("m", 1.0, "mass of the body", positive, "> 0");
+  const double mass = params.real("m", 1.0, "mass of the body", Range::above(0));
   const double gravity =
-      params.real("g", 9.81, "gravitational acceleration (along -e3)", positive, "> 0");
+      params.real("g", 9.81, "gravitational acceleration (along -e3)", Range::above(0));
   Eigen::Vector3d centre;
   centre[0] = params.real("chi1", 0.0, "centre of mass in the body frame, component 1");
   centre[1] = params.real("chi2", 0.0, "centre of mass in the body frame, component 2");

@@ -48,9 +48,8 @@ class HenonHeiles final : public Problem {
 }  // namespace
 
 std::unique_ptr<Problem> make_henon_heiles(Params& params) {
-  const double energy = params.real(
-      "energy", 1.0 / 12, "total energy H (orbits with H < 1/6 stay bounded)",
-      [](double x) { return std::isfinite(x); }, "finite");
+  const double energy =
+      params.real("energy", 1.0 / 12, "total energy H (orbits with H < 1/6 stay bounded)");
   const double q1 = params.real("q1", 0.0, "initial q1");
   const double q2 = params.real("q2", 0.1, "initial q2");
   const double p1 = params.real("p1", 0.1, "initial p1 (p2 >= 0 follows from the energy)");

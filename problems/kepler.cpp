@@ -139,6 +139,9 @@ class KeplerPolar final : public Problem, public LagrangianSystem {
     set_defaults(0.01, 10 * 2 * kPi);
   }
 
+  std::vector<PositiveCoordinate> positive_coordinates() const override {
+    return {{0, "r (the radius)"}};
+  }
   State initial_state() const override { return to_polar(cartesian_.initial_state()); }
 
   void mass_matrix(const Vec& q, DenseMatrix& M) const override {
@@ -201,9 +204,8 @@ class KeplerPolar final : public Problem, public LagrangianSystem {
 }  // namespace
 
 std::unique_ptr<Problem> make_kepler(Params& params) {
-  const double e = params.real(
-      "e", 0.6, "eccentricity (semi-major axis 1, period 2pi)",
-      [](double x) { return x >= 0 && x < 1; }, "in [0, 1)");
+  const double e = params.real("e", 0.6, "eccentricity (semi-major axis 1, period 2pi)",
+                               Range::closed_open(0, 1));
   const std::string coordinates =
       params.choice("coordinates", "cartesian", {"cartesian", "polar"},
                     "q = (x, y), or q = (r, phi) with the mass diag(1, r^2) (non_separable)");

@@ -368,8 +368,7 @@ std::unique_ptr<Problem> make_nbody(Params& params) {
             std::to_string(data.velocities.size()) + "; or file=bodies.csv");
       }
     }
-    data.gravity = params.real(
-        "G", 1.0, "gravitational constant", [](double g) { return g > 0; }, "> 0");
+    data.gravity = params.real("G", 1.0, "gravitational constant", Range::above(0));
     check_bodies(data);
   }
   if (params.choice(

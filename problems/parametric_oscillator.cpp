@@ -38,16 +38,13 @@ class ParametricOscillator final : public OscillatorBase, public NonConservative
 }  // namespace
 
 std::unique_ptr<Problem> make_parametric_oscillator(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
   const double omega =
-      params.real("omega", 1.0, "unmodulated angular frequency ω", positive, "> 0");
-  const double epsilon = params.real(
-      "epsilon", 0.1, "relative stiffness modulation ε", [](double e) { return std::abs(e) < 1; },
-      "in (-1, 1), so the stiffness stays positive");
-  const double nu = params.real(
-      "nu", 1.3, "modulation frequency ν (ν = 2ω: parametric resonance)",
-      [](double x) { return x >= 0; }, ">= 0");
-  const double mass = params.real("mass", 1.0, "mass m", positive, "> 0");
+      params.real("omega", 1.0, "unmodulated angular frequency ω", Range::above(0));
+  const double epsilon =
+      params.real("epsilon", 0.1, "relative stiffness modulation ε", Range::open(-1, 1));
+  const double nu = params.real("nu", 1.3, "modulation frequency ν (ν = 2ω: parametric resonance)",
+                                Range::at_least(0));
+  const double mass = params.real("mass", 1.0, "mass m", Range::above(0));
   const double q0 = params.real("q0", 1.0, "initial position");
   const double v0 = params.real("v0", 0.0, "initial velocity");
   return std::make_unique<ParametricOscillator>(omega, epsilon, nu, mass, q0, v0);

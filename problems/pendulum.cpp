@@ -197,15 +197,12 @@ class Pendulum final : public Problem {
 
 std::unique_ptr<Problem> make_pendulum(Params& params) {
   // An angle of 1e3 rad still resolves 1e-13 rad; far beyond, θ + hθ̇ loses the step.
-  const double theta0 = params.real(
-      "theta0", 0.5, "initial angle from the bottom (rad)",
-      [](double x) { return std::abs(x) <= 1e3; }, "|theta0| <= 1000");
-  const double omega0 = params.real(
-      "omega0", 1.0, "small-amplitude angular frequency sqrt(g/L)", [](double x) { return x > 0; },
-      "> 0");
+  const double theta0 =
+      params.real("theta0", 0.5, "initial angle from the bottom (rad)", Range::magnitude(1000));
+  const double omega0 =
+      params.real("omega0", 1.0, "small-amplitude angular frequency sqrt(g/L)", Range::above(0));
   const double v0 = params.real(
-      "v0", 0.0, "initial angular velocity (released from rest by default)",
-      [](double x) { return std::abs(x) <= 1e6; }, "|v0| <= 1e6");
+      "v0", 0.0, "initial angular velocity (released from rest by default)", Range::magnitude(1e6));
   return std::make_unique<Pendulum>(theta0, omega0, v0);
 }
 

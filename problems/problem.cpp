@@ -95,8 +95,8 @@ std::unique_ptr<Problem> make_problem(const std::string& spec_text) {
       problem->check_consistent(problem->initial_state(), "initial state");
     return problem;
   }
-  throw InputError(
-      fmt::format("unknown problem '{}' (valid: {})", spec.name, fmt::join(names, ", ")));
+  throw InputError(fmt::format("unknown problem '{}'{} (valid: {})", spec.name,
+                               did_you_mean(spec.name, names), fmt::join(names, ", ")));
 }
 
 std::vector<std::string> capability_names(unsigned capabilities) {

@@ -130,6 +130,14 @@ class Problem {
 
   int dof() const { return dof_; }
   virtual State initial_state() const = 0;
+  // The coordinates that must stay > 0 for q to mean a state (a polar radius: at r < 0 the polar
+  // Kepler force 1/r² pulls outward), as (index into q, name): an initial state read from a file
+  // is refused unless each is > 0 (given_initial_state.cpp).
+  struct PositiveCoordinate {
+    int index;
+    const char* name;
+  };
+  virtual std::vector<PositiveCoordinate> positive_coordinates() const { return {}; }
   // Diagonal of the (lumped) mass matrix M, all entries > 0. Only the kSeparable kind has one:
   // on a kLagrangian problem (M(q), use its LagrangianSystem) or a kFirstOrder one (no mass at
   // all) mass(), inverse_mass() and kinetic() throw std::logic_error naming problem and kind.

@@ -163,22 +163,20 @@ class RodChainJoint final : public Problem, public LagrangianSystem {
 }  // namespace
 
 std::unique_ptr<Problem> make_rod_chain(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
   const int n =
       static_cast<int>(params.integer("n", 2, "number of rods (and moving nodes)", 1, 64));
-  const double mass = params.real("mass", 1.0, "mass of node 1", positive, "> 0");
+  const double mass = params.real("mass", 1.0, "mass of node 1", Range::above(0));
   const double mass_ratio =
-      params.real("mass_ratio", 1.0, "mass of node i+1 / mass of node i", positive, "> 0");
-  const double length = params.real("length", 1.0, "length of rod 1", positive, "> 0");
+      params.real("mass_ratio", 1.0, "mass of node i+1 / mass of node i", Range::above(0));
+  const double length = params.real("length", 1.0, "length of rod 1", Range::above(0));
   const double length_ratio =
-      params.real("length_ratio", 1.0, "length of rod i+1 / length of rod i", positive, "> 0");
+      params.real("length_ratio", 1.0, "length of rod i+1 / length of rod i", Range::above(0));
   const double gravity =
-      params.real("gravity", 1.0, "gravitational acceleration (along -y)", positive, "> 0");
-  const auto angle_ok = [](double x) { return std::abs(x) <= 1000; };
+      params.real("gravity", 1.0, "gravitational acceleration (along -y)", Range::above(0));
   const double theta = params.real("theta", 2.0,
                                    "initial angle of every rod from the downward vertical (rad); "
                                    "theta<i> overrides it for rod i",
-                                   angle_ok, "|theta| <= 1000");
+                                   Range::magnitude(1000));
   const double omega =
       params.real("omega", 0.0, "initial angular velocity of every rod (rad per time unit)");
   const std::string coordinates = params.choice(
@@ -195,9 +193,9 @@ std::unique_ptr<Problem> make_rod_chain(Params& params) {
   // construction (make_problem still checks it).
   double x = 0, y = 0, vx = 0, vy = 0;
   for (int i = 0; i < n; ++i) {
-    const double angle = params.real(fmt::format("theta{}", i + 1), theta,
-                                     fmt::format("initial angle of rod {} (rad)", i + 1), angle_ok,
-                                     "|theta<i>| <= 1000");
+    const double angle =
+        params.real(fmt::format("theta{}", i + 1), theta,
+                    fmt::format("initial angle of rod {} (rad)", i + 1), Range::magnitude(1000));
     const double rod_length = length * std::pow(length_ratio, i);
     node_mass[i] = mass * std::pow(mass_ratio, i);
     if (!std::isfinite(rod_length) || !std::isfinite(node_mass[i]) || rod_length <= 0 ||

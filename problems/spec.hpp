@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -35,11 +36,53 @@ std::vector<std::string> split_variants(const std::string& text);
 // register_method() and register_problem() accept; `kind` is "method" or "problem".
 void check_registration_name(const std::string& name, const std::string& kind);
 
-// Documentation of one parameter, collected while a factory reads its parameters.
+// Candidates within an edit distance of a quarter of the word's length, at least 1
+// (Damerau–Levenshtein, optimal string alignment; case-insensitive), closest first, at most three:
+// what "did you mean" offers for a misspelt name, key, verb or option.
+std::vector<std::string> close_matches(const std::string& word,
+                                       const std::vector<std::string>& candidates);
+// " (did you mean 'x' or 'y'?)" from close_matches, "" when nothing is close.
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
+
+// The allowed values of a numeric parameter, as data rather than code: Params checks a value
+// against it and `geomint list NAME` prints it, so the printed range is the enforced one.
+struct Range {
+  static constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double min = -kInfinity;
+  double max = kInfinity;
+  bool min_open = false, max_open = false;
+  bool nonzero = false;  // additionally != 0 (a charge, a field)
+
+  static Range above(double x) { return {x, kInfinity, true, false}; }          // > x
+  static Range at_least(double x) { return {x, kInfinity, false, false}; }      // >= x
+  static Range closed(double a, double b) { return {a, b, false, false}; }      // [a, b]
+  static Range closed_open(double a, double b) { return {a, b, false, true}; }  // [a, b)
+  static Range open(double a, double b) { return {a, b, true, true}; }          // (a, b)
+  static Range open_closed(double a, double b) { return {a, b, true, false}; }  // (a, b]
+  static Range magnitude(double m) { return closed(-m, m); }                    // |x| <= m
+  static Range non_zero() {
+    Range range;
+    range.nonzero = true;
+    return range;
+  }
+
+  bool contains(double x) const;
+  // "> 0", ">= 0", "in [0, 1)", "|theta0| <= 1000" (for name "theta0"), "!= 0"; "" when
+  // unrestricted.
+  std::string text(const std::string& name = "x") const;
+  bool restricts() const { return nonzero || min > -kInfinity || max < kInfinity; }
+};
+
+// Documentation of one parameter, collected while a factory reads its parameters: its kind
+// ("real", "integer", "choice", "flag", "reals", "text"), default, help, and for numbers the
+// range the reader enforces (`range` set) or, for the older lambda form, its description.
 struct ParamDoc {
   std::string key;
   std::string default_value;
   std::string help;
+  std::string kind;
+  std::optional<Range> range;
+  std::string allowed;  // what is allowed, as printed by `geomint list NAME`
 };
 
 // Bound on the magnitude of every real parameter (Params::real).
@@ -52,11 +95,16 @@ class Params {
  public:
   Params(const Spec& spec, std::string context);
 
-  // Real parameter; `valid` describes the allowed range for the message ("> 0", "in [0, 1]").
-  // Every real parameter must also satisfy |x| <= kMaxParameterMagnitude: larger values square
-  // or multiply into overflow (ω², k·x²) or leave no digits for a step (θ + hω at θ = 1e308).
+  // Real parameter in `range` (docs/PROBLEMS.md: ranges are data, printed by `geomint list
+  // NAME`). Every real parameter must also satisfy |x| <= kMaxParameterMagnitude: larger values
+  // square or multiply into overflow (ω², k·x²) or leave no digits for a step (θ + hω at
+  // θ = 1e308).
   double real(const std::string& key, double default_value, const std::string& help,
-              const std::function<bool(double)>& ok = nullptr, const std::string& valid = "");
+              const Range& range = Range{});
+  // The older form: a predicate and its description `valid` ("> 0"). `geomint list` prints the
+  // description but cannot check it against the predicate; prefer a Range.
+  double real(const std::string& key, double default_value, const std::string& help,
+              const std::function<bool(double)>& ok, const std::string& valid);
   // Integer parameter, bounds inclusive.
   long integer(const std::string& key, long default_value, const std::string& help, long min_value,
                long max_value);
@@ -89,8 +137,8 @@ class Params {
 
  private:
   const std::string* raw(const std::string& key);
-  void record(const std::string& key, const std::string& default_value, const std::string& help,
-              const std::string& value);
+  void record(ParamDoc doc, const std::string& value);
+  double read_real(const std::string& key, double default_value);
 
   Spec spec_;
   std::string context_;

@@ -174,18 +174,14 @@ class SphericalPendulumAngles final : public Problem, public LagrangianSystem {
 }  // namespace
 
 std::unique_ptr<Problem> make_spherical_pendulum(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
   SphericalParameters P{};
-  P.length = params.real("length", 1.0, "rod length L", positive, "> 0");
+  P.length = params.real("length", 1.0, "rod length L", Range::above(0));
   P.gravity =
-      params.real("gravity", 1.0, "gravitational acceleration g (along -z)", positive, "> 0");
-  P.mass = params.real("mass", 1.0, "bob mass", positive, "> 0");
-  P.theta0 = params.real(
-      "theta0", 1.0, "initial angle from the downward vertical (rad)",
-      [](double x) { return std::abs(x) <= 1000; }, "|theta0| <= 1000");
-  P.phi0 = params.real(
-      "phi0", 0.0, "initial azimuth (rad)", [](double x) { return std::abs(x) <= 1000; },
-      "|phi0| <= 1000");
+      params.real("gravity", 1.0, "gravitational acceleration g (along -z)", Range::above(0));
+  P.mass = params.real("mass", 1.0, "bob mass", Range::above(0));
+  P.theta0 = params.real("theta0", 1.0, "initial angle from the downward vertical (rad)",
+                         Range::magnitude(1000));
+  P.phi0 = params.real("phi0", 0.0, "initial azimuth (rad)", Range::magnitude(1000));
   P.theta_dot0 = params.real("theta_dot0", 0.0, "initial polar angular velocity");
   const double cos_theta0 = std::cos(P.theta0);
   const bool can_be_conical = cos_theta0 > 0 && std::sin(P.theta0) != 0;

@@ -209,7 +209,6 @@ class SpringChain final : public Problem {
 }  // namespace
 
 std::unique_ptr<Problem> make_spring_chain(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
   SpringChainConfig config;
   config.n = static_cast<int>(params.integer("n", 8, "number of masses", 2, 10'000'000));
   const std::string ends =
@@ -219,12 +218,12 @@ std::unique_ptr<Problem> make_spring_chain(Params& params) {
   config.fixed_right = ends == "fixed";
   const std::string model = params.choice("model", "linear", {"linear", "fpu_alpha", "fpu_beta"},
                                           "spring law: 1/2 k d^2, plus alpha d^3/3, or beta d^4/4");
-  config.mass = params.real("mass", 1.0, "mass of each node", positive, "> 0");
-  config.stiffness = params.real("stiffness", 1.0, "linear spring stiffness k", positive, "> 0");
+  config.mass = params.real("mass", 1.0, "mass of each node", Range::above(0));
+  config.stiffness = params.real("stiffness", 1.0, "linear spring stiffness k", Range::above(0));
   const double alpha =
-      params.real("alpha", 0.25, "cubic coefficient (model=fpu_alpha only)", positive, "> 0");
+      params.real("alpha", 0.25, "cubic coefficient (model=fpu_alpha only)", Range::above(0));
   const double beta =
-      params.real("beta", 1.0, "quartic coefficient (model=fpu_beta only)", positive, "> 0");
+      params.real("beta", 1.0, "quartic coefficient (model=fpu_beta only)", Range::above(0));
   config.alpha = model == "fpu_alpha" ? alpha : 0.0;
   config.beta = model == "fpu_beta" ? beta : 0.0;
   const std::string init = params.choice("init", "mode", {"mode", "node"},

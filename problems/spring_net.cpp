@@ -303,8 +303,6 @@ class SpringNet final : public Problem, public NonConservativeForce {
 std::unique_ptr<Problem> make_spring_net(Params& params) {
   // Up to 10⁷ degrees of freedom: the Hessian's entry count then still fits Eigen's int indices.
   constexpr long kMaxDof = 10'000'000;
-  const auto positive = [](double x) { return x > 0; };
-  const auto non_negative = [](double x) { return x >= 0; };
   SpringNetConfig config;
   const long dim = params.integer("dim", 2, "spatial dimension", 2, 3);
   config.nx = static_cast<int>(params.integer("nx", 8, "nodes along x", 2, kMaxDof));
@@ -321,30 +319,30 @@ std::unique_ptr<Problem> make_spring_net(Params& params) {
         "degrees of freedom",
         config.nx, config.ny, config.nz, dim, kMaxDof));
   }
-  config.spacing = params.real("spacing", 1.0, "lattice spacing", positive, "> 0");
-  config.mass = params.real("mass", 1.0, "mass of each node", positive, "> 0");
-  config.stiffness = params.real("stiffness", 100.0, "spring stiffness k", positive, "> 0");
+  config.spacing = params.real("spacing", 1.0, "lattice spacing", Range::above(0));
+  config.mass = params.real("mass", 1.0, "mass of each node", Range::above(0));
+  config.stiffness = params.real("stiffness", 100.0, "spring stiffness k", Range::above(0));
   const std::string model = params.choice("model", "hookean", {"hookean", "nonlinear"},
                                           "spring law: 1/2 k (r-L)^2, or plus 1/4 k4 (r-L)^4");
   const double quartic = params.real(
       "quartic", 10 * config.stiffness,
-      "quartic coefficient k4 (model=nonlinear only; default 10*stiffness)", non_negative, ">= 0");
+      "quartic coefficient k4 (model=nonlinear only; default 10*stiffness)", Range::at_least(0));
   config.quartic = model == "nonlinear" ? quartic : 0.0;
   config.diagonals = params.flag("diagonals", true, "add face/body diagonal springs (rigid)");
-  config.rest_perturbation = params.real(
-      "rest_perturbation", 0.1, "relative random perturbation of the rest lengths",
-      [](double x) { return x >= 0 && x < 1; }, "in [0, 1)");
-  config.position_jitter = params.real(
-      "position_jitter", 0.05, "random initial displacement relative to spacing",
-      [](double x) { return x >= 0 && x < 0.5; }, "in [0, 0.5)");
+  config.rest_perturbation =
+      params.real("rest_perturbation", 0.1, "relative random perturbation of the rest lengths",
+                  Range::closed_open(0, 1));
+  config.position_jitter =
+      params.real("position_jitter", 0.05, "random initial displacement relative to spacing",
+                  Range::closed_open(0, 0.5));
   config.velocity =
-      params.real("velocity", 1.0, "scale of the random initial velocities", non_negative, ">= 0");
+      params.real("velocity", 1.0, "scale of the random initial velocities", Range::at_least(0));
   config.spin = params.real("spin", 0.5, "angular velocity of a rigid spin about the centre");
   config.drift = params.real("drift", 0.3, "uniform initial velocity along x");
   config.seed = static_cast<unsigned long>(
       params.integer("seed", 1, "random seed (std::mt19937_64)", 0, 1L << 62));
   config.damping =
-      params.real("damping", 0.0, "damping coefficient c along the springs", non_negative, ">= 0");
+      params.real("damping", 0.0, "damping coefficient c along the springs", Range::at_least(0));
   if (dim == 2) return std::make_unique<SpringNet<2>>(config);
   return std::make_unique<SpringNet<3>>(config);
 }

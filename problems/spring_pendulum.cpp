@@ -30,6 +30,9 @@ class SpringPendulum final : public Problem, public LagrangianSystem {
     set_defaults(0.05 / fastest, 10 * 2 * std::numbers::pi / slowest);
   }
 
+  std::vector<PositiveCoordinate> positive_coordinates() const override {
+    return {{0, "r (the spring length)"}};
+  }
   State initial_state() const override {
     State state{0.0, Vec(2), Vec(2)};
     state.q << P_.r0, P_.phi0;
@@ -88,22 +91,19 @@ class SpringPendulum final : public Problem, public LagrangianSystem {
 }  // namespace
 
 std::unique_ptr<Problem> make_spring_pendulum(Params& params) {
-  const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
-  const auto angle = [](double x) { return std::abs(x) <= 1e3; };
-  const auto rate = [](double x) { return std::abs(x) <= 1e6; };
   SpringPendulumParameters P{};
-  P.mass = params.real("m", 1.0, "bob mass", positive, "> 0");
-  P.stiffness = params.real("k", 40.0, "spring stiffness", positive, "> 0");
-  P.rest_length = params.real("l0", 1.0, "spring rest length", positive, "> 0");
-  P.gravity = params.real("g", 9.81, "gravitational acceleration", positive, "> 0");
+  P.mass = params.real("m", 1.0, "bob mass", Range::above(0));
+  P.stiffness = params.real("k", 40.0, "spring stiffness", Range::above(0));
+  P.rest_length = params.real("l0", 1.0, "spring rest length", Range::above(0));
+  P.gravity = params.real("g", 9.81, "gravitational acceleration", Range::above(0));
   P.r0 =
       params.real("r0", 1.4, "initial spring length (the mass m diag(1, r^2) is singular at r = 0)",
-                  positive, "> 0");
-  P.phi0 = params.real("phi0", 0.5, "initial angle from the downward vertical (rad)", angle,
-                       "|phi0| <= 1000");
-  P.rdot0 = params.real("rdot0", 0.0, "initial rate of r", rate, "|rdot0| <= 1e6");
+                  Range::above(0));
+  P.phi0 = params.real("phi0", 0.5, "initial angle from the downward vertical (rad)",
+                       Range::magnitude(1000));
+  P.rdot0 = params.real("rdot0", 0.0, "initial rate of r", Range::magnitude(1e6));
   P.phidot0 =
-      params.real("phidot0", 0.0, "initial rate of phi (rad per time)", rate, "|phidot0| <= 1e6");
+      params.real("phidot0", 0.0, "initial rate of phi (rad per time)", Range::magnitude(1e6));
   return std::make_unique<SpringPendulum>(P);
 }
 

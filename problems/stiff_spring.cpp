@@ -87,12 +87,11 @@ class StiffSpring final : public Problem {
 }  // namespace
 
 std::unique_ptr<Problem> make_stiff_spring(Params& params) {
-  const auto positive = [](double x) { return x > 0; };
-  const double soft = params.real("k_soft", 1.0, "soft spring (wall to mass 1)", positive, "> 0");
-  const double ratio = params.real(
-      "ratio", 1e4, "stiffness ratio k_stiff/k_soft (stiff spring between the masses)",
-      [](double x) { return x >= 1 && x <= 1e12; }, "in [1, 1e12]");
-  const double mass = params.real("mass", 1.0, "mass of each of the two bodies", positive, "> 0");
+  const double soft = params.real("k_soft", 1.0, "soft spring (wall to mass 1)", Range::above(0));
+  const double ratio =
+      params.real("ratio", 1e4, "stiffness ratio k_stiff/k_soft (stiff spring between the masses)",
+                  Range::closed(1, 1e12));
+  const double mass = params.real("mass", 1.0, "mass of each of the two bodies", Range::above(0));
   const double q0 = params.real("q0", 1.0, "initial displacement of both masses");
   const double stretch =
       params.real("stretch", 0.0, "initial elongation of the stiff spring (excites the fast mode)");

@@ -71,7 +71,7 @@ std::unique_ptr<Problem> make_van_der_pol(Params& params) {
       "mu", 1000.0,
       "van der Pol parameter mu; the scaled form has epsilon = 1/mu^2 (mu = 1000: the Test Set's "
       "VDPOL, epsilon = 1e-6, with its reference at t = 2)",
-      [](double x) { return x >= 1 && x <= 1e8; }, "in [1, 1e8]");
+      Range::closed(1, 1e8));
   return std::make_unique<VanDerPol>(mu);
 }
 

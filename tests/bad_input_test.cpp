@@ -254,7 +254,8 @@ const std::vector<Case>& cases() {
        "run --problem kepler:coordinates=polar --method rk4 --initial {dir}/start.csv --dt 0.01 "
        "--t-end 1",
        2,
-       "allowed: a q where M(q) is positive definite",
+       "q = 0 is out of range for r (the radius) of problem 'kepler:coordinates=polar,e=0.6' "
+       "(allowed: > 0)",
        {{"start.csv", "q,p\n0,0.1\n0.2,0.3\n"}},
        {"start.csv"}},
       {"ConstrainedOrderOnUnconstrainedProblem",
@@ -472,10 +473,10 @@ const std::vector<Case>& cases() {
         {"site/index.html", "old"}},
        {"r", "r/s", "r/s/scene.toml", "site", "site/.geomint-report", "site/index.html",
         "site/style.css", "site/s", "site/s/index.html"}},
-      {"ReportOutEmpty",
+      {"ReportOutEmpty",  // refused for every option (harden_options), before report's own check
        "report --results {dir}/r --out ''",
        2,
-       "--out is empty",
+       "--out: an empty value is not allowed",
        {{"r/", ""}, {"r/s/", ""}, {"r/s/scene.toml", "title = 'x'\n"}},
        {"r", "r/s", "r/s/scene.toml"}},
       {"ReportOutIsTheCurrentFolder",  // run inside a previous site: `--out .` deleted it
@@ -1398,7 +1399,7 @@ const std::vector<Case>& cases() {
       {"WallBudgetTooLarge", "run --problem pendulum --method rk4 --wall-budget 1e9", 2,
        "--wall-budget must be in [0, 86400]"},
       {"WallBudgetNan", "run --problem pendulum --method rk4 --wall-budget nan", 2,
-       "--wall-budget must be in [0, 86400]"},
+       "--wall-budget: NaN is not allowed"},
       {"WallBudgetSpentIsATimeoutRow",
        "run --problem kepler --method rk4 --dt 0.001 --t-end 100 --wall-budget 1e-9", 1,
        ",timeout,"},
@@ -1520,6 +1521,100 @@ const std::vector<Case>& cases() {
       {"OrderFromErrorsAboveTheSolutionIsNoFit",
        "order --problem kepler:e=0.999 --method stormer_verlet --dt 0.01 --levels 4 --t-end 2", 1,
        "not small against the solution"},
+      // --- files that are not there: said so, not "malformed ...: File could not be opened" ---
+      {"SceneDoesNotExist", "sweep {dir}/missing.toml", 2, "missing.toml' does not exist"},
+      {"GatesFileDoesNotExist", "gate {dir}/missing.toml {dir}", 2, "missing.toml' does not exist"},
+      {"MergeImplicitSceneDoesNotExist",
+       "merge {dir}/out",
+       2,
+       "out/scene.toml' does not exist",
+       {{"out/", ""}, {"out/shards/", ""}, {"out/shards/summary.csv", "# variant: full\nlabel\n"}},
+       {"out", "out/shards", "out/shards/summary.csv"}},
+      // --- NaN and inf pass a plain range check (comparisons with NaN are false) ---
+      {"ProgressIntervalNan",
+       "sweep {dir}/scene.toml --progress-interval nan",
+       2,
+       "--progress-interval",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"}},
+      {"ProgressIntervalInf",
+       "sweep {dir}/scene.toml --progress-interval inf",
+       2,
+       "--progress-interval",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"}},
+      {"ProgressIntervalNanFromEnvironment",
+       "sweep {dir}/scene.toml",
+       2,
+       "--progress-interval",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"},
+       30,
+       "GEOMINT_PROGRESS_INTERVAL=nan"},
+      {"DtNan", "run --problem pendulum --method rk4 --dt nan --t-end 1", 2, "--dt"},
+      {"PerfCompareAlphaNan",
+       "perf-compare {dir}/a.json {dir}/a.json --alpha nan",
+       2,
+       "--alpha",
+       {{"a.json", kBenchJson}},
+       {"a.json"}},
+      // --- an empty value (an unset shell variable) is not 0 ---
+      {"EmptyDivergeFactor", "run --problem pendulum --method rk4 --diverge-factor ''", 2,
+       "--diverge-factor: an empty value is not allowed"},
+      {"EmptyWallBudget", "run --problem pendulum --method rk4 --wall-budget ''", 2,
+       "--wall-budget: an empty value is not allowed"},
+      {"EmptyTimingRepeats", "run --problem pendulum --method rk4 --timing-repeats ''", 2,
+       "--timing-repeats: an empty value is not allowed"},
+      {"EmptyJobs",
+       "sweep {dir}/scene.toml --jobs ''",
+       2,
+       "--jobs: an empty value is not allowed",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"}},
+      {"EmptyOrderLevels", "order --problem pendulum --method rk4 --dt 0.1 --t-end 1 --levels ''",
+       2, "--levels: an empty value is not allowed"},
+      {"EmptySpecValue", "run --problem pendulum:theta0= --method rk4", 2,
+       "key 'theta0' has an empty value"},
+      {"EmptyMethodSpecValue", "run --problem pendulum --method hp:alpha=,tol=1e-10", 2,
+       "key 'alpha' has an empty value"},
+      // --- initial states: a radius or length coordinate must be > 0 ---
+      {"PolarKeplerNegativeRadius",
+       "run --problem kepler:coordinates=polar --method gauss --initial {dir}/start.csv",
+       2,
+       "r (the radius)",
+       {{"start.csv", "q,p\n-1,0\n0,1\n"}},
+       {"start.csv"}},
+      {"SpringPendulumNegativeLength",
+       "run --problem spring_pendulum --method gauss --initial {dir}/start.csv",
+       2,
+       "r (the spring length)",
+       {{"start.csv", "q,p\n-1.4,0\n0.5,0\n"}},
+       {"start.csv"}},
+      // --- slurm --submit without sbatch: refused before any script is written ---
+      {"SlurmSubmitWithoutSbatch",
+       "slurm {dir}/scene.toml --submit",
+       2,
+       "sbatch is not on PATH",
+       {{"scene.toml", scene(kRunBlock + "dt = 0.1\nt_end = 1.0\n")}},
+       {"scene.toml"},
+       30,
+       "PATH=/nonexistent"},
+      // --- did you mean: misspelt verbs, options, names and keys ---
+      {"MisspeltVerb", "swep {dir}/scene.toml", 2, "did you mean 'sweep'?"},
+      {"MisspeltVerbTransposed", "rnu --problem pendulum", 2, "did you mean 'run'?"},
+      {"MisspeltOption", "run --problem pendulum --method rk4 --dtt 0.1", 2,
+       "did you mean '--dt'?"},
+      {"MisspeltOptionWithValue", "run --problem pendulum --method rk4 --t-edn=1", 2,
+       "did you mean '--t-end'?"},
+      {"MisspeltProblem", "run --problem pendlum --method rk4", 2, "did you mean 'pendulum'?"},
+      {"MisspeltMethod", "run --problem pendulum --method stormer_verlett", 2,
+       "did you mean 'stormer_verlet'?"},
+      {"MisspeltParameter", "run --problem pendulum:thta0=1 --method rk4", 2,
+       "did you mean 'theta0'?"},
+      {"MisspeltListName", "list rod_chian", 2, "did you mean 'rod_chain'?"},
+      {"ListUnknownName", "list frobnicate", 2, "neither a method nor a problem"},
+      // --- the ranges `geomint list NAME` prints are the ones enforced ---
+      {"RodChainTooManyRods", "run --problem rod_chain:n=65 --method rattle", 2, "1..64"},
       // The thread count of the element loops (problems/parallel.hpp): refused before any output.
       {"ThreadsZero",
        "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --out {dir}/a.csv",
@@ -1701,9 +1796,11 @@ std::string binary() {
 // own, and a relative output that escapes the checks is caught as a stray file.
 std::string fmt_command(const Case& c, const fs::path& dir) {
   return "cd " + dir.string() + " && " +
-         (c.environment.empty() ? "" : "env " + c.environment + " ") + "timeout -k 5 " +
-         std::to_string(c.timeout_s) + " " + fs::absolute(binary()).string() + " " +
-         replace_all(c.arguments, "{dir}", dir.string()) + " 2>&1";
+         // timeout found on the suite's PATH: a case may set its own (one without sbatch).
+         (c.environment.empty() ? "" : "env " + c.environment + " ") +
+         "\"$(command -v timeout)\" -k 5 " + std::to_string(c.timeout_s) + " " +
+         fs::absolute(binary()).string() + " " + replace_all(c.arguments, "{dir}", dir.string()) +
+         " 2>&1";
 }
 
 class BadInput : public testing::TestWithParam<Case> {};

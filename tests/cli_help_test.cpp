@@ -14,8 +14,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 namespace geomint {
 namespace {
@@ -79,6 +82,71 @@ TEST(CliHelp, EveryHelpTextEqualsItsGoldenFile) {
     ++verbs;
   }
   EXPECT_EQ(compared, verbs + 1);
+}
+
+// The options of a help text: one string per option (continuation lines joined), from the
+// "Options:" section.
+std::vector<std::string> option_entries(const std::string& help) {
+  std::vector<std::string> entries;
+  std::istringstream lines(help);
+  bool inside = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line == "Options:") {
+      inside = true;
+    } else if (line.empty()) {
+      inside = false;
+    } else if (inside && line.rfind("  -", 0) == 0) {
+      entries.push_back(line);
+    } else if (inside && !entries.empty()) {
+      entries.back() += " " + line;
+    }
+  }
+  return entries;
+}
+
+// Every verb's --help shows the default of each option that takes a value and is not required,
+// and leaves the exit codes to `geomint --help` (printed once there, not 520 characters per verb).
+TEST(CliHelp, EveryVerbShowsItsDefaultsAndNotTheExitCodes) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("geomint_help_defaults_" + std::to_string(getpid()));
+  fs::create_directories(folder);
+  fs::remove(folder / "geomint");
+  fs::create_symlink(GEOMINT_BINARY, folder / "geomint");
+  const Captured top = run_as_geomint(folder, "--help");
+  EXPECT_NE(top.out.find("Exit codes: 0 ok"), std::string::npos) << top.out;
+  std::istringstream verbs(top.out.substr(top.out.find("Subcommands:")));
+  const std::regex takes_value(R"(^\s+\S+ [A-Z]+(:\S*)?( |$).*)");
+  int options = 0;
+  for (std::string line; std::getline(verbs, line);) {
+    if (line.rfind("  ", 0) != 0) continue;
+    const std::string verb = line.substr(2, line.find(' ', 2) - 2);
+    const Captured help = run_as_geomint(folder, verb + " --help");
+    EXPECT_EQ(help.out.find("Exit codes: 0 ok"), std::string::npos) << verb << ":\n" << help.out;
+    for (const std::string& entry : option_entries(help.out)) {
+      if (!std::regex_match(entry, takes_value) || entry.find("REQUIRED") != std::string::npos) {
+        continue;
+      }
+      EXPECT_NE(entry.find("default"), std::string::npos) << verb << ": " << entry;
+      ++options;
+    }
+  }
+  EXPECT_GT(options, 20);
+  // The defaults no help text used to mention.
+  for (const auto& [verb, option, shown] : {std::tuple{"sweep", "--jobs", "(default: 1)"},
+                                            {"run", "--timing-repeats", "(default: 3)"},
+                                            {"run", "--every", "(default: 1)"},
+                                            {"order", "--levels", "(default: 6)"},
+                                            {"slurm", "--shards", "default"}}) {
+    const Captured help = run_as_geomint(folder, std::string(verb) + " --help");
+    bool found = false;
+    for (const std::string& entry : option_entries(help.out)) {
+      if (entry.rfind(std::string("  ") + option + " ", 0) != 0) continue;
+      found = true;
+      EXPECT_NE(entry.find(shown), std::string::npos) << verb << ": " << entry;
+    }
+    EXPECT_TRUE(found) << verb << " " << option << ":\n" << help.out;
+  }
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "integrators/integrator.hpp"
+#include "problems/problem.hpp"
 
 namespace geomint {
 namespace {
@@ -550,6 +552,87 @@ TEST(Cli, ListColumnsStayAlignedForTheLongestEntries) {
     }
     EXPECT_GT(rows, 10) << listing.output;
   }
+}
+
+// Values just outside each bound `geomint list NAME` prints for a parameter (Range, or the integer
+// bounds), and just above the magnitude bound every real parameter has.
+std::vector<std::string> values_just_outside(const ParamDoc& doc) {
+  std::vector<std::string> out;
+  const auto text = [](double value) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    return std::string(buffer);
+  };
+  const double infinity = std::numeric_limits<double>::infinity();
+  if (doc.kind == "integer" && doc.range) {
+    if (doc.range->min > -1e15) out.push_back(std::to_string(std::lround(doc.range->min) - 1));
+    if (doc.range->max < 1e15) out.push_back(std::to_string(std::lround(doc.range->max) + 1));
+  }
+  if (doc.kind == "real") {
+    const Range range = doc.range.value_or(Range{});
+    if (std::isfinite(range.min)) {
+      out.push_back(text(range.min_open ? range.min : std::nextafter(range.min, -infinity)));
+    }
+    if (std::isfinite(range.max)) {
+      out.push_back(text(range.max_open ? range.max : std::nextafter(range.max, infinity)));
+    }
+    if (range.nonzero) out.push_back("0");
+    if (!(range.max < kMaxParameterMagnitude)) {
+      out.push_back(text(std::nextafter(kMaxParameterMagnitude, infinity)));
+    }
+  }
+  return out;
+}
+
+// `geomint list NAME` for every registered method and problem: its parameters with defaults and
+// allowed ranges; and each printed range is the enforced one: a value just outside any bound is
+// refused with exit 2 as out of range (rod_chain's n = 65 among them).
+TEST(Cli, ListNameShowsEveryEntryAndEveryPrintedRangeIsEnforced) {
+  const auto check = [](const std::string& name, const Params& params, bool method) -> int {
+    const Outcome listing = geomint("list " + name);
+    EXPECT_EQ(listing.exit_code, 0) << name << ":\n" << listing.output;
+    if (listing.exit_code != 0) return 0;
+    EXPECT_EQ(listing.output.rfind(name + (method ? " (method)" : " (problem)"), 0), 0)
+        << listing.output;
+    int refused = 0;
+    for (const ParamDoc& doc : params.docs()) {
+      EXPECT_NE(listing.output.find("\n" + doc.key + " "), std::string::npos)
+          << name << ": no row for " << doc.key << ":\n"
+          << listing.output;
+      EXPECT_NE(listing.output.find(doc.allowed), std::string::npos) << name << " " << doc.key;
+      for (const std::string& value : values_just_outside(doc)) {
+        const std::string spec = name + ":" + doc.key + "=" + value;
+        const Outcome run = geomint(method ? "run --problem pendulum --method '" + spec + "'"
+                                           : "run --problem '" + spec + "' --method rk4");
+        EXPECT_EQ(run.exit_code, 2) << spec << ":\n" << run.output;
+        EXPECT_NE(run.output.find("parameter " + doc.key + "="), std::string::npos) << spec << ":\n"
+                                                                                    << run.output;
+        EXPECT_NE(run.output.find("out of range (allowed: "), std::string::npos) << spec << ":\n"
+                                                                                 << run.output;
+        ++refused;
+      }
+    }
+    return refused;
+  };
+  int entries = 0, refused = 0;
+  for (const auto& entry : integrator_registry()) {
+    if (!entry.builtin) continue;
+    Params params(Spec{entry.name, {}}, entry.name);
+    entry.factory(params);
+    refused += check(entry.name, params, true);
+    ++entries;
+  }
+  for (const auto& entry : problem_registry()) {
+    if (!entry.builtin) continue;
+    Params params(Spec{entry.name, {}}, entry.name);
+    entry.factory(params);
+    refused += check(entry.name, params, false);
+    ++entries;
+  }
+  EXPECT_GT(entries, 40);
+  EXPECT_GT(refused, 100);
+  const Outcome rod_chain = geomint("list rod_chain");
+  EXPECT_NE(rod_chain.output.find("1..64"), std::string::npos) << rod_chain.output;
 }
 
 // The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of its catalogue.

@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
 
 #include "harness/paths.hpp"
 #include "harness/run.hpp"
@@ -40,8 +43,8 @@ bool check_command(const std::string& program, const std::vector<std::string>& c
   const std::string first = argv[1];
   if (first.empty() || first[0] != '-') {
     if (std::find(commands.begin(), commands.end(), first) == commands.end()) {
-      fmt::print(stderr, "{0}: error: unknown command '{1}' (commands: {2}); see {0} --help\n",
-                 program, first, listed);
+      fmt::print(stderr, "{0}: error: unknown command '{1}'{3} (commands: {2}); see {0} --help\n",
+                 program, first, listed, did_you_mean(first, commands));
       return false;
     }
   }
@@ -103,6 +106,29 @@ std::string parse_error_advice(const CLI::App& app, const std::vector<std::strin
   }
   const bool unexpected = dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr;
   std::string advice = what;
+  if (unexpected) {
+    // "--dtt" → "did you mean '--dt'?": the first unexpected word that looks like an option.
+    for (int i = 2; i < argc; ++i) {
+      std::string word = argv[i];
+      if (word.rfind("--", 0) != 0 ||
+          command->get_option_no_throw(word.substr(0, word.find('=')))) {
+        continue;
+      }
+      word = word.substr(0, word.find('='));
+      if (what.find(word) == std::string::npos) continue;
+      // Compared without the dashes every option shares, which would widen the threshold.
+      std::vector<std::string> bare, close;
+      for (const std::string& name : names) {
+        if (name.rfind("--", 0) == 0) bare.push_back(name.substr(2));
+      }
+      for (const std::string& match : close_matches(word.substr(2), bare)) {
+        close.push_back("--" + match);
+      }
+      const std::string suggestion = did_you_mean(word, close);
+      if (!suggestion.empty()) advice += fmt::format("\n  '{}'{}", word, suggestion);
+      break;
+    }
+  }
   if (named && !unexpected) {
     advice +=
         fmt::format("\n  {} takes {}", named->get_name(), value_phrase(named->get_type_name()));
@@ -111,6 +137,86 @@ std::string parse_error_advice(const CLI::App& app, const std::vector<std::strin
     advice += fmt::format("\n  {} takes: {}", verb, fmt::join(names, ", "));
   }
   return advice + fmt::format("\n  see {}", help);
+}
+
+CLI::Validator finite_range(double min, double max) {
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        const double value = std::strtod(begin, &end);
+        if (end == begin || *end != '\0') return fmt::format("'{}' is not a number", text);
+        // !(in range), not (out of range): NaN compares false both ways.
+        if (!(std::isfinite(value) && value >= min && value <= max)) {
+          return fmt::format("{} is out of range (allowed: a finite number in [{:g}, {:g}])", text,
+                             min, max);
+        }
+        return "";
+      },
+      fmt::format("FLOAT in [{:g} - {:g}]", min, max));
+}
+
+CLI::Validator integer_range(long min, long max) {
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        if (text.empty()) return "an empty value is not allowed (an unset shell variable?)";
+        long value = 0;
+        const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (result.ec != std::errc() || result.ptr != text.data() + text.size()) {
+          return fmt::format("'{}' is not an integer in [{}, {}]", text, min, max);
+        }
+        if (value < min || value > max) {
+          return fmt::format("{} is out of range (allowed: an integer in [{}, {}])", text, min,
+                             max);
+        }
+        return "";
+      },
+      fmt::format("INT in [{} - {}]", min, max));
+}
+
+namespace {
+
+// True when a help text already says its default ("default: the problem's", "(default 10",
+// "0 = none, the default"); "defaults" ("its parameters and their defaults") does not count.
+bool states_default(const std::string& help) {
+  for (std::size_t at = help.find("default"); at != std::string::npos;
+       at = help.find("default", at + 1)) {
+    if (at + 7 == help.size() || help[at + 7] != 's') return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+void harden_options(CLI::App& command) {
+  const CLI::Validator non_empty(
+      [](std::string& text) -> std::string {
+        return text.empty() ? "an empty value is not allowed (an unset shell variable?)" : "";
+      },
+      "");
+  const CLI::Validator not_nan(
+      [](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        const double value = std::strtod(begin, &end);
+        return end != begin && *end == '\0' && std::isnan(value)
+                   ? "NaN is not allowed (a number is required)"
+                   : "";
+      },
+      "");
+  for (CLI::Option* option : command.get_options()) {
+    if (option->get_expected_max() == 0) continue;  // a flag (--help, --quick) takes no value
+    option->check(non_empty);
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(not_nan);
+    if (option->get_required()) continue;
+    // The default as the help states it: "(default: 3)", or "(default: none)" when unset.
+    option->capture_default_str();
+    std::string value = option->get_default_str();
+    option->default_str("");
+    if (states_default(option->get_description())) continue;
+    if (value.empty() || value == "[]") value = "none";
+    option->description(fmt::format("{} (default: {})", option->get_description(), value));
+  }
 }
 
 std::string diverge_factor_help() {

@@ -54,6 +54,20 @@ std::string parse_error_advice(const CLI::App& app, const std::vector<std::strin
                                const std::string& program, int argc, char** argv,
                                const CLI::ParseError& error);
 
+// The range check of a real-valued option (and its environment variable): refuses NaN and ±inf,
+// which compare false and pass CLI::Range, and values outside [min, max]. Every range-checked
+// real option uses it.
+CLI::Validator finite_range(double min, double max);
+// The same for an integer option: an empty value, a non-integer and one outside [min, max] are
+// each named as such (CLI::Range would say "Value  not in range" for an empty one).
+CLI::Validator integer_range(long min, long max);
+
+// What every option of `command` gets (harness/cli/app.cpp): an empty value is refused (CLI11
+// would read '' as 0, so `--wall-budget "$UNSET"` would remove the budget); a real-valued option
+// refuses NaN (only what its help allows: `inf` where documented); and its default is appended
+// to its help as "(default: X)" unless the help already says it.
+void harden_options(CLI::App& command);
+
 // Option help shared by run and order.
 std::string diverge_factor_help();
 extern const char* const kInitialStateHelp;

@@ -1,5 +1,6 @@
-// `geomint list [methods|problems|all] [--markdown]`: the registries as aligned columns with every
-// parameter's default, or as the README's Markdown tables (docs/CLI.md "list").
+// `geomint list [methods|problems|all|NAME] [--markdown]`: the registries as aligned columns with
+// every parameter's default, as the README's Markdown tables, or one method or problem with its
+// parameters, their defaults and the ranges Params enforces (docs/CLI.md "list").
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -107,10 +108,22 @@ void print_methods(bool markdown) {
   if (!markdown) print_aligned(rows, {false, true, false, false});
 }
 
+// The integer parameters with their ranges ("`n` 1..64"): the size limits a reader of the table
+// needs before writing a spec; the real parameters' ranges are in `geomint list NAME`.
+std::string integer_limits(const Params& params) {
+  std::vector<std::string> limits;
+  for (const auto& doc : params.docs()) {
+    if (doc.kind == "integer") limits.push_back(fmt::format("`{}` {}", doc.key, doc.allowed));
+  }
+  return fmt::format("{}", fmt::join(limits, ", "));
+}
+
 void print_problems(bool markdown) {
   std::vector<std::vector<std::string>> rows;
   if (markdown) {
-    fmt::print("| problem | dof | capabilities | what it is |\n|---|---|---|---|\n");
+    fmt::print(
+        "| problem | dof | capabilities | integer parameters | what it is |\n"
+        "|---|---|---|---|---|\n");
   } else {
     rows.push_back({"problem", "dof", "capabilities (defaults)", "parameters (default)"});
   }
@@ -120,8 +133,9 @@ void print_problems(bool markdown) {
     const auto problem = entry.factory(params);
     const auto capabilities = capability_names(problem->capabilities());
     if (markdown) {
-      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, problem->dof(),
-                 fmt::format("{}", fmt::join(capabilities, ", ")), markdown_cell(entry.summary));
+      fmt::print("| `{}` | {} | {} | {} | {} |\n", entry.name, problem->dof(),
+                 fmt::format("{}", fmt::join(capabilities, ", ")), integer_limits(params),
+                 markdown_cell(entry.summary));
     } else {
       rows.push_back({entry.name, std::to_string(problem->dof()),
                       fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params)});
@@ -130,7 +144,71 @@ void print_problems(bool markdown) {
   if (!markdown) print_aligned(rows, {false, true, false, false});
 }
 
+// One parameter per row: key, kind, default, what is allowed (the Range Params checks), help.
+void print_parameters(const Params& params) {
+  std::vector<std::vector<std::string>> rows = {
+      {"parameter", "kind", "default", "allowed", "help"}};
+  for (const auto& doc : params.docs()) {
+    std::string allowed = doc.allowed;
+    const bool bounded = doc.range && doc.range->min >= -kMaxParameterMagnitude &&
+                         doc.range->max <= kMaxParameterMagnitude;
+    if (doc.kind == "real" && !bounded) {
+      // Every real parameter is bounded in magnitude as well (Params::real).
+      const std::string bound = fmt::format("|{}| <= {:g}", doc.key, kMaxParameterMagnitude);
+      allowed = allowed.empty() ? bound : allowed + ", " + bound;
+    }
+    rows.push_back({doc.key, doc.kind, doc.default_value.empty() ? "(none)" : doc.default_value,
+                    allowed, doc.help});
+  }
+  if (rows.size() == 1) {
+    fmt::print("parameters: none\n");
+  } else {
+    print_aligned(rows, {false, false, false, false, false});
+  }
+}
+
+// `geomint list NAME`: the entry named NAME (a method, a problem, or both when both registries
+// have it); InputError with the close names otherwise.
+void print_entry(const std::string& name) {
+  bool found = false;
+  for (const auto& entry : integrator_registry()) {
+    if (entry.name != name) continue;
+    Params params(Spec{entry.name, {}}, entry.name);
+    const MethodInfo info = entry.factory(params)->info();
+    fmt::print("{} (method): {}\norder {}; flags: {}\n\n", entry.name, entry.summary,
+               order_column(entry, info.order), fmt::join(flag_names(info.flags), ", "));
+    print_parameters(params);
+    found = true;
+  }
+  for (const auto& entry : problem_registry()) {
+    if (entry.name != name) continue;
+    if (found) fmt::print("\n");
+    Params params(Spec{entry.name, {}}, entry.name);
+    const auto problem = entry.factory(params);
+    fmt::print("{} (problem): {}\ndof {} (with the defaults); capabilities: {}\n\n", entry.name,
+               entry.summary, problem->dof(),
+               fmt::join(capability_names(problem->capabilities()), ", "));
+    print_parameters(params);
+    found = true;
+  }
+  if (found) return;
+  std::vector<std::string> names = {"methods", "problems", "all"};
+  for (const auto& entry : integrator_registry()) names.push_back(entry.name);
+  for (const auto& entry : problem_registry()) names.push_back(entry.name);
+  throw InputError(fmt::format(
+      "list: '{}' is neither a method nor a problem{} (allowed: methods, problems, all, or a name "
+      "that `geomint list` shows)",
+      name, did_you_mean(name, names)));
+}
+
 int run_list(const ListOptions& options) {
+  if (options.what != "methods" && options.what != "problems" && options.what != "all") {
+    if (options.markdown) {
+      throw InputError("list: --markdown goes with methods, problems or all, not with one name");
+    }
+    print_entry(options.what);
+    return kExitOk;
+  }
   if (options.what != "problems") print_methods(options.markdown);
   if (options.what == "all") fmt::print("\n");
   if (options.what != "methods") print_problems(options.markdown);
@@ -142,8 +220,9 @@ int run_list(const ListOptions& options) {
 Verb add_list(CLI::App& app) {
   auto options = std::make_shared<ListOptions>();
   auto* command = app.add_subcommand("list", "List registered methods and/or problems");
-  command->add_option("what", options->what, "methods | problems | all")
-      ->check(CLI::IsMember({"methods", "problems", "all"}));
+  command->add_option("what", options->what,
+                      "methods | problems | all | NAME (one method or problem: its description, "
+                      "parameters, their defaults and allowed ranges)");
   command->add_flag("--markdown", options->markdown,
                     "print the README's Markdown tables (methods: order, flags, summary; "
                     "problems: dof, capabilities of the defaults, summary); `make readme-tables` "

@@ -2,8 +2,10 @@
 // to the scene (harness/shard.hpp), optionally submitted as a dependency chain (docs/CLI.md
 // "slurm").
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -22,7 +24,26 @@ struct SlurmCliOptions {
   bool submit = false, quick = false;
 };
 
+// True when an executable `name` is in one of $PATH's folders: what the shell's lookup finds.
+bool on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::string folders = path ? path : "";
+  for (std::size_t start = 0; start <= folders.size();) {
+    const std::size_t colon = std::min(folders.find(':', start), folders.size());
+    const std::string folder = colon == start ? "." : folders.substr(start, colon - start);
+    if (::access((folder + "/" + name).c_str(), X_OK) == 0) return true;
+    start = colon + 1;
+  }
+  return false;
+}
+
 int run_slurm(const SlurmCliOptions& cli, const Context& context) {
+  // --submit without sbatch would leave the scripts written and then fail: refuse before writing.
+  if (cli.submit && !on_path("sbatch")) {
+    throw InputError(
+        "--submit: sbatch is not on PATH (run on a Slurm login node, or leave out --submit to "
+        "only write the scripts)");
+  }
   const Scene scene = load_scene(cli.scene, cli.quick);
   SlurmOptions options;
   options.scene_path = cli.scene;
@@ -65,9 +86,11 @@ Verb add_slurm(CLI::App& app) {
       "Write sweep.sbatch, merge.sbatch and timing.sbatch next to the scene (and submit them)");
   command->add_option("scene", options->scene, "results/<scene>/scene.toml")->required();
   command->add_option("--shards", options->shards, "array size N (default: min(units, 1000))")
-      ->check(CLI::Range(1, kMaxShards));
-  command->add_option("--max-parallel", options->max_parallel, "at most K array tasks at once")
-      ->check(CLI::Range(1, 1000000));
+      ->check(integer_range(1, kMaxShards));
+  command
+      ->add_option("--max-parallel", options->max_parallel,
+                   "at most K array tasks at once (default: no limit)")
+      ->check(integer_range(1, 1000000));
   command->add_option("--partition", options->partition, "Slurm partition");
   command->add_option("--time", options->time,
                       "time limit of each job (Slurm format, e.g. 1:00:00)");

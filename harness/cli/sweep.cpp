@@ -163,7 +163,8 @@ Verb add_sweep(CLI::App& app) {
   auto options = std::make_shared<SweepCliOptions>();
   auto* command = app.add_subcommand("sweep", "Run a scene file and write its tables");
   command->add_option("scene", options->scene_path, "results/<scene>/scene.toml")->required();
-  command->add_option("--jobs", options->jobs, "parallel accuracy runs")->check(CLI::Range(1, 256));
+  command->add_option("--jobs", options->jobs, "parallel accuracy runs")
+      ->check(integer_range(1, 256));
   command->add_flag("--quick", options->quick, "apply the scene's quick_* settings (CI-sized)");
   command->add_flag("--markdown-only", options->markdown_only,
                     "run nothing: rewrite table.md from the CSVs already in the output folder");
@@ -182,8 +183,10 @@ Verb add_sweep(CLI::App& app) {
   command->add_flag("--shard-from-env", options->shard_from_env,
                     "take i/N from SLURM_ARRAY_TASK_ID and --shards, or from "
                     "OMPI_COMM_WORLD_RANK/_SIZE or PMI_RANK/PMI_SIZE");
-  command->add_option("--shards", options->shard_count, "N for --shard-from-env")
-      ->check(CLI::Range(1, kMaxShards));
+  command
+      ->add_option("--shards", options->shard_count,
+                   "N for --shard-from-env (default: none, the environment's size)")
+      ->check(integer_range(1, kMaxShards));
   command->add_flag("--timing-only", options->timing_only,
                     "run only the timing passes, one at a time, into the merged tables of the "
                     "output folder (after `geomint merge`), with this node's CPU in provenance");
@@ -193,7 +196,7 @@ Verb add_sweep(CLI::App& app) {
                    "(a log): done/total runs and an ETA weighted by expected steps; default 10, or "
                    "$GEOMINT_PROGRESS_INTERVAL")
       ->envname("GEOMINT_PROGRESS_INTERVAL")
-      ->check(CLI::Range(0.01, 86400.0));
+      ->check(finite_range(0.01, 86400.0));
   return {"sweep", command,
           [options](const Context& context) { return run_sweep_verb(*options, context); }};
 }
