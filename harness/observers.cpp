@@ -13,8 +13,8 @@
 #include "harness/metrics.hpp"
 #include "harness/reference.hpp"
 #include "integrators/newton.hpp"
-#include "problems/charged_particle.hpp"
-#include "problems/rigid_body.hpp"
+#include "problems/structures/attitude.hpp"
+#include "problems/structures/charged_particle.hpp"
 
 namespace geomint {
 namespace {
@@ -167,7 +167,7 @@ class OrthogonalityObserver : public Observer {
     observe(problem, state);
   }
   void observe(const Problem& problem, const State& state) override {
-    const Eigen::Matrix3d Q = problem.as_attitude()->attitude(state.q);
+    const Eigen::Matrix3d Q = problem.as<AttitudeStructure>()->attitude(state.q);
     err_max_ = std::max(err_max_, (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());
   }
   void finish(std::map<std::string, double>& metrics) const override {
@@ -501,13 +501,13 @@ void add_constraint_observer(const ObserverContext& context, ObserverList& obser
 }
 
 void add_orthogonality_observer(const ObserverContext& context, ObserverList& observers) {
-  if (context.problem.as_attitude() != nullptr) {
+  if (context.problem.as<AttitudeStructure>() != nullptr) {
     observers.push_back(std::make_unique<OrthogonalityObserver>());
   }
 }
 
 void add_magnetic_moment_observer(const ObserverContext& context, ObserverList& observers) {
-  if (const auto* particle = context.problem.as_charged_particle()) {
+  if (const auto* particle = context.problem.as<ChargedParticleStructure>()) {
     observers.push_back(std::make_unique<MagneticMomentObserver>(*particle));
   }
 }

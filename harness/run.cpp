@@ -484,7 +484,7 @@ RunResult run_one(const RunSpec& spec) {
   // so that re-running the row's spec reproduces it (integrators/general_step.hpp).
   const std::string ran_spec = spec_on(*integrator, *problem);
   record.method = ran_spec;
-  record.family = method_family(info);
+  record.family = method_family(info, integrator->provider());
   if (!adaptive) record.dt = config.dt;
   record.t_end = config.t_end;
 

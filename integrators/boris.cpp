@@ -5,7 +5,7 @@
 
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
-#include "problems/charged_particle.hpp"
+#include "problems/structures/charged_particle.hpp"
 
 namespace geomint {
 namespace {
@@ -28,7 +28,7 @@ class Boris final : public ExplicitStepper<Boris> {
   // through A at the step's start and p written back through A at its end.
   void advance_by(const Problem& problem, State& state, double h) {
     // applicable() admits only problems that offer the structure.
-    const ChargedParticleStructure& particle = *problem.as_charged_particle();
+    const ChargedParticleStructure& particle = *problem.as<ChargedParticleStructure>();
     const double mass = particle.particle_mass(), charge = particle.particle_charge();
     Vector3 x = state.q.head<3>();
     Vector3 v = (Vector3(state.p.head<3>()) - charge * particle.vector_potential(x)) / mass;

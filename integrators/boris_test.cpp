@@ -221,7 +221,7 @@ TEST(Boris, RunsOnChargedParticlesOnly) {
   for (const auto& spec : problem_test_specs()) {
     const auto problem = make_problem(spec);
     const Applicability verdict = applicable(*boris, *problem);
-    const bool charged = problem->as_charged_particle() != nullptr;
+    const bool charged = problem->as<ChargedParticleStructure>() != nullptr;
     EXPECT_EQ(verdict.ok, charged) << spec;
     EXPECT_EQ(charged, problem->name() == "charged_particle") << spec;
     if (verdict.ok) {

@@ -9,12 +9,12 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
-#include "problems/charged_particle.hpp"
-#include "problems/rigid_body.hpp"
+#include "problems/structures/charged_particle.hpp"
+#include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
 
-#define GEOMINT_METHOD(name, factory, variants, summary) \
+#define GEOMINT_METHOD(name, factory, provider, variants, summary) \
   std::unique_ptr<Integrator> factory(Params&);
 #include "integrators/registry.def"
 #undef GEOMINT_METHOD
@@ -22,10 +22,14 @@ namespace geomint {
 namespace {
 // A function-local static, so register_method() called from another translation unit's static
 // initialiser (MethodRegistrar) finds the built-in entries already in place.
+// The provider column of registry.def.
+MethodProvider by_geomint() { return MethodProvider::geomint(); }
+MethodProvider by_library(const char* name) { return MethodProvider::library_named(name); }
+
 std::vector<IntegratorEntry>& mutable_integrator_registry() {
   static std::vector<IntegratorEntry> entries = {
-#define GEOMINT_METHOD(name, factory, variants, summary) \
-  {#name, summary, &factory, split_variants(variants)},
+#define GEOMINT_METHOD(name, factory, provider, variants, summary) \
+  {#name, summary, &factory, split_variants(variants), true, provider},
 #include "integrators/registry.def"
 #undef GEOMINT_METHOD
   };
@@ -48,7 +52,25 @@ void register_method(IntegratorEntry entry) {
     }
   }
   entry.builtin = false;
+  // A method registered at run time is the user's, unless the entry says it wraps a library or
+  // an engine (the default provider, geomint, is the built-ins' alone).
+  if (entry.provider.kind == MethodProvider::Kind::kGeomint)
+    entry.provider = MethodProvider::user();
   entries.push_back(std::move(entry));
+}
+
+std::string MethodProvider::label() const {
+  switch (kind) {
+    case Kind::kGeomint:
+      return "geomint";
+    case Kind::kLibrary:
+      return "library:" + library;
+    case Kind::kEngine:
+      return "engine:" + library;
+    case Kind::kUser:
+      return "user";
+  }
+  return "geomint";
 }
 
 namespace {
@@ -71,7 +93,12 @@ std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {
   auto integrator = entry.factory(params);
   params.finish();
   integrator->spec_ = params.canonical();
+  integrator->provider_ = entry.provider;
   return integrator;
+}
+
+const MethodProvider& method_provider(const std::string& name) {
+  return find_method(Spec{name, {}}).provider;
 }
 
 IntegratorMaker integrator_maker(const std::string& spec_text) {
@@ -79,11 +106,14 @@ IntegratorMaker integrator_maker(const std::string& spec_text) {
   // integrators reuse the parsed spec and the entry's factory.
   const std::string canonical = make_integrator(spec_text)->spec();
   const Spec spec = Spec::parse(spec_text);
-  const auto factory = find_method(spec).factory;
-  return [spec, factory, canonical] {
+  const IntegratorEntry& entry = find_method(spec);
+  const auto factory = entry.factory;
+  const MethodProvider provider = entry.provider;
+  return [spec, factory, canonical, provider] {
     Params params(spec, fmt::format("method '{}'", spec.name));
     auto integrator = factory(params);
     integrator->spec_ = canonical;
+    integrator->provider_ = provider;
     return integrator;
   };
 }
@@ -97,13 +127,6 @@ std::vector<std::string> integrator_test_specs() {
   return specs;
 }
 
-bool library_method(const std::string& name) {
-  for (const char* prefix : {"cvode_", "ida", "arkode_", "gsl_", "odeint_"}) {
-    if (name.rfind(prefix, 0) == 0) return true;
-  }
-  return false;
-}
-
 const std::vector<std::string>& method_families() {
   static const std::vector<std::string> families = {"explicit_symplectic",  "explicit_rk",
                                                     "implicit_variational", "implicit_other",
@@ -111,10 +134,11 @@ const std::vector<std::string>& method_families() {
   return families;
 }
 
-std::string method_family(const MethodInfo& info) {
+std::string method_family(const MethodInfo& info, const MethodProvider& provider) {
   // Error control first: an adaptive method's cost is set by its tolerance, not a step.
   if (info.flags & kAdaptive) {
-    return library_method(info.name) ? "adaptive_library" : "adaptive_geomint";
+    return provider.kind == MethodProvider::Kind::kLibrary ? "adaptive_library"
+                                                           : "adaptive_geomint";
   }
   if (info.flags & kExplicit) {
     return (info.flags & kSymplectic) ? "explicit_symplectic" : "explicit_rk";
@@ -201,14 +225,24 @@ void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatr
   }
 }
 
+namespace {
+// The structure-only flags and the structure interface (problems/structures/) each one needs:
+// applicable() asks the problem for that interface by its key and knows no structure by name.
+const std::pair<MethodFlag, const StructureKey*> kStructureNeeds[] = {
+    {kFreeRigidBodyOnly, &FreeRigidBodyStructure::kStructureKey},
+    {kChargedParticleOnly, &ChargedParticleStructure::kStructureKey},
+};
+}  // namespace
+
 MethodNeeds method_needs(const MethodInfo& info) {
   MethodNeeds needs;
   if (info.flags & kFirstOrderCapable)
     needs.kinds |= static_cast<unsigned>(ProblemKind::kFirstOrder);
   if (info.flags & kGeneralLagrangian)
     needs.kinds |= static_cast<unsigned>(ProblemKind::kLagrangian);
-  if (info.flags & kFreeRigidBodyOnly) needs.structure = MethodNeeds::Structure::kFreeRigidBody;
-  if (info.flags & kChargedParticleOnly) needs.structure = MethodNeeds::Structure::kChargedParticle;
+  for (const auto& [flag, key] : kStructureNeeds) {
+    if (info.flags & flag) needs.structure = key;
+  }
   needs.handles_constraints = (info.flags & kConstrained) != 0;
   needs.handles_rheonomic = (info.flags & kRheonomic) != 0;
   needs.needs_constraints = (info.flags & kConstraintsOnly) != 0;
@@ -217,34 +251,22 @@ MethodNeeds method_needs(const MethodInfo& info) {
   return needs;
 }
 
+MethodRecord method_record(const Integrator& method) {
+  MethodRecord record{method.info(), method.provider(), {}};
+  record.needs = method_needs(record.info);
+  return record;
+}
+
 namespace {
 
-bool offers(const Problem& problem, MethodNeeds::Structure structure) {
-  switch (structure) {
-    case MethodNeeds::Structure::kNone:
-      return false;
-    case MethodNeeds::Structure::kFreeRigidBody:
-      return problem.as_free_rigid_body() != nullptr;
-    case MethodNeeds::Structure::kChargedParticle:
-      return problem.as_charged_particle() != nullptr;
-  }
-  return false;
+bool offers(const Problem& problem, const StructureKey* structure) {
+  return structure != nullptr && problem.structure(*structure) != nullptr;
 }
 
 std::string structure_refusal(const Integrator& method, const Problem& problem,
-                              MethodNeeds::Structure structure) {
-  if (structure == MethodNeeds::Structure::kFreeRigidBody) {
-    return fmt::format(
-        "method '{}' integrates free rigid bodies only (rigid_body, "
-        "rigid_body_euler, which offer their moments and (Q, Pi)); "
-        "problem '{}' is none",
-        method.spec(), problem.name());
-  }
-  return fmt::format(
-      "method '{}' integrates charged particles only (charged_particle, "
-      "which offers its mass, charge, fields and vector potential); "
-      "problem '{}' is none",
-      method.spec(), problem.name());
+                              const StructureKey& structure) {
+  return fmt::format("method '{}' integrates {} only ({}); problem '{}' is none", method.spec(),
+                     structure.what, structure.offered_by, problem.name());
 }
 
 std::string lagrangian_kind_refusal(const Integrator& method, const Problem& problem) {
@@ -283,8 +305,8 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         "that apply: {}",
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
   }
-  if (needs.structure != MethodNeeds::Structure::kNone) {
-    return {false, structure_refusal(method, problem, needs.structure)};
+  if (needs.structure != nullptr) {
+    return {false, structure_refusal(method, problem, *needs.structure)};
   }
   if (!needs.runs(kind)) return {false, lagrangian_kind_refusal(method, problem)};
   // On a non-separable problem the second derivatives come from its LagrangianSystem.

@@ -37,13 +37,15 @@ enum MethodFlag : unsigned {
   // it a method assumes ½vᵀMv − V with a constant M, and applicable() refuses it there.
   kGeneralLagrangian = 1u << 12,
   // Runs on free rigid bodies only (the Lie–Poisson splitting): applicable() admits it exactly
-  // where problem.as_free_rigid_body() (problems/rigid_body.hpp) finds the structure it reads.
+  // where problem.as<FreeRigidBodyStructure>() (problems/structures/free_rigid_body.hpp) finds
+  // the structure it reads.
   kFreeRigidBodyOnly = 1u << 13,
   // Keeps the energy H(q, p) of a conservative problem to round-off and solver tolerance by
   // construction (avf for polynomial V, projection): a contrast to symplecticity, not a kind of it.
   kEnergyPreserving = 1u << 14,
   // Runs on charged particles only (the Boris pusher): applicable() admits it exactly where
-  // problem.as_charged_particle() (problems/charged_particle.hpp) finds m, q, E, B and A.
+  // problem.as<ChargedParticleStructure>() (problems/structures/charged_particle.hpp) finds m, q,
+  // E, B and A.
   kChargedParticleOnly = 1u << 16,
 };
 std::vector<std::string> flag_names(unsigned flags);
@@ -53,6 +55,29 @@ struct MethodInfo {
   int order = 0;     // classical order of accuracy
   unsigned flags = 0;
   std::string reference;  // where the scheme is defined
+};
+
+// Who implements a method (docs/DESIGN.md §2, "Needs and provider"): this suite, a wrapped
+// library (named: SUNDIALS, GSL, Boost.Odeint), an engine, or a user's run-time registration
+// (register_method). Declared per registry entry (integrators/registry.def); reports and
+// work-precision fronts ("best geomint method against best library solver") read it, never the
+// method's name.
+struct MethodProvider {
+  enum class Kind { kGeomint, kLibrary, kEngine, kUser };
+  Kind kind = Kind::kGeomint;
+  std::string library;  // kLibrary (and kEngine): its name
+  static MethodProvider geomint() { return {}; }
+  static MethodProvider library_named(std::string name) {
+    return {Kind::kLibrary, std::move(name)};
+  }
+  static MethodProvider user() { return {Kind::kUser, ""}; }
+  // "geomint", "library:SUNDIALS", "engine:NAME", "user": the `provider` column of `geomint
+  // list methods` and docs/METHODS.md, which scripts/work_precision_table.sh reads.
+  std::string label() const;
+  // Written out: odeint.cpp is compiled as C++17 (Boost.Odeint), where it cannot be defaulted.
+  bool operator==(const MethodProvider& other) const {
+    return kind == other.kind && library == other.library;
+  }
 };
 
 // What a method needs of a problem (docs/DESIGN.md §2): the problem kinds it runs, the structure
@@ -65,11 +90,10 @@ struct MethodNeeds {
   // structure-only method is admitted by its structure first), kFirstOrder with
   // kFirstOrderCapable, kLagrangian with kGeneralLagrangian.
   unsigned kinds = static_cast<unsigned>(ProblemKind::kSeparable);
-  // A structure the method reads and cannot run without (Problem::as_free_rigid_body(),
-  // Problem::as_charged_particle()); where the problem offers it the method runs, whatever its
-  // kind.
-  enum class Structure { kNone, kFreeRigidBody, kChargedParticle };
-  Structure structure = Structure::kNone;
+  // The key of a structure interface the method reads and cannot run without
+  // (problems/structures/, Problem::as<Structure>()), nullptr for none; where the problem offers
+  // it the method runs, whatever its kind.
+  const StructureKey* structure = nullptr;
   bool handles_constraints = false;  // kConstrained
   bool handles_rheonomic = false;    // kRheonomic
   bool needs_constraints = false;    // kConstraintsOnly
@@ -84,14 +108,12 @@ MethodNeeds method_needs(const MethodInfo& info);
 // error-controlled ones), explicit_symplectic, explicit_rk (explicit, not symplectic: RK4,
 // Euler, the penalty wrapper), implicit_variational (implicit and variational or symplectic),
 // implicit_other (implicit, neither: backward Euler, Newmark, HHT, generalized-α). Derived from the
-// flags alone, plus the library name prefixes of library_method(); a method with neither kExplicit
-// nor kImplicit is a defect (std::logic_error), so a new flag combination cannot silently leave a
-// method unlabelled.
-std::string method_family(const MethodInfo& info);
+// flags alone, plus the provider for adaptive methods (a library's is adaptive_library, any other
+// adaptive_geomint); a method with neither kExplicit nor kImplicit is a defect (std::logic_error),
+// so a new flag combination cannot silently leave a method unlabelled.
+std::string method_family(const MethodInfo& info, const MethodProvider& provider);
 // Every value method_family() returns, in the order figures list them.
 const std::vector<std::string>& method_families();
-// A registry name implemented by a library wrapper (cvode_*, ida, arkode_*, gsl_*, odeint_*).
-bool library_method(const std::string& name);
 
 // Result of one step; a failed step leaves the state unspecified and ends the run. [[nodiscard]]:
 // a caller that drops a status turns a failed run into an `ok` row (a step loop that ignored its
@@ -199,6 +221,9 @@ class Integrator {
   virtual MethodInfo info() const = 0;
   // Canonical spec ("newmark:beta=0.25,gamma=0.5"), set by the registry.
   const std::string& spec() const { return spec_; }
+  // Who implements it: its registry entry's provider, set by the registry (geomint for an
+  // integrator built without it).
+  const MethodProvider& provider() const { return provider_; }
 
   // Prepares for a run from `state` with nominal step h (h may be negative for reversibility
   // checks). Resets the counters. Methods with internal variables initialise them here.
@@ -283,6 +308,7 @@ class Integrator {
   friend std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
   friend IntegratorMaker integrator_maker(const std::string& spec_text);
   std::string spec_;
+  MethodProvider provider_;
 };
 
 // The diagonal mass matrix as a sparse matrix for Newton Jacobians: `matrix` is rebuilt only when
@@ -313,6 +339,16 @@ double roundoff_tolerance_ratio(const double* y, long n, double rtol, double ato
 StepStatus too_much_accuracy(const std::string& reason, const std::string& method, double t,
                              double rtol, double atol, double ratio);
 
+// One record of what a method is (its declared MethodInfo), who provides it (its registry entry's
+// MethodProvider) and what it needs of a problem (method_needs of its flags): what reports,
+// `geomint list` and applicable() read, none of it from the method's name.
+struct MethodRecord {
+  MethodInfo info;
+  MethodProvider provider;
+  MethodNeeds needs;
+};
+MethodRecord method_record(const Integrator& method);
+
 // Registry (integrators/registry.def). Throws InputError for unknown names/keys/values.
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text);
 // The same check, once: a callable that makes fresh integrators of this spec from the parsed
@@ -333,7 +369,14 @@ struct IntegratorEntry {
   std::vector<std::string> variants;  // extra parameter sets the test suite must also cover
   // false for register_method() entries, which docs/METHODS.md's table leaves out
   bool builtin = true;
+  // Who implements it: registry.def says for the built-ins; register_method() sets kUser unless
+  // the entry names a library or an engine.
+  // (Braced, so an entry written {name, summary, factory, variants} leaves it out without a
+  // missing-initializer warning.)
+  MethodProvider provider{};
 };
+// The provider of the registry entry `name` (a spec's name); InputError for an unknown name.
+const MethodProvider& method_provider(const std::string& name);
 // The built-in entries (registry.def) followed by the register_method() ones, in call order.
 const std::vector<IntegratorEntry>& integrator_registry();
 

@@ -713,7 +713,8 @@ TEST(Registry, EveryMethodHasAFamily) {
   const auto& families = method_families();
   for (const auto& spec : integrator_test_specs()) {
     SCOPED_TRACE(spec);
-    const std::string family = method_family(make_integrator(spec)->info());
+    const auto method = make_integrator(spec);
+    const std::string family = method_family(method->info(), method->provider());
     EXPECT_FALSE(family.empty());
     EXPECT_NE(std::find(families.begin(), families.end(), family), families.end()) << family;
     reached.insert(family);
@@ -731,9 +732,41 @@ TEST(Registry, EveryMethodHasAFamily) {
       {"gsl_rk8pd", "adaptive_library"},
       {"odeint_dopri5", "adaptive_library"}};
   for (const auto& [spec, family] : anchors) {
-    EXPECT_EQ(method_family(make_integrator(spec)->info()), family) << spec;
+    const auto method = make_integrator(spec);
+    EXPECT_EQ(method_family(method->info(), method->provider()), family) << spec;
   }
-  EXPECT_THROW(method_family(MethodInfo{"flagless", 1, 0, "none"}), std::logic_error);
+  EXPECT_THROW(method_family(MethodInfo{"flagless", 1, 0, "none"}, MethodProvider::geomint()),
+               std::logic_error);
+}
+
+// The provider is data of the registry entry (integrators/registry.def), not a reading of the
+// name: an adaptive method's family follows it whatever the method is called, every built-in
+// entry names geomint or a library by name, and make_integrator and integrator_maker pass it on.
+TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
+  const MethodInfo adaptive{"cvode_lookalike", 4, kExplicit | kAdaptive, "none"};
+  EXPECT_EQ(method_family(adaptive, MethodProvider::geomint()), "adaptive_geomint");
+  EXPECT_EQ(method_family(adaptive, MethodProvider::library_named("SUNDIALS")), "adaptive_library");
+  const std::map<std::string, std::string> anchors = {{"cvode_bdf", "library:SUNDIALS"},
+                                                      {"ida", "library:SUNDIALS"},
+                                                      {"arkode_erk", "library:SUNDIALS"},
+                                                      {"gsl_msbdf", "library:GSL"},
+                                                      {"odeint_mclachlan4", "library:Boost.Odeint"},
+                                                      {"adaptive_verlet", "geomint"},
+                                                      {"rkn_adaptive", "geomint"}};
+  for (const auto& entry : integrator_registry()) {
+    if (!entry.builtin) continue;
+    SCOPED_TRACE(entry.name);
+    const MethodProvider& provider = method_provider(entry.name);
+    EXPECT_TRUE(provider.kind == MethodProvider::Kind::kGeomint ||
+                (provider.kind == MethodProvider::Kind::kLibrary && !provider.library.empty()));
+    EXPECT_EQ(make_integrator(entry.name)->provider(), provider);
+    EXPECT_EQ(integrator_maker(entry.name)()->provider(), provider);
+    const auto anchor = anchors.find(entry.name);
+    if (anchor != anchors.end()) {
+      EXPECT_EQ(provider.label(), anchor->second);
+    }
+  }
+  EXPECT_THROW(method_provider("no_such_method"), InputError);
 }
 
 }  // namespace

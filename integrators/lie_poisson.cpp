@@ -5,7 +5,7 @@
 
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
-#include "problems/rigid_body.hpp"
+#include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
 namespace {
@@ -39,7 +39,7 @@ class LiePoisson final : public ExplicitStepper<LiePoisson> {
   // the step count (measured 4e-11 after 5000 steps) instead of round-off.
   void advance_by(const Problem& problem, State& state, double h) {
     // applicable() admits only problems that offer the structure.
-    const FreeRigidBodyStructure& body = *problem.as_free_rigid_body();
+    const FreeRigidBodyStructure& body = *problem.as<FreeRigidBodyStructure>();
     const Eigen::Vector3d moments = body.principal_moments();
     if (!carried_ || !same(state.q, written_q_) || !same(state.p, written_p_)) {
       body.read_body(state.q, state.p, attitude_, pi_);

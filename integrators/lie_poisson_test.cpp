@@ -33,7 +33,7 @@ Eigen::Vector3d body_momentum_after(const std::string& method, const std::string
   for (int k = 0; k < steps; ++k) EXPECT_TRUE(integrator->step(*problem, state, h).ok);
   Eigen::Matrix3d attitude;
   Eigen::Vector3d pi;
-  problem->as_free_rigid_body()->read_body(state.q, state.p, attitude, pi);
+  problem->as<FreeRigidBodyStructure>()->read_body(state.q, state.p, attitude, pi);
   return pi;
 }
 

@@ -5,7 +5,7 @@
 
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
-#include "problems/rigid_body.hpp"
+#include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
 namespace {
@@ -41,7 +41,7 @@ class QuaternionIntegrator final : public ExplicitStepper<QuaternionIntegrator> 
   // back from it (or Π through it) would hide the drift this method exists to show.
   void advance_by(const Problem& problem, State& state, double h) {
     // applicable() admits only problems that offer the structure.
-    const FreeRigidBodyStructure& structure = *problem.as_free_rigid_body();
+    const FreeRigidBodyStructure& structure = *problem.as<FreeRigidBodyStructure>();
     const Eigen::Vector3d moments = structure.principal_moments();
     if (!carried_ || !same(state.q, written_q_) || !same(state.p, written_p_)) {
       Eigen::Matrix3d attitude;

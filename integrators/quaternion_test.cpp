@@ -34,7 +34,7 @@ BodyRun run(const std::string& method, const std::string& problem_spec, double h
   BodyRun result;
   for (int k = 0; k < steps; ++k) {
     EXPECT_TRUE(integrator->step(*problem, state, h).ok);
-    problem->as_free_rigid_body()->read_body(state.q, state.p, result.attitude, result.pi);
+    problem->as<FreeRigidBodyStructure>()->read_body(state.q, state.p, result.attitude, result.pi);
     const Eigen::Matrix3d& Q = result.attitude;
     result.orthogonality_err = std::max(result.orthogonality_err,
                                         (Q.transpose() * Q - Eigen::Matrix3d::Identity()).norm());

@@ -136,11 +136,11 @@ TEST(Rkn, DefaultsFlagsAndFamilies) {
   const MethodInfo fixed = make_integrator("rkn:table=dprkn8")->info();
   EXPECT_EQ(fixed.order, 8);
   EXPECT_FALSE(fixed.flags & kSymplectic);
-  EXPECT_EQ(method_family(fixed), "explicit_rk");
+  EXPECT_EQ(method_family(fixed, MethodProvider::geomint()), "explicit_rk");
   const MethodInfo adaptive = make_integrator("rkn_adaptive")->info();
   EXPECT_EQ(adaptive.order, 6);
   EXPECT_FALSE(adaptive.flags & kSymplectic);
-  EXPECT_EQ(method_family(adaptive), "adaptive_geomint");
+  EXPECT_EQ(method_family(adaptive, MethodProvider::geomint()), "adaptive_geomint");
   EXPECT_THROW(make_integrator("rkn:table=dprkn7"), InputError);
   EXPECT_THROW(make_integrator("rkn_adaptive:pair=nystrom4"), InputError);  // no embedded pair
 }

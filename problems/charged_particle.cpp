@@ -28,7 +28,10 @@ class ChargedParticle final : public Problem,
                               public ChargedParticleStructure {
  public:
   const LagrangianSystem* as_lagrangian() const override { return this; }
-  const ChargedParticleStructure* as_charged_particle() const override { return this; }
+  const void* structure(const StructureKey& key) const override {
+    if (const void* offered = offer<ChargedParticleStructure>(key, this)) return offered;
+    return Problem::structure(key);
+  }
   explicit ChargedParticle(const ChargedParticleParameters& parameters) : p_(parameters) {
     set_dof(3);  // no constant mass: the Lagrangian is non-separable
     const bool axisymmetric = p_.electric[0] == 0 && p_.electric[1] == 0;

@@ -11,6 +11,7 @@
 
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
+#include "problems/structures/charged_particle.hpp"
 
 namespace geomint {
 namespace {
@@ -85,8 +86,9 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
   }
   // A charged particle's mass, charge, fields and vector potential do not depend on its start:
   // the Boris pusher and the magnetic-moment metric keep them.
-  const ChargedParticleStructure* as_charged_particle() const override {
-    return base_->as_charged_particle();
+  const void* structure(const StructureKey& key) const override {
+    if (&key == &ChargedParticleStructure::kStructureKey) return base_->structure(key);
+    return nullptr;
   }
   std::vector<std::string> series_names() const override { return base_->series_names(); }
   void series_values(const Vec& q, const Vec& p, std::vector<double>& values) const override {

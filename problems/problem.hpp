@@ -14,6 +14,7 @@
 #include "problems/constraints.hpp"
 #include "problems/fixed_gradient.hpp"
 #include "problems/spec.hpp"
+#include "problems/structure.hpp"
 
 namespace geomint {
 
@@ -58,15 +59,12 @@ enum Capability : unsigned {
 // Capability names for `geomint list` and error messages.
 std::vector<std::string> capability_names(unsigned capabilities);
 
-// The interfaces a problem may offer beyond Problem (problems/first_order.hpp,
-// problems/lagrangian.hpp, problems/force.hpp, problems/rigid_body.hpp,
-// problems/charged_particle.hpp).
+// The interfaces that define a problem's kind, its constraints and its force
+// (problems/first_order.hpp, problems/lagrangian.hpp, problems/force.hpp). Structures that only
+// some methods and metrics read come through Problem::as<Structure>() (problems/structures/).
 class FirstOrderSystem;
 class LagrangianSystem;
 class NonConservativeForce;
-class FreeRigidBodyStructure;
-class AttitudeProblem;
-class ChargedParticleStructure;
 
 // The kind of system a problem is (docs/DESIGN.md §2): which interface defines its motion, and so
 // which methods can run it (MethodInfo's kinds, integrators/integrator.hpp).
@@ -114,12 +112,21 @@ class Problem {
   // problem has no constant mass (mass() throws; its constructor calls set_dof), p = M(q)v + a(q),
   // energy() is H(q, p) and first_order_rhs() Hamilton's equations.
   virtual const LagrangianSystem* as_lagrangian() const { return nullptr; }
-  // The free rigid body's Lie–Poisson structure (rigid_body, rigid_body_euler).
-  virtual const FreeRigidBodyStructure* as_free_rigid_body() const { return nullptr; }
-  // The attitude problem Q ∈ SO(3) as 9 constrained coordinates (rigid_body, heavy_top).
-  virtual const AttitudeProblem* as_attitude() const { return nullptr; }
-  // A charged particle's mass, charge, fields and vector potential (charged_particle).
-  virtual const ChargedParticleStructure* as_charged_particle() const { return nullptr; }
+  // A structure interface the problem offers (problems/structures/: FreeRigidBodyStructure,
+  // AttitudeStructure, ChargedParticleStructure, ...), or nullptr: one generic query, so Problem
+  // names no concrete structure. Structure is any class with a `static constexpr StructureKey
+  // kStructureKey` (problems/structure.hpp).
+  template <class Structure>
+  const Structure* as() const {
+    return static_cast<const Structure*>(structure(Structure::kStructureKey));
+  }
+  // The interface of `key` as a pointer to it (the Structure subobject), or nullptr. A problem
+  // that offers structures overrides it with one offer<Structure>() line per structure and ends
+  // with its base class's structure(key).
+  virtual const void* structure(const StructureKey& key) const {
+    (void)key;
+    return nullptr;
+  }
   // Holonomic constraints g(q) = 0 or g(q, t) = 0 (problems/constraints.hpp: what a constrained
   // problem implements). Callers take the pointer once per run or step, not per element.
   virtual const HolonomicConstraints* as_constrained() const { return nullptr; }
@@ -248,6 +255,13 @@ class Problem {
   virtual State end_reference() const;
 
  protected:
+  // `self` as its Structure subobject when `key` is Structure's key, else nullptr: the body of a
+  // structure() override, `if (auto* s = offer<FreeRigidBodyStructure>(key, this)) return s;`.
+  template <class Structure, class Self>
+  static const void* offer(const StructureKey& key, const Self* self) {
+    if (&key != &Structure::kStructureKey) return nullptr;
+    return static_cast<const Structure*>(self);
+  }
   // Called once by the constructor: set_mass for a kSeparable problem (it sets dof() as well),
   // set_dof for a kLagrangian or kFirstOrder one, which has no constant mass.
   void set_mass(const Vec& mass);

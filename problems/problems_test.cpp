@@ -162,6 +162,44 @@ class ProblemTest : public ::testing::TestWithParam<std::string> {
   std::unique_ptr<Problem> problem_;
 };
 
+// A new structure is one interface with its key plus one offer line in the problem that has it
+// (docs/DESIGN.md §2, "Structures"): Problem::as<>() finds it with no change to Problem, other
+// structures stay absent, and a key is its address, not its texts (a copy with the same name
+// is another structure).
+class TimeCrystalStructure {
+ public:
+  static constexpr StructureKey kStructureKey{"time_crystal", "time crystals", "none built in"};
+  virtual ~TimeCrystalStructure() = default;
+  virtual double crystal_period() const = 0;
+};
+struct LookalikeStructure {
+  static constexpr StructureKey kStructureKey{"time_crystal", "time crystals", "none built in"};
+};
+
+class TimeCrystal final : public Problem, public TimeCrystalStructure {
+ public:
+  TimeCrystal() { set_mass(Vec::Ones(1)); }
+  const void* structure(const StructureKey& key) const override {
+    if (const void* offered = offer<TimeCrystalStructure>(key, this)) return offered;
+    return Problem::structure(key);
+  }
+  double crystal_period() const override { return 3.0; }
+  State initial_state() const override { return {0.0, Vec::Zero(1), Vec::Zero(1)}; }
+  double potential(const Vec&) const override { return 0.0; }
+  void gradient(const Vec& q, Vec& g) const override { g = Vec::Zero(q.size()); }
+};
+
+TEST(Structures, ANewStructureIsFoundByItsKeyAlone) {
+  const TimeCrystal crystal;
+  const Problem& problem = crystal;
+  ASSERT_EQ(problem.as<TimeCrystalStructure>(), static_cast<const TimeCrystalStructure*>(&crystal));
+  EXPECT_EQ(problem.as<TimeCrystalStructure>()->crystal_period(), 3.0);
+  EXPECT_EQ(problem.as<LookalikeStructure>(), nullptr);
+  EXPECT_EQ(problem.as<FreeRigidBodyStructure>(), nullptr);
+  EXPECT_EQ(problem.as<ChargedParticleStructure>(), nullptr);
+  EXPECT_EQ(make_problem("pendulum")->as<TimeCrystalStructure>(), nullptr);
+}
+
 TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
   const Problem& problem = *problem_;
   if (problem.has(kFirstOrderOnly)) GTEST_SKIP() << "first-order only (problems/first_order_test)";
@@ -513,9 +551,11 @@ TEST_P(ProblemTest, RejectsUnknownKeysAndMalformedValues) {
 TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   const Problem& problem = *problem_;
   EXPECT_EQ(problem.as_lagrangian(), dynamic_cast<const LagrangianSystem*>(&problem));
-  EXPECT_EQ(problem.as_free_rigid_body(), dynamic_cast<const FreeRigidBodyStructure*>(&problem));
-  EXPECT_EQ(problem.as_attitude(), dynamic_cast<const AttitudeProblem*>(&problem));
-  EXPECT_EQ(problem.as_charged_particle(), dynamic_cast<const ChargedParticleStructure*>(&problem));
+  EXPECT_EQ(problem.as<FreeRigidBodyStructure>(),
+            dynamic_cast<const FreeRigidBodyStructure*>(&problem));
+  EXPECT_EQ(problem.as<AttitudeStructure>(), dynamic_cast<const AttitudeStructure*>(&problem));
+  EXPECT_EQ(problem.as<ChargedParticleStructure>(),
+            dynamic_cast<const ChargedParticleStructure*>(&problem));
   // Constraints are instance-level (elastic_bar has them only with clamp=constraint|pin): when
   // present they are the class's own interface; a class that derives from it and declines it has
   // none (m = 0), so one that forgets to return `this` fails here; the query alone sets the bits.

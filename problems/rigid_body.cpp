@@ -36,7 +36,10 @@ Eigen::Vector3d column(const Vec& x, int k) { return x.segment<3>(3 * k); }
 // The free body: V = 0, and the Lie–Poisson structure (FreeRigidBodyStructure) through Q and Π.
 class RigidBody final : public AttitudeProblem, public FreeRigidBodyStructure {
  public:
-  const FreeRigidBodyStructure* as_free_rigid_body() const override { return this; }
+  const void* structure(const StructureKey& key) const override {
+    if (const void* offered = offer<FreeRigidBodyStructure>(key, this)) return offered;
+    return AttitudeProblem::structure(key);
+  }
   RigidBody(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude)
       : AttitudeProblem(parameters, attitude, kHessian | kAngularMomentum | kCasimir),
         flip_axis_(
@@ -192,12 +195,6 @@ void AttitudeProblem::series_values(const Vec& q, const Vec& p, std::vector<doub
   const Eigen::Vector3d pi = rigid_body_body_momentum(q, p);
   values.assign(pi.data(), pi.data() + 3);
 }
-
-const FreeRigidBodyStructure* free_rigid_body(const Problem& problem) {
-  return problem.as_free_rigid_body();
-}
-
-const AttitudeProblem* attitude_problem(const Problem& problem) { return problem.as_attitude(); }
 
 Eigen::Matrix3d read_initial_attitude(Params& params, const std::string& problem) {
   Eigen::Vector3d axis;

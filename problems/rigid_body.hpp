@@ -7,6 +7,8 @@
 #include <string>
 
 #include "problems/problem.hpp"
+#include "problems/structures/attitude.hpp"
+#include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
 
@@ -57,14 +59,17 @@ class FreeBodyMotion {
 // column) under the 6 constraints QᵀQ = I, masses d_k = ½(I1 + I2 + I3) − I_k (MECHANICS.md §6):
 // the constraints, the initial state Q̇ = QΩ̂ and the spatial angular momentum Σ_k c_k × p_k shared
 // by rigid_body (V = 0) and heavy_top (gravity); each adds its potential and invariants.
-class AttitudeProblem : public Problem, public HolonomicConstraints {
+class AttitudeProblem : public Problem, public HolonomicConstraints, public AttitudeStructure {
  public:
   AttitudeProblem(const RigidBodyParameters& parameters, const Eigen::Matrix3d& attitude,
                   unsigned capabilities);
   State initial_state() const override;
-  const AttitudeProblem* as_attitude() const override { return this; }
+  const void* structure(const StructureKey& key) const override {
+    if (const void* offered = offer<AttitudeStructure>(key, this)) return offered;
+    return Problem::structure(key);
+  }
   // Q from its columns.
-  Eigen::Matrix3d attitude(const Vec& q) const;
+  Eigen::Matrix3d attitude(const Vec& q) const override;
   // Σ_k c_k × p_k = Q J Ω, the spatial angular momentum.
   Vec angular_momentum(const Vec& q, const Vec& p) const override;
   const HolonomicConstraints* as_constrained() const override { return this; }
@@ -87,28 +92,17 @@ class AttitudeProblem : public Problem, public HolonomicConstraints {
   Eigen::Matrix3d attitude_;
 };
 
-// The free rigid body's Lie–Poisson structure, offered by rigid_body and rigid_body_euler: the
-// principal moments J = diag(I1, I2, I3), and the state read as the attitude Q (the identity when
-// the state holds none, as in Euler's equations) and the body angular momentum Π, and written back
-// from them. The Lie–Poisson splitting (integrators/lie_poisson.cpp) reads and writes the state
-// only through it, and applicable() admits it only where free_rigid_body() finds it.
-class FreeRigidBodyStructure {
- public:
-  virtual ~FreeRigidBodyStructure() = default;
-  virtual Eigen::Vector3d principal_moments() const = 0;
-  virtual void read_body(const Vec& q, const Vec& p, Eigen::Matrix3d& attitude,
-                         Eigen::Vector3d& body_momentum) const = 0;
-  virtual void write_body(const Eigen::Matrix3d& attitude, const Eigen::Vector3d& body_momentum,
-                          Vec& q, Vec& p) const = 0;
-};
-
-// (Compatibility shims for Problem::as_free_rigid_body() and as_attitude().)
+// (Compatibility shims for Problem::as<FreeRigidBodyStructure>() and as<AttitudeStructure>().)
 // The structure a problem offers, or nullptr (every other problem, and a rigid body started from
 // an `initial=` file, whose given state drops the problem's own pieces).
-const FreeRigidBodyStructure* free_rigid_body(const Problem& problem);
-// The attitude problem (rigid_body, heavy_top) behind `problem`, or nullptr: the
-// orthogonality_err_max metric reads Q through it.
-const AttitudeProblem* attitude_problem(const Problem& problem);
+inline const FreeRigidBodyStructure* free_rigid_body(const Problem& problem) {
+  return problem.as<FreeRigidBodyStructure>();
+}
+// The attitude Q of rigid_body and heavy_top, or nullptr: the orthogonality_err_max metric reads
+// Q through it.
+inline const AttitudeStructure* attitude_problem(const Problem& problem) {
+  return problem.as<AttitudeStructure>();
+}
 
 // The initial attitude from the spec keys axis1..3 and angle (identity by default), read the same
 // way by rigid_body and heavy_top.

@@ -12,7 +12,10 @@ namespace {
 
 class RigidBodyEuler final : public FirstOrderProblem, public FreeRigidBodyStructure {
  public:
-  const FreeRigidBodyStructure* as_free_rigid_body() const override { return this; }
+  const void* structure(const StructureKey& key) const override {
+    if (const void* offered = offer<FreeRigidBodyStructure>(key, this)) return offered;
+    return FirstOrderProblem::structure(key);
+  }
   RigidBodyEuler(const RigidBodyParameters& parameters, const Eigen::Vector3d& pi0,
                  const FreeBodyMotion& motion)
       : FirstOrderProblem(Vec(pi0), Capabilities(motion)),

@@ -32,7 +32,11 @@ summary=${1:-summary.csv}
 rm -rf wp
 mkdir -p wp
 # split_csv comes from scripts/csv.awk; the program is read from the here-document.
-awk -v out=wp -f "$(dirname "$0")/csv.awk" -f /dev/stdin "$summary" > time_to_error.md <<'AWK'
+# Who implements each method: the provider column of docs/METHODS.md's table, which
+# scripts/readme_tables.py writes from integrators/registry.def (and tests/cli_test.cpp keeps in
+# step with it), so no method name prefix decides which side of the goal a method is on.
+methods_md="$(cd "$(dirname "$0")/.." && pwd)/docs/METHODS.md"
+awk -v out=wp -v methods_md="$methods_md" -f "$(dirname "$0")/csv.awk" -f /dev/stdin "$summary" > time_to_error.md <<'AWK'
 # Curve name: the method name and its scheme, s, table or pair (tolerances and library defaults
 # dropped), file-name safe.
 function curve_name(spec,    name, rest, parts, n, i, kept) {
@@ -45,8 +49,22 @@ function curve_name(spec,    name, rest, parts, n, i, kept) {
   }
   return kept
 }
-# The library wrappers, as integrators/integrator.cpp library_method() names them.
-function library(spec) { return spec ~ /^(cvode_|ida|arkode_|gsl_|odeint_)/ }
+# The provider of each method name, from the rows between <!-- methods:begin/end -->:
+# "| `cvode_bdf` | library:SUNDIALS | ...".
+function read_providers(    line, inside, cells, name, count) {
+  while ((getline line < methods_md) > 0) {
+    if (line ~ /<!-- methods:begin -->/) inside = 1
+    else if (line ~ /<!-- methods:end -->/) inside = 0
+    else if (inside && line ~ /^\| `[a-z0-9_]+` \| /) {
+      split(line, cells, / \| /); name = cells[1]; gsub(/^\| `|`$/, "", name); provider[name] = cells[2]; count++
+    }
+  }
+  close(methods_md)
+  if (count == 0) { print "no method table with a provider column in " methods_md > "/dev/stderr"; failed = 1; exit 2 }
+}
+# A library wrapper: its registry entry's provider is library:NAME (a method the table does not
+# list, a user's, is not one).
+function library(spec,    name) { name = spec; sub(/:.*/, "", name); return provider[name] ~ /^library:/ }
 # A column's cell, nan when the column is absent or empty (a problem without that metric).
 function cell(name) { return (name in col) && f[col[name]] != "" ? f[col[name]] : "nan" }
 # The largest value of diagram y axis a over a group's ok runs: where its timeout markers sit.
@@ -110,8 +128,9 @@ header == 0 {
   has_data[key] = 1; group_has_data[group] = 1
   for (l = 1; l <= nlevels; l++) if (err <= level[l]) consider(key, l, wall, iqr, lo)
 }
-BEGIN { nlevels = split("1e-2 1e-4 1e-6 1e-8 1e-10", level, " "); for (l = 1; l <= nlevels; l++) level[l] += 0; goal_level = 4 }
+BEGIN { read_providers(); nlevels = split("1e-2 1e-4 1e-6 1e-8 1e-10", level, " "); for (l = 1; l <= nlevels; l++) level[l] += 0; goal_level = 4 }
 END {
+  if (failed) exit 2
   print "# Time to reach error X (least median wall time of an ok run with error_final <= X)\n"
   print "Per group (problem and horizon) and method curve: the median wall time of the timed repeats"
   print "of the cheapest run that reaches X, with that run's interquartile range (IQR, seconds);"

@@ -195,7 +195,7 @@ const std::string kTop =
     "omega2=-0.3,omega3=6,axis1=1,axis2=0.5,axis3=0,angle=0.7";
 
 double height_of_centre(const Problem& problem, const Vec& q) {
-  return (problem.as_attitude()->attitude(q) * Eigen::Vector3d(0.2, -0.1, 0.6))[2];
+  return (problem.as<AttitudeStructure>()->attitude(q) * Eigen::Vector3d(0.2, -0.1, 0.6))[2];
 }
 
 TEST(HeavyTopRuns, FallsFromRestAndKeepsEnergyAndVerticalMomentum) {
@@ -219,7 +219,7 @@ TEST(HeavyTopRuns, FallsFromRestAndKeepsEnergyAndVerticalMomentum) {
     EXPECT_LE(metrics.at("angular_momentum_err_max"), 1e-12 * vertical) << method;
     EXPECT_LE(metrics.at("energy_err_max"), 1e-3) << method;
     EXPECT_LE(metrics.at("orthogonality_err_max"), 1e-13) << method;
-    const AttitudeProblem& body = *top->as_attitude();
+    const AttitudeStructure& body = *top->as<AttitudeStructure>();
     const Eigen::Matrix3d Q0 = body.attitude(start.q), Q = body.attitude(result.final_state.q);
     Eigen::Vector3d spatial0 = Eigen::Vector3d::Zero(), spatial = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) {

@@ -86,9 +86,9 @@ void print_aligned(const std::vector<std::vector<std::string>>& rows,
 void print_methods(bool markdown) {
   std::vector<std::vector<std::string>> rows;
   if (markdown) {
-    fmt::print("| method | order | flags | what it is |\n|---|---|---|---|\n");
+    fmt::print("| method | provider | order | flags | what it is |\n|---|---|---|---|---|\n");
   } else {
-    rows.push_back({"method", "order", "flags", "parameters (default)"});
+    rows.push_back({"method", "provider", "order", "flags", "parameters (default)"});
   }
   for (const auto& entry : integrator_registry()) {
     if (markdown && !entry.builtin) continue;
@@ -96,16 +96,17 @@ void print_methods(bool markdown) {
     const auto integrator = entry.factory(params);
     const MethodInfo info = integrator->info();
     if (markdown) {
-      fmt::print("| `{}` | {} | {} | {} |\n", entry.name, order_column(entry, info.order),
+      fmt::print("| `{}` | {} | {} | {} | {} |\n", entry.name, entry.provider.label(),
+                 order_column(entry, info.order),
                  fmt::format("{}", fmt::join(flag_names(info.flags), ", ")),
                  markdown_cell(entry.summary));
     } else {
-      rows.push_back({entry.name, std::to_string(info.order),
+      rows.push_back({entry.name, entry.provider.label(), std::to_string(info.order),
                       fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
                       parameter_list(params)});
     }
   }
-  if (!markdown) print_aligned(rows, {false, true, false, false});
+  if (!markdown) print_aligned(rows, {false, false, true, false, false});
 }
 
 // The integer parameters with their ranges ("`n` 1..64"): the size limits a reader of the table

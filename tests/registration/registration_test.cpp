@@ -33,12 +33,22 @@ TEST(Registration, StaticRegistrarAddsAnExternalEntry) {
   EXPECT_FALSE(entry->builtin);
   EXPECT_TRUE(registry.front().builtin);
   EXPECT_EQ(make_integrator("registrar_verlet")->spec(), "registrar_verlet");
+  // A method registered at run time is the user's (MethodProvider), whatever it is called.
+  EXPECT_EQ(entry->provider.kind, MethodProvider::Kind::kUser);
+  EXPECT_EQ(make_integrator("registrar_verlet")->provider().label(), "user");
+  EXPECT_EQ(registry.front().provider.label(), "geomint");
   const auto specs = integrator_test_specs();
   EXPECT_NE(std::find(specs.begin(), specs.end(), "registrar_verlet"), specs.end());
 }
 
 TEST(Registration, MethodsAndProblemsReachTheFactories) {
   register_method({"external_verlet", "test", &make_renamed_verlet, {}});
+  // An entry that says it wraps a library keeps that provider.
+  IntegratorEntry wrapped{"external_wrapped_verlet", "test", &make_renamed_verlet, {}};
+  wrapped.provider = MethodProvider::library_named("SomeLib");
+  register_method(wrapped);
+  EXPECT_EQ(method_provider("external_wrapped_verlet").label(), "library:SomeLib");
+  EXPECT_EQ(method_provider("external_verlet").label(), "user");
   register_problem({"external_harmonic", "test", &make_renamed_harmonic, {"omega=2"}});
   EXPECT_EQ(make_integrator("external_verlet")->info().order, 2);
   const auto problem = make_problem("external_harmonic:omega=3");
