@@ -13,6 +13,8 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "problems/structures/charged_particle.hpp"
+#include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
 namespace {
@@ -767,6 +769,14 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
     }
   }
   EXPECT_THROW(method_provider("no_such_method"), InputError);
+  // One record of info, provider and needs; a structure need is the interface's key.
+  const MethodRecord boris = method_record(*make_integrator("boris"));
+  EXPECT_EQ(boris.info.name, "boris");
+  EXPECT_EQ(boris.provider.label(), "geomint");
+  EXPECT_EQ(boris.needs.structure, &ChargedParticleStructure::kStructureKey);
+  EXPECT_EQ(method_record(*make_integrator("lie_poisson")).needs.structure,
+            &FreeRigidBodyStructure::kStructureKey);
+  EXPECT_EQ(method_record(*make_integrator("gsl_rk8pd")).provider.label(), "library:GSL");
 }
 
 }  // namespace

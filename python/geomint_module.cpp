@@ -48,7 +48,8 @@ py::list method_entries() {
     item["summary"] = entry.summary;
     item["order"] = info.order;
     item["flags"] = flag_names(info.flags);
-    item["family"] = method_family(info);
+    item["provider"] = entry.provider.label();
+    item["family"] = method_family(info, entry.provider);
     item["parameters"] = parameter_docs(params);
     item["builtin"] = entry.builtin;
     entries.append(item);

@@ -298,7 +298,7 @@ TEST(GeneralRows, InitialStateFileUsesThePositionDependentMass) {
 }
 
 // A charged particle started from a file keeps its mass, charge and fields
-// (Problem::as_charged_particle() forwarded by the initial= wrapper): Boris runs, and it and the
+// (Problem::as<ChargedParticleStructure>() forwarded by the initial= wrapper): Boris runs, and it and the
 // magnetic-moment metric give the direct run's bits from the same start.
 TEST(GeneralRows, ChargedParticleFromAFileKeepsItsFields) {
   const std::filesystem::path dir =

@@ -103,6 +103,9 @@ def test_registries_match_geomint_list():
         assert (problem.dof, problem.capabilities) == (entry["dof"], entry["capabilities"])
     verlet = next(entry for entry in geomint.methods() if entry["name"] == "stormer_verlet")
     assert verlet["order"] == 2 and "symplectic" in verlet["flags"]
+    providers = {entry["name"]: entry["provider"] for entry in geomint.methods()}
+    assert providers["stormer_verlet"] == "geomint"
+    assert providers["cvode_bdf"] == "library:SUNDIALS"
     assert [parameter["key"] for parameter in verlet["parameters"]] == ["compensated"]
 
 
