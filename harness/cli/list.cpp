@@ -176,8 +176,9 @@ void print_entry(const std::string& name) {
     if (entry.name != name) continue;
     Params params(Spec{entry.name, {}}, entry.name);
     const MethodInfo info = entry.factory(params)->info();
-    fmt::print("{} (method): {}\norder {}; flags: {}\n\n", entry.name, entry.summary,
-               order_column(entry, info.order), fmt::join(flag_names(info.flags), ", "));
+    fmt::print("{} (method): {}\nprovider {}; order {}; flags: {}\n\n", entry.name, entry.summary,
+               entry.provider.label(), order_column(entry, info.order),
+               fmt::join(flag_names(info.flags), ", "));
     print_parameters(params);
     found = true;
   }
