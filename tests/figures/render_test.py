@@ -60,6 +60,9 @@ def main():
                     if p.stem != "common" and (source / "results" / p.stem / "scene.toml").is_file())
     shutil.rmtree(scratch, ignore_errors=True)
     shutil.copytree(source / "scripts", scratch / "scripts")
+    # scripts/work_precision_table.sh takes each method's provider from the methods table.
+    (scratch / "docs").mkdir()
+    shutil.copy(source / "docs" / "METHODS.md", scratch / "docs" / "METHODS.md")
     for scene in scenes:
         shutil.copytree(source / "results" / scene, scratch / "results" / scene,
                         ignore=lambda _, names: [n for n in names if n.endswith(FIGURE_SUFFIXES)])
