@@ -20,6 +20,7 @@
 #include "harness/run_spec.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/spec.hpp"
+#include "tests/test_util.hpp"
 
 namespace geomint {
 namespace {
@@ -38,16 +39,9 @@ void write(const fs::path& path, const std::string& bytes) {
 
 // A .npy file (format 1.0) of `rows` x `columns` little-endian float64 values.
 std::string npy_bytes(const std::vector<double>& values, size_t rows, size_t columns) {
-  std::string header =
-      fmt::format("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {}), }}", rows, columns);
-  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
-  header += '\n';
-  std::string bytes("\x93NUMPY\x01\x00", 8);
-  bytes += static_cast<char>(header.size() & 0xff);
-  bytes += static_cast<char>(header.size() >> 8);
-  bytes += header;
-  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
-  return bytes;
+  return test::npy_file(
+      fmt::format("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {}), }}", rows, columns),
+      values);
 }
 
 // The first method (of a few that cover every kind of problem) that runs `problem`.

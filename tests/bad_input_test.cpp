@@ -25,11 +25,13 @@
 #include <vector>
 
 #include "harness/table.hpp"
+#include "tests/test_util.hpp"
 
 namespace geomint {
 namespace {
 
 namespace fs = std::filesystem;
+using test::npy_file;
 
 struct Case {
   std::string name;       // test name suffix (letters, digits, underscores)
@@ -86,18 +88,6 @@ std::string bench_json(const std::vector<double>& times_us) {
 }
 const std::string kBenchJson = bench_json({10, 11, 12, 10.5, 11.5, 10.2});
 
-// A .npy file (format 1.0) with the header dict `dict` and the float64 `values` (score cases).
-std::string npy_file(const std::string& dict, const std::vector<double>& values) {
-  std::string header = dict;
-  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
-  header += '\n';
-  std::string bytes("\x93NUMPY\x01\x00", 8);
-  bytes += static_cast<char>(header.size() & 0xff);
-  bytes += static_cast<char>(header.size() >> 8);
-  bytes += header;
-  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
-  return bytes;
-}
 const std::string kPendulumNpyDict = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }";
 const std::vector<double> kPendulumRows = {0, 0.5, 0, 0.1, 0.49, 0.1};
 const std::string kPendulumNpy = npy_file(kPendulumNpyDict, kPendulumRows);

@@ -16,6 +16,21 @@
 
 namespace geomint::test {
 
+// A .npy file (NumPy format 1.0) with the header dict `dict` (e.g. "{'descr': '<f8', ...}") and
+// the float64 `values` as raw bytes: the header padded with spaces so the data starts at a
+// multiple of 64 bytes, as numpy.save writes it.
+inline std::string npy_file(const std::string& dict, const std::vector<double>& values) {
+  std::string header = dict;
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return bytes;
+}
+
 // Success when make(input) throws InputError and its message contains every fragment; the
 // failure names the input and quotes the message, or says the input was accepted. Use as
 // EXPECT_TRUE(input_error_names(make_problem, "kepler:e=1", "e=1")) so a failure points at the
