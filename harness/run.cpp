@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -172,6 +173,13 @@ struct [[nodiscard]] LoopOutcome {
 
 using Clock = std::chrono::steady_clock;
 
+std::atomic<bool> interrupt_flag{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "request_interrupt runs in a signal handler");
+
+StepStatus interrupted_at(double t) {
+  return StepStatus::failure(kInterruptedStatus, fmt::format("interrupted at t={:.6g}", t));
+}
+
 // Advances from the initial state to t_end; `visit(state, last)` sees every step point.
 // Fixed steps use t_k = t_0 + k·dt (no accumulated round-off in t); the last step is shortened
 // only when dt does not divide t_end. With `checked`, a step point must be finite and pass
@@ -211,6 +219,10 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
   auto check = [&](const State& s) {
     if (!checked) return true;
     if (!within_budget(s)) return false;
+    if (interrupt_requested()) {
+      outcome.status = interrupted_at(s.t);
+      return false;
+    }
     if (!finite(s)) {
       outcome.status = StepStatus::failure("nan", fmt::format("non-finite state at t={}", s.t));
       return false;
@@ -229,6 +241,11 @@ LoopOutcome integrate(const Problem& problem, Integrator& integrator, State& sta
         return outcome;
       }
       if (!check(state) || (!checked && !within_budget(state))) {
+        outcome.seconds = seconds_since_start();
+        return outcome;
+      }
+      if (!checked && interrupt_requested()) {
+        outcome.status = interrupted_at(state.t);
         outcome.seconds = seconds_since_start();
         return outcome;
       }
@@ -358,6 +375,10 @@ TimingStats timing_stats(std::vector<double> seconds) {
   return stats;
 }
 
+void request_interrupt() { interrupt_flag.store(true, std::memory_order_relaxed); }
+void clear_interrupt() { interrupt_flag.store(false, std::memory_order_relaxed); }
+bool interrupt_requested() { return interrupt_flag.load(std::memory_order_relaxed); }
+
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats) {
   return time_run(RunSpec::parse(problem_spec, method_spec, config), repeats);
@@ -372,6 +393,10 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
   // One run from a fresh integrator; its wall time, or nullopt with the failed status.
   StepStatus failed = StepStatus::success();
   const auto one_run = [&]() -> std::optional<double> {
+    if (interrupt_requested()) {
+      failed = interrupted_at(problem->initial_state().t);
+      return std::nullopt;
+    }
     auto integrator = spec.method.make();
     State state = problem->initial_state();
     const auto start = Clock::now();

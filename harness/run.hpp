@@ -22,6 +22,13 @@ struct RunSpec;  // harness/run_spec.hpp
 constexpr double kDefaultDivergeFactor = 1e8;
 // The failure reason of a run that exceeded RunConfig::wall_budget_s.
 inline constexpr const char* kTimeoutStatus = "timeout";
+// Cancellation (the Python package's Ctrl-C, docs/PYTHON.md): once request_interrupt() is called
+// (async-signal-safe: a lock-free atomic store), a metric pass ends at its next step point with
+// this status, a timing pass before its next repeat or adaptive step, until clear_interrupt().
+inline constexpr const char* kInterruptedStatus = "interrupted";
+void request_interrupt();
+void clear_interrupt();
+bool interrupt_requested();
 // Caps on counts that would otherwise let one option request unbounded work.
 constexpr int kMaxTimingRepeats = 100;
 // Wall-clock budget of one timing pass (warm-up + repeats), scene key `timing_budget_s`: a pass

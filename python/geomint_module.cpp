@@ -18,8 +18,9 @@
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
-
-namespace py = pybind11;
+#include "python/interrupt_scope.hpp"
+#include "python/py_problem.hpp"
+#include "python/python_method.hpp"
 
 namespace geomint {
 namespace {
@@ -45,7 +46,7 @@ py::list method_entries() {
     const MethodInfo info = entry.factory(params)->info();
     py::dict item;
     item["name"] = entry.name;
-    item["summary"] = entry.summary;
+    item["summary"] = python_method_summary(entry.name, entry.summary);
     item["order"] = info.order;
     item["flags"] = flag_names(info.flags);
     item["provider"] = entry.provider.label();
@@ -76,77 +77,6 @@ py::list problem_entries() {
   return entries;
 }
 
-// A ValueError, as an InputError would be, for a query the problem does not offer (the C++ API
-// throws std::logic_error there, which would surface as a RuntimeError).
-void require(const Problem& problem, Capability capability, const char* what) {
-  if (!problem.has(capability)) {
-    throw InputError(fmt::format("problem '{}' has no {}", problem.spec(), what));
-  }
-}
-
-// Problem wrapper: one parsed problem object, shared with the runs started from it.
-class PyProblem {
- public:
-  explicit PyProblem(const std::string& spec) : problem_(parse_problem(spec)) {}
-  const Problem& get() const { return *problem_; }
-  const std::shared_ptr<const Problem>& shared() const { return problem_; }
-
-  py::tuple initial_state() const {
-    const State state = problem_->initial_state();
-    return py::make_tuple(state.q, state.p);
-  }
-  py::tuple exact(double t) const {
-    require(*problem_, kExact, "exact solution");
-    const State state = problem_->exact(t);
-    return py::make_tuple(state.q, state.p);
-  }
-  Vec grad_potential(const Vec& q) const {
-    if (problem_->kind() != ProblemKind::kSeparable) {
-      throw InputError(
-          fmt::format("problem '{}' is of kind {}: grad_potential needs a separable "
-                      "problem (L = ½vᵀMv − V(q))",
-                      problem_->spec(), kind_name(problem_->kind())));
-    }
-    check_size(q, "q");
-    Vec g;
-    problem_->gradient(q, g);
-    return g;
-  }
-  double energy(const Vec& q, const Vec& p) const {
-    check_size(q, "q");
-    if (!problem_->has(kFirstOrderOnly)) check_size(p, "p");
-    return problem_->energy(q, p);
-  }
-  // The conserved quantities the problem declares, by the series columns' names.
-  py::dict invariants(const Vec& q, const Vec& p) const {
-    check_size(q, "q");
-    if (!problem_->has(kFirstOrderOnly)) check_size(p, "p");
-    py::dict values;
-    if (!problem_->has(kFirstOrderOnly)) values["energy"] = problem_->energy(q, p);
-    if (problem_->has(kLinearMomentum)) {
-      values["linear_momentum"] = Vec(problem_->linear_momentum(q, p));
-    }
-    if (problem_->has(kAngularMomentum)) {
-      values["angular_momentum"] = Vec(problem_->angular_momentum(q, p));
-    }
-    if (problem_->has(kCasimir)) values["casimir"] = problem_->casimir(q, p);
-    return values;
-  }
-  double period() const {
-    require(*problem_, kPeriod, "period");
-    return problem_->period();
-  }
-
- private:
-  void check_size(const Vec& v, const char* name) const {
-    if (v.size() != problem_->dof()) {
-      throw InputError(fmt::format("{} has {} entries; problem '{}' has dof = {}", name, v.size(),
-                                   problem_->spec(), problem_->dof()));
-    }
-  }
-  std::shared_ptr<const Problem> problem_;
-};
-
 // A record's cells as `geomint run` writes them (to_row: the one formatter of every table).
 py::dict cells(const RunRecord& record) {
   py::dict row;
@@ -157,11 +87,13 @@ py::dict cells(const RunRecord& record) {
 py::dict run(const PyProblem& problem, const std::string& method_spec, const RunConfig& config) {
   RunSpec spec{problem.shared(), MethodFactory(method_spec), config};
   RunResult result;
+  InterruptScope interrupt;
   {
     // A run may take minutes; other Python threads go on meanwhile.
     py::gil_scoped_release release;
     result = run_one(spec);
   }
+  interrupt.raise_if_interrupted();
   py::dict out;
   out["row"] = cells(result.record);
   out["columns"] = record_columns({result.record});
@@ -175,10 +107,12 @@ py::dict order(const PyProblem& problem, const std::string& method_spec, double 
                double t_end, double diverge_factor) {
   const MethodFactory method(method_spec);
   OrderStudy study;
+  InterruptScope interrupt;
   {
     py::gil_scoped_release release;
     study = order_study(problem.shared(), method, dt0, levels, t_end, diverge_factor);
   }
+  interrupt.raise_if_interrupted();
   std::vector<RunRecord> records;
   py::list rows;
   for (const RunResult& level : study.runs) {
@@ -224,6 +158,9 @@ PYBIND11_MODULE(_geomint, module) {
       .def("exact", &PyProblem::exact, py::arg("t"))
       .def("energy", &PyProblem::energy, py::arg("q"), py::arg("p"))
       .def("grad_potential", &PyProblem::grad_potential, py::arg("q"))
+      .def("potential", &PyProblem::potential, py::arg("q"))
+      .def("mass", &PyProblem::mass)
+      .def("inverse_mass", &PyProblem::inverse_mass)
       .def("invariants", &PyProblem::invariants, py::arg("q"), py::arg("p"))
       .def("period", &PyProblem::period);
 
@@ -249,4 +186,5 @@ PYBIND11_MODULE(_geomint, module) {
              py::arg("levels"), py::arg("t_end"), py::arg("diverge_factor"));
   module.attr("default_diverge_factor") = kDefaultDivergeFactor;
   module.attr("default_max_steps") = kDefaultMaxSteps;
+  bind_python_methods(module);
 }

@@ -10,7 +10,10 @@ import numpy as np
 from . import _geomint
 from ._geomint import InputError  # a subclass of ValueError
 
-__all__ = ["problems", "methods", "Problem", "Run", "Series", "run", "order", "InputError"]
+__all__ = [
+    "problems", "methods", "Problem", "Run", "Series", "run", "order", "InputError",
+    "register_method", "check_names", "check", "verify",
+]
 
 
 def methods():
@@ -179,3 +182,83 @@ def order(problem, method, dt, t_end, levels=6, diverge_factor=None):
     frame.attrs["fit"] = parse_row(result["summary"])
     frame.attrs["note"] = result["note"]
     return frame
+
+
+def register_method(method, step=None, *, name=None, order=None, implicit=False,
+                    symplectic=False, symmetric=False, variational=False,
+                    energy_preserving=False, flags=None, summary=None, reference=""):
+    """Registers an integrator written in Python; it then runs in run(), order(), sweep() and the
+    verify kit (check(), verify()) like a built-in method, with provider "user".
+
+    Either register_method(name, step, order=2, symplectic=True, ...) with a function
+    step(problem, q, p, t, h) -> (q, p), or register_method(obj) with an object or a class that
+    has a step method of that signature and `name`, `order` (and optionally `flags`, a list of
+    flag names, and `summary`) as attributes; a class is instantiated once per run, and an
+    optional reset(problem, q, p, t, h) is called before the first step. Keywords override the
+    attributes. Declarable flags: explicit (the default) or implicit, symplectic, symmetric,
+    variational, energy_preserving. The step sees problem.grad_potential(q), .potential(q),
+    .mass(), .inverse_mass() and the rest of geomint.Problem, so Python methods run on
+    conservative separable problems. Registering a name again replaces the Python method; a
+    built-in's name is a ValueError. Returns the name."""
+    if isinstance(method, str):
+        if step is None:
+            raise TypeError("register_method(name, step, ...): step is missing")
+        name = method if name is None else name
+        target = step
+    elif step is not None:
+        raise TypeError("register_method(obj) takes no step: obj.step is the step")
+    else:
+        target = method
+    factory = function = None
+    if isinstance(target, type):
+        if not callable(getattr(target, "step", None)):
+            raise TypeError(f"class {target.__name__} has no step method")
+        factory = target
+    elif callable(getattr(target, "step", None)):
+        function = target.step
+    elif callable(target):
+        function = target
+    else:
+        raise TypeError(f"{target!r} is neither a function nor an object with a step method")
+    name = name if name is not None else getattr(target, "name", None)
+    order = order if order is not None else getattr(target, "order", None)
+    if not isinstance(name, str):
+        raise ValueError("register_method: a name is required (argument or attribute `name`)")
+    if order is None:
+        raise ValueError(f"register_method: method '{name}' needs its order (argument or "
+                         "attribute `order`)")
+    declared = flags if flags is not None else getattr(target, "flags", ())
+    declared = [declared] if isinstance(declared, str) else list(declared)
+    if "implicit" not in declared and "explicit" not in declared:
+        declared.append("implicit" if implicit else "explicit")
+    keywords = {"symplectic": symplectic, "symmetric": symmetric, "variational": variational,
+                "energy_preserving": energy_preserving}
+    declared += [flag for flag, given in keywords.items() if given and flag not in declared]
+    if summary is None:
+        summary = getattr(target, "summary", None) or (
+            (target.__doc__ or "").strip().split("\n")[0] or f"Python method {name}")
+    _geomint.register_method(name, function, factory, int(order), declared, summary, reference)
+    return name
+
+
+def check_names():
+    """The verify kit's checks in the order verify() runs them (docs/VERIFY.md)."""
+    return list(_geomint.check_names())
+
+
+def check(method, name, constrained_problem="cartesian_pendulum"):
+    """One check of the verify kit on `method` (a spec, a Python method included): a dict with
+    check, method, problem, applies, passed, measured, bound, detail and text (one line, as the
+    C++ kit's describe() prints it). applies is False (and passed True) when the method's flags
+    do not call for the check."""
+    return dict(_geomint.check(method, name, constrained_problem))
+
+
+def verify(method, constrained_problem="cartesian_pendulum"):
+    """Every check of check_names() on `method`: a pandas DataFrame, one row per check, the
+    verdicts a built-in method gets from the C++ verify kit (GEOMINT_VERIFY_METHOD)."""
+    import pandas as pd
+
+    rows = [check(method, name, constrained_problem) for name in check_names()]
+    return pd.DataFrame(rows, columns=["check", "method", "problem", "applies", "passed",
+                                       "measured", "bound", "detail", "text"])
