@@ -7,14 +7,20 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "harness/gate.hpp"
 #include "harness/order.hpp"
+#include "harness/paths.hpp"
 #include "harness/record.hpp"
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
+#include "harness/scene.hpp"
+#include "harness/shard.hpp"
+#include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
 #include "problems/spec.hpp"
@@ -130,6 +136,53 @@ py::dict order(const PyProblem& problem, const std::string& method_spec, double 
   return out;
 }
 
+// `geomint sweep SCENE [--quick] --out OUT [--no-timing]`, as harness/cli/sweep.cpp sets it up
+// (the scene's name is the folder holding scene.toml, whatever the output folder): the number of
+// failed runs; the tables are the CSV files in `out_dir`.
+int sweep(const std::string& scene_path, bool quick, const std::string& out_dir, int jobs,
+          bool timing, bool progress, const std::string& command_line) {
+  const Scene scene = load_scene(scene_path, quick);
+  SweepOptions options;
+  options.jobs = jobs;
+  options.progress = progress;
+  options.command_line = command_line;
+  options.out_dir = out_dir;
+  options.scene_name = std::filesystem::absolute(scene_path).parent_path().filename().string();
+  options.variant = quick ? "quick" : "full";
+  options.scene_hash = scene_content_hash(scene_path, quick);
+  options.timing = timing;
+  check_output_dir(options.out_dir, "out");
+  int failed = 0;
+  InterruptScope interrupt;
+  {
+    py::gil_scoped_release release;
+    failed = run_sweep(scene, options);
+  }
+  interrupt.raise_if_interrupted();
+  return failed;
+}
+
+// `geomint gate GATES RESULTS...`'s verdicts, one dict per gate (applicable or not).
+py::list gate(const std::string& gates_path, const std::vector<std::string>& results) {
+  const std::vector<Gate> gates = load_gates(gates_path);
+  const std::vector<ResultFile> files = load_result_files(results);
+  py::list verdicts;
+  for (const GateOutcome& outcome : check_gates(gates, files)) {
+    py::dict verdict;
+    verdict["gate"] = outcome.gate->name;
+    verdict["scene"] = outcome.gate->scene;
+    verdict["table"] = outcome.gate->table;
+    verdict["column"] = outcome.gate->column;
+    verdict["file"] = outcome.gate->file;
+    verdict["applicable"] = outcome.applicable;
+    verdict["passed"] = outcome.passed;
+    verdict["rows_checked"] = outcome.rows_checked;
+    verdict["lines"] = outcome.lines;
+    verdicts.append(verdict);
+  }
+  return verdicts;
+}
+
 }  // namespace
 }  // namespace geomint
 
@@ -186,5 +239,8 @@ PYBIND11_MODULE(_geomint, module) {
              py::arg("levels"), py::arg("t_end"), py::arg("diverge_factor"));
   module.attr("default_diverge_factor") = kDefaultDivergeFactor;
   module.attr("default_max_steps") = kDefaultMaxSteps;
+  module.def("sweep", &sweep, py::arg("scene"), py::arg("quick"), py::arg("out_dir"),
+             py::arg("jobs"), py::arg("timing"), py::arg("progress"), py::arg("command_line"));
+  module.def("gate", &gate, py::arg("gates"), py::arg("results"));
   bind_python_methods(module);
 }

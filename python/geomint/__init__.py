@@ -12,7 +12,7 @@ from ._geomint import InputError  # a subclass of ValueError
 
 __all__ = [
     "problems", "methods", "Problem", "Run", "Series", "run", "order", "InputError",
-    "register_method", "check_names", "check", "verify",
+    "register_method", "check_names", "check", "verify", "sweep", "gate", "read_table", "Tables",
 ]
 
 
@@ -114,6 +114,105 @@ class Run:
 
 def _problem(problem):
     return problem if isinstance(problem, _geomint.Problem) else Problem(problem)
+
+
+def read_table(path):
+    """A table CSV the harness wrote, as pandas reads it with comment="#" (docs/PYTHON.md), but
+    only whole lines starting with # are provenance: they go to df.attrs["provenance"]."""
+    import io
+
+    import pandas as pd
+
+    with open(path, encoding="utf-8") as handle:
+        lines = handle.readlines()
+    provenance = {}
+    for line in lines:
+        if line.startswith("# ") and ":" in line:
+            key, value = line[2:].split(":", 1)
+            provenance[key.strip()] = value.strip()
+    frame = pd.read_csv(io.StringIO("".join(line for line in lines if not line.startswith("#"))))
+    frame.attrs["provenance"] = provenance
+    return frame
+
+
+class Tables(dict):
+    """A sweep's tables by name (summary, order, order_points, stability: those the scene has),
+    each a pandas DataFrame; `failed` is the number of failed runs (rows, not errors) and
+    `folder` where the CSVs are (None when they were written to a temporary folder)."""
+
+    def __init__(self, tables, failed, folder):
+        super().__init__(tables)
+        self.failed = failed
+        self.folder = folder
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+SWEEP_TABLES = ("summary", "order", "order_points", "stability")
+
+
+def sweep(scene, quick=False, out=None, jobs=1, timing=True, progress=False):
+    """Runs a scene (its scene.toml, or the folder holding it) as `geomint sweep SCENE` does,
+    with --quick, --jobs and --no-timing (timing=False), and returns its tables as a Tables dict
+    of DataFrames equal to the CSVs the program writes. `out` is the output folder (as --out);
+    by default a temporary folder, removed afterwards (never the scene's results folder)."""
+    scene = os.fspath(scene)
+    if os.path.isdir(scene):
+        scene = os.path.join(scene, "scene.toml")
+    command = f"python: geomint.sweep({scene!r}, quick={bool(quick)!r}, timing={bool(timing)!r})"
+
+    def run_into(folder):
+        failed = _geomint.sweep(scene, bool(quick), folder, int(jobs), bool(timing),
+                                bool(progress), command)
+        tables = {
+            name: read_table(os.path.join(folder, name + ".csv"))
+            for name in SWEEP_TABLES
+            if os.path.exists(os.path.join(folder, name + ".csv"))
+        }
+        return tables, failed
+
+    if out is not None:
+        out = os.fspath(out)
+        tables, failed = run_into(out)
+        return Tables(tables, failed, out)
+    with tempfile.TemporaryDirectory(prefix="geomint-sweep-") as folder:
+        tables, failed = run_into(folder)
+    return Tables(tables, failed, None)
+
+
+def gate(gates, results=None):
+    """The verdicts of `geomint gate GATES RESULTS...`: a DataFrame with one row per gate that
+    applies to the results (gate, scene, table, column, file, passed, rows_checked, lines: the
+    checked rows' verdicts), and df.attrs["passed"] (every gate passed: the program's exit 0)
+    and df.attrs["not_applicable"] (the other gates' names). `gates` is a gates file or a scene
+    folder (its gates.toml, and by default its results); `results` a folder, a CSV or a list.
+    ValueError, as the program's exit 2, when no gate applies or a file is malformed."""
+    import pandas as pd
+
+    gates = os.fspath(gates)
+    if os.path.isdir(gates):
+        results = [gates] if results is None else results
+        gates = os.path.join(gates, "gates.toml")
+    if results is None:
+        raise ValueError(f"gate: give the results to check after the gates file '{gates}'")
+    if isinstance(results, (str, os.PathLike)):
+        results = [results]
+    verdicts = _geomint.gate(gates, [os.fspath(path) for path in results])
+    applied = [verdict for verdict in verdicts if verdict["applicable"]]
+    if not applied:
+        raise InputError(f"gate: none of the {len(verdicts)} gate(s) in '{gates}' applies to the "
+                         "results given (their scenes and variants differ); nothing was checked")
+    frame = pd.DataFrame(
+        [{key: value for key, value in verdict.items() if key != "applicable"}
+         for verdict in applied],
+        columns=["gate", "scene", "table", "column", "file", "passed", "rows_checked", "lines"])
+    frame.attrs["passed"] = bool(frame["passed"].all())
+    frame.attrs["not_applicable"] = [v["gate"] for v in verdicts if not v["applicable"]]
+    return frame
 
 
 def run(
