@@ -19,6 +19,7 @@
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
 #include "harness/scene.hpp"
+#include "harness/score.hpp"
 #include "harness/shard.hpp"
 #include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
@@ -136,6 +137,36 @@ py::dict order(const PyProblem& problem, const std::string& method_spec, double 
   return out;
 }
 
+// `geomint score --problem SPEC FILE`'s row for one trajectory file (read and validated by the
+// program's reader: InputError naming the first bad row); `label` replaces the path in `method`
+// when not empty (a temporary file written from arrays).
+py::dict score(const PyProblem& problem, const std::string& path, double start_tol, bool velocities,
+               const std::vector<std::string>& metrics, const std::string& label,
+               const std::string& reference_dir) {
+  std::vector<std::string> errors = score_metric_errors(metrics);
+  if (!(start_tol >= 0 && std::isfinite(start_tol))) {
+    errors.push_back(fmt::format("start_tol must be a finite number >= 0 (got {})", start_tol));
+  }
+  throw_input_errors(errors);
+  const Trajectory trajectory = read_trajectory(path, problem.get(), start_tol, velocities);
+  ScoreConfig config;
+  config.reference_dir = reference_dir;
+  config.extra_metrics = metrics;
+  RunRecord record;
+  {
+    py::gil_scoped_release release;
+    record = score_trajectory(problem.get(), trajectory, config);
+  }
+  if (!label.empty()) record.method = label;
+  py::dict out;
+  out["row"] = cells(record);
+  out["columns"] = record_columns({record});
+  out["ok"] = record.status == "ok";
+  out["final_q"] = trajectory.states.back().q;
+  out["final_p"] = trajectory.states.back().p;
+  return out;
+}
+
 // `geomint sweep SCENE [--quick] --out OUT [--no-timing]`, as harness/cli/sweep.cpp sets it up
 // (the scene's name is the folder holding scene.toml, whatever the output folder): the number of
 // failed runs; the tables are the CSV files in `out_dir`.
@@ -242,5 +273,7 @@ PYBIND11_MODULE(_geomint, module) {
   module.def("sweep", &sweep, py::arg("scene"), py::arg("quick"), py::arg("out_dir"),
              py::arg("jobs"), py::arg("timing"), py::arg("progress"), py::arg("command_line"));
   module.def("gate", &gate, py::arg("gates"), py::arg("results"));
+  module.def("score", &score, py::arg("problem"), py::arg("path"), py::arg("start_tol"),
+             py::arg("velocities"), py::arg("metrics"), py::arg("label"), py::arg("reference_dir"));
   bind_python_methods(module);
 }

@@ -12,7 +12,7 @@ from ._geomint import InputError  # a subclass of ValueError
 
 __all__ = [
     "problems", "methods", "Problem", "Run", "Series", "run", "order", "InputError",
-    "register_method", "check_names", "check", "verify", "sweep", "gate", "read_table", "Tables",
+    "register_method", "check_names", "check", "verify", "sweep", "gate", "read_table", "Tables", "score",
 ]
 
 
@@ -262,6 +262,41 @@ def run(
         result = _geomint.run(problem, method, config)
         series = Series.read_csv(config.series_path) if os.path.exists(config.series_path) else None
     return Run(result, series)
+
+
+def score(problem, t=None, q=None, p=None, *, v=None, path=None, metrics=(),
+          start_tol=1e-9, reference_dir="results/references"):
+    """The metrics of a trajectory another program computed, as `geomint score --problem SPEC
+    FILE` gives them (docs/USAGE.md "Scoring a trajectory from another program"): a Run whose row
+    has the columns of `geomint run`'s row (method = the file, or "arrays"). Either arrays t (n),
+    q (n x dof) and p or v (n x dof; v = velocities, turned into momenta by the problem), or
+    `path` (a CSV with a header or a .npy, as the program reads it). The first row must be the
+    problem's initial state within start_tol; a bad input is a ValueError naming the first bad row."""
+    problem = _problem(problem)
+    metrics = list(metrics)
+    if path is not None:
+        if t is not None or q is not None or p is not None or v is not None:
+            raise ValueError("score: give either path or the arrays t, q, p (or v), not both")
+        result = _geomint.score(problem, os.fspath(path), float(start_tol), False, metrics, "",
+                                os.fspath(reference_dir))
+        return Run(result)
+    if t is None or q is None or (p is None) == (v is None):
+        raise ValueError("score: give t, q and one of p or v (or path)")
+    t = np.asarray(t, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    second = np.asarray(p if p is not None else v, dtype=np.float64)
+    if q.ndim == 1:
+        q, second = q[:, None], second[:, None]
+    if t.ndim != 1 or q.shape != second.shape or q.shape[0] != t.shape[0]:
+        raise ValueError(f"score: t must have shape (n,) and q, {'p' if p is not None else 'v'} "
+                         f"shape (n, dof); got {t.shape}, {q.shape}, {second.shape}")
+    table = np.ascontiguousarray(np.column_stack([t, q, second]))
+    with tempfile.TemporaryDirectory(prefix="geomint-score-") as folder:
+        file = os.path.join(folder, "trajectory.npy")
+        np.save(file, table)
+        result = _geomint.score(problem, file, float(start_tol), v is not None, metrics,
+                                "arrays", os.fspath(reference_dir))
+    return Run(result)
 
 
 def order(problem, method, dt, t_end, levels=6, diverge_factor=None):

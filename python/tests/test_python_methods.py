@@ -229,3 +229,25 @@ def test_python_methods_run_from_several_threads():
         thread.join()
     assert all(row["status"] == "ok" for row in rows)
     assert len({row["energy_err_max"] for row in rows}) == 1
+
+
+def test_score_of_a_numpy_loop_equals_the_python_method_run():
+    # The loop of py_verlet's step on the harness's grid t_k = k·dt (each step h = t_k+1 − t_k,
+    # as the harness computes it), written out: geomint.score gives the row of geomint.run.
+    problem = geomint.Problem("kepler")
+    dt, steps = 0.01, 300
+    t = np.arange(steps + 1) * dt
+    q, p = problem.initial_state()
+    qs, ps = [q], [p]
+    for k in range(steps):
+        q, p = verlet(problem, q, p, t[k], t[k + 1] - t[k])
+        qs.append(q)
+        ps.append(p)
+    scored = geomint.score(problem, t, np.array(qs), np.array(ps))
+    run = geomint.run(problem, "py_verlet", dt=dt, t_end=steps * dt)
+    assert scored.ok and scored.row["method"] == "arrays"
+    for column in ("energy_err_max", "energy_err_final", "energy_drift", "error_final",
+                   "angular_momentum_err_max", "phase_err"):
+        assert scored.row[column] == run.row[column], column
+    with pytest.raises(ValueError, match="row"):
+        geomint.score(problem, [0.0, 0.0], np.array(qs[:2]), np.array(ps[:2]))
