@@ -1,6 +1,7 @@
 // The timing pass's statistics (harness/run.hpp TimingStats: minimum, median, interquartile
 // range by Hyndman–Fan type 7) on injected samples with exact answers, and its budget: a pass
-// that cannot fit its repeats still yields a time, with the count and a note saying why.
+// that cannot fit its repeats still yields a time, with the count and a note saying why; the
+// interrupt flag that ends runs early.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -75,6 +76,30 @@ TEST(TimingPass, RecordsEveryRepeatOrSaysTheBudgetCutThem) {
   ASSERT_TRUE(record.wall_s.has_value());
   EXPECT_EQ(*record.wall_s, cut.stats.median);
   EXPECT_EQ(record.message, cut.budget_note);
+}
+
+// The interrupt flag (the Python package's Ctrl-C): a metric pass ends at its first step point
+// with status `interrupted`, fixed-step and adaptive alike, a timing pass before any run; once
+// cleared, the same run goes through.
+TEST(Interrupt, EndsRunsAtTheNextStepPointUntilCleared) {
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 2.0;
+  config.timing_repeats = 0;
+  request_interrupt();
+  for (const char* method : {"stormer_verlet", "cvode_bdf"}) {
+    const RunResult run = run_one("harmonic", method, config);
+    EXPECT_FALSE(run.ok) << method;
+    EXPECT_EQ(run.record.status, kInterruptedStatus) << method;
+    EXPECT_EQ(run.record.steps, 0L) << method;
+  }
+  const TimingOutcome timing = time_run("harmonic", "stormer_verlet", config, 3);
+  EXPECT_EQ(timing.status.reason, kInterruptedStatus);
+  clear_interrupt();
+  EXPECT_FALSE(interrupt_requested());
+  const RunResult run = run_one("harmonic", "stormer_verlet", config);
+  EXPECT_TRUE(run.ok) << run.record.message.value_or("");
+  EXPECT_EQ(run.record.steps, 200L);
 }
 
 }  // namespace
