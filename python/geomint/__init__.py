@@ -103,7 +103,8 @@ class Run:
         self.cells = {column: result["row"][column] for column in self.columns}
         self.row = parse_row(self.cells)
         self.ok = bool(result["ok"])
-        self.status = self.row["status"]
+        # The text: a row dict parses the status "nan" (a non-finite state) as a float.
+        self.status = self.cells["status"]
         self.final_q = result["final_q"]
         self.final_p = result["final_p"]
         self.series = series

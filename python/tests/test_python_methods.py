@@ -124,7 +124,7 @@ def test_bad_return_is_a_failure_row_naming_it(case):
     step, status, text = BAD_RETURNS[case]
     name = geomint.register_method(f"py_bad_{case}", step, order=2)
     result = geomint.run("kepler", name, dt=0.1, t_end=1.0)
-    assert not result.ok and result.cells["status"] == status, result.row
+    assert not result.ok and result.status == status, result.row
     assert text in result.row["message"], result.row["message"]
     assert "t=0.3" in result.row["message"] and result.row["t_reached"] == pytest.approx(0.3)
     assert result.row["steps"] == 3
