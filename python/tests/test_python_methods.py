@@ -251,3 +251,23 @@ def test_score_of_a_numpy_loop_equals_the_python_method_run():
         assert scored.row[column] == run.row[column], column
     with pytest.raises(ValueError, match="row"):
         geomint.score(problem, [0.0, 0.0], np.array(qs[:2]), np.array(ps[:2]))
+
+
+class FailingReset:
+    name = "py_failing_reset"
+    order = 2
+
+    def reset(self, problem, q, p, t, h):
+        raise RuntimeError("no history to start from")
+
+    def step(self, problem, q, p, t, h):
+        return q, p
+
+
+def test_a_failing_reset_is_a_failure_row():
+    geomint.register_method(FailingReset)
+    result = geomint.run("pendulum", "py_failing_reset", dt=0.1, t_end=1.0)
+    assert not result.ok and result.status == "python_exception", result.row
+    assert "reset failed" in result.row["message"]
+    assert "RuntimeError: no history to start from" in result.row["message"]
+    assert result.row["steps"] == 0
