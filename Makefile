@@ -30,9 +30,17 @@ build: configure
 # second, not in CI's mutation stage); fast suites (< 10 minutes on 2 cores; long runs carry the
 # CTest label "slow"), then what a user's CI does: the CI-sized scenes, gated; then geomint installed into a temporary prefix and
 # examples/external_method built and tested against it (docs/VERIFY.md "Verify your own integrator").
+# The GoogleTest tests run in shards of each executable (scripts/gtest-shards.py: a process per
+# test cost a third of the suite's CPU time), after the other tests, which go through ctest;
+# TEST_PER_PROCESS=1 runs every test in a process of its own as ctest does.
+TEST_PER_PROCESS ?= 0
 test: build
 	@/usr/bin/python3 scripts/mutation.py --check
+ifeq ($(TEST_PER_PROCESS),1)
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
+else
+	@cd $(BUILD_DIR) && /usr/bin/python3 $(CURDIR)/scripts/gtest-shards.py . $(JOBS) --labels fast,nosan --others
+endif
 	@$(MAKE) --no-print-directory gate-quick
 	@$(MAKE) --no-print-directory report-quick SITE=$(BUILD_DIR)/site-quick
 	@$(MAKE) --no-print-directory test-external
@@ -81,7 +89,7 @@ fuzz-build: deps
 # same method, problem or scene do not run under them, committed rows that clang's round-off
 # moves, and the Python/browser checks. tests/slow_tests.cmake lists them with the reason for each
 # (`ctest -N -L nosan` in a build prints them). The GoogleTest tests run in shards of each executable
-# (scripts/test-sanitize.py: a process per test costs a third of the time under the sanitizers),
+# (scripts/gtest-shards.py: a process per test costs a third of the time under the sanitizers),
 # the few others through ctest; SAN_PER_TEST=1 runs every test in a process of its own as ctest does.
 # SAN_EXCLUDE is an extra regex on ctest test names to leave out for a local run (empty by default).
 SAN_EXCLUDE ?=
@@ -91,7 +99,7 @@ ifeq ($(SAN_PER_TEST),1)
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan' \
 	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
 else
-	@cd $(SAN_DIR) && $(SAN_ENV) /usr/bin/python3 $(CURDIR)/scripts/test-sanitize.py . $(JOBS) \
+	@cd $(SAN_DIR) && $(SAN_ENV) /usr/bin/python3 $(CURDIR)/scripts/gtest-shards.py . $(JOBS) \
 	  $(if $(SAN_EXCLUDE),--exclude '$(SAN_EXCLUDE)')
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan|fast' \
 	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')

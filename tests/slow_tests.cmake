@@ -120,11 +120,13 @@ set(GEOMINT_NOSAN_TESTS
 # (tests/test_main.cpp), so tests that ctest runs at the same time never share one either.
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/test-tmp)
 
-# The filter of the `fast` tests, for scripts/test-sanitize.py, which runs them a shard of an
-# executable at a time instead of a process per test.
+# The filters of the `fast` tests (`make test-sanitize`) and of all but the `slow` ones (`make
+# test`), for scripts/gtest-shards.py, which runs them a shard of an executable at a time instead
+# of a process per test.
 list(JOIN GEOMINT_SLOW_TESTS ":" geomint_slow_filter)
 list(JOIN GEOMINT_NOSAN_TESTS ":" geomint_nosan_filter)
 file(WRITE ${CMAKE_BINARY_DIR}/gtest-fast-filter.txt "-${geomint_slow_filter}:${geomint_nosan_filter}\n")
+file(WRITE ${CMAKE_BINARY_DIR}/gtest-notslow-filter.txt "-${geomint_slow_filter}\n")
 
 function(geomint_discover_tests target)
   cmake_parse_arguments(PARSE_ARGV 1 ARG "" "DISCOVERY_TIMEOUT" "PROPERTIES")
