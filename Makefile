@@ -9,7 +9,7 @@ SCENES ?= $(notdir $(patsubst %/,%,$(dir $(wildcard results/*/scene.toml))))
 LONG_SCENES ?= work_precision_full
 FIGURE_SCENES = $(filter-out $(LONG_SCENES),$(SCENES))
 
-.PHONY: all deps configure build test test-all reproduce-figures reproduce-all reproduce-quick gates gate-quick bench \
+.PHONY: all deps deps-sanitize configure build test test-all reproduce-figures reproduce-all reproduce-quick gates gate-quick bench \
         format clean mutation mutation-check sanitize-build fuzz-build test-sanitize fuzz readme-tables \
         report report-quick citation \
         test-cluster test-external perf
@@ -19,8 +19,22 @@ all: build
 deps:
 	@bash scripts/install-deps.sh --quiet
 
+# clang and its sanitizer runtimes, for the sanitizer and fuzzing builds only.
+deps-sanitize:
+	@bash scripts/install-deps.sh sanitize --quiet
+
+# Compiles go through ccache when it is installed (scripts/install-deps.sh installs it) and no
+# launcher is given already (CMAKE_CXX_COMPILER_LAUNCHER in the environment, as .ci/run sets):
+# a second `make test`, in this clone or a fresh one, recompiles only what changed. The cache is
+# ccache's own (~/.cache/ccache, or CCACHE_DIR); CCACHE=0 configures the build without it. Checked
+# when the recipe runs, after `deps` may have installed ccache (docs/TESTING.md "Fresh clone").
+CCACHE ?= 1
 configure: deps
-	@mkdir -p $(BUILD_DIR) && cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release > $(BUILD_DIR)/configure.log 2>&1 \
+	@mkdir -p $(BUILD_DIR) && launcher=; \
+	if [ "$(CCACHE)" = 0 ]; then launcher=-DCMAKE_CXX_COMPILER_LAUNCHER=; \
+	elif [ -z "$$CMAKE_CXX_COMPILER_LAUNCHER" ] && command -v ccache > /dev/null; then \
+	  launcher=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache; fi; \
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $$launcher > $(BUILD_DIR)/configure.log 2>&1 \
 	  || (cat $(BUILD_DIR)/configure.log; exit 1)
 
 build: configure
@@ -68,7 +82,7 @@ SAN_DIR ?= build-asan
 SAN_CXX ?= clang++
 SAN_ENV = ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
           UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-sanitize-build: deps
+sanitize-build: deps deps-sanitize
 	@mkdir -p $(SAN_DIR) && cmake -S . -B $(SAN_DIR) -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
 	  -DGEOMINT_FUZZ_COVERAGE=OFF > $(SAN_DIR)/configure.log 2>&1 || (cat $(SAN_DIR)/configure.log; exit 1)
@@ -77,7 +91,7 @@ sanitize-build: deps
 # The fuzzing build: the same, with libFuzzer's coverage instrumentation on the fuzzed libraries
 # (problems, harness), which `make fuzz` needs and the sanitizer suite does not.
 FUZZ_DIR ?= build-fuzz
-fuzz-build: deps
+fuzz-build: deps deps-sanitize
 	@mkdir -p $(FUZZ_DIR) && cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_CXX_COMPILER=$(SAN_CXX) -DGEOMINT_BUILD_BENCH=OFF -DGEOMINT_BUILD_FUZZ=ON \
 	  -DGEOMINT_FUZZ_COVERAGE=ON > $(FUZZ_DIR)/configure.log 2>&1 || (cat $(FUZZ_DIR)/configure.log; exit 1)

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages geomint builds with (docs/DESIGN.md §8). Idempotent: installs only
 # what is missing, waits for the dpkg lock, never pulls recommends. As non-root it prints the
-# exact command to run and exits 1. `install-deps.sh cluster` installs the local single-node Slurm
-# that `make test-cluster` runs (docs/CLUSTER.md "Running on a cluster") instead.
+# exact command to run and exits 1. `install-deps.sh sanitize` installs clang 14 with its sanitizer
+# and libFuzzer runtimes, which only `make sanitize-build`, `test-sanitize` and `fuzz` use (not
+# `make test`: 14 packages, 48 MB to download, docs/TESTING.md "Fresh clone");
+# `install-deps.sh cluster` installs the local single-node Slurm that `make test-cluster` runs
+# (docs/CLUSTER.md "Running on a cluster") instead.
 set -euo pipefail
 
 PACKAGES=(
@@ -11,7 +14,7 @@ PACKAGES=(
   gnuplot-nox libtomlplusplus-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev libhypre-dev
-  clang libclang-rt-14-dev python3 ccache
+  python3 ccache
   libxml2-utils tidy chromium python3-yaml python3-jsonschema
   libcmark-gfm-dev libcmark-gfm-extensions-dev
   pybind11-dev python3-numpy python3-pandas python3-pytest
@@ -19,6 +22,9 @@ PACKAGES=(
 if [ "${1:-}" = cluster ]; then
   shift
   PACKAGES=(slurmctld slurmd slurm-client munge)
+elif [ "${1:-}" = sanitize ]; then
+  shift
+  PACKAGES=(clang libclang-rt-14-dev)
 fi
 
 missing=()

@@ -13,9 +13,14 @@ trap 'status=$?; if [[ $status == 0 ]]; then rm -rf "$work"; else echo "test-ext
 
 cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log" ||
   { cat "$work/install.log"; echo "test-external: cmake --install failed" >&2; exit 1; }
+# The example compiles through the launcher the build uses (the environment's, or the ccache that
+# `make configure` set up), so that a second run recompiles nothing.
 launcher=()
+build_launcher=$(sed -n 's/^CMAKE_CXX_COMPILER_LAUNCHER:[A-Z]*=//p' "$build_dir/CMakeCache.txt")
 if [[ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ]]; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER="$CMAKE_CXX_COMPILER_LAUNCHER")
+elif [[ -n "$build_launcher" ]]; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER="$build_launcher")
 fi
 cmake -S "$source_dir/examples/external_method" -B "$work/build" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$work/prefix" "${launcher[@]}" > "$work/configure.log" ||
