@@ -12,6 +12,7 @@
 #include "harness/run_spec.hpp"
 #include "integrators/constrained_step.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -40,7 +41,7 @@ double block_scale(const Vec& block, double fallback) {
 // the LagrangianSystem on the general kind (which has no constant mass).
 Vec velocity_of(const Problem& problem, const Vec& q, const Vec& p) {
   if (const LagrangianSystem* general = problem.as_lagrangian()) return general->velocity(q, p);
-  return problem.inverse_mass().cwiseProduct(p);
+  return MassOperator(problem).solve(q, p);
 }
 
 // The central difference of the map at `state` in direction k with step δ; false on failure.
@@ -171,7 +172,7 @@ Eigen::MatrixXd dense_constraint_jacobian(const Problem& problem, double t, cons
 // manifold, so DP·u = u for every tangent vector u: it is only the chart's way back. False when
 // the Newton iteration does not reach round-off.
 bool project_onto_manifold(const Problem& problem, State& state) {
-  const Vec& inverse_mass = problem.inverse_mass();
+  const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
   const HolonomicConstraints& constraints = constraints_of(problem);
   const Eigen::MatrixXd direction =
       inverse_mass.asDiagonal() * dense_constraint_jacobian(problem, state.t, state.q).transpose();
@@ -210,7 +211,8 @@ Eigen::MatrixXd chart_directions(const Problem& problem, const State& state) {
   const long m = G.rows();
   const Eigen::MatrixXd basis = Eigen::HouseholderQR<Eigen::MatrixXd>(G.transpose()).householderQ();
   const Eigen::MatrixXd tangent = basis.rightCols(n - m);
-  const Eigen::MatrixXd mass_tangent = problem.inverse_mass().cwiseInverse().asDiagonal() * tangent;
+  const Eigen::MatrixXd mass_tangent =
+      MassOperator(problem).constant_inverse_diagonal().cwiseInverse().asDiagonal() * tangent;
   const Eigen::MatrixXd dual = mass_tangent * (tangent.transpose() * mass_tangent).inverse();
   Eigen::MatrixXd directions = Eigen::MatrixXd::Zero(2 * n, 2 * (n - m));
   directions.topLeftCorner(n, n - m) = tangent;

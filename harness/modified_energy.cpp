@@ -13,6 +13,7 @@
 #include "harness/metrics.hpp"
 #include "harness/run_spec.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 
@@ -48,13 +49,13 @@ std::string modified_energy_not_applicable(const Integrator& method, const Probl
 
 double modified_energy(const ModifiedEnergyCorrection& correction, const Problem& problem,
                        const Vec& q, const Vec& p, double h) {
-  const Vec velocity = problem.inverse_mass().cwiseProduct(p);
+  const Vec velocity = MassOperator(problem).solve(q, p);
   Vec gradient;
   problem.gradient(q, gradient);
   SparseMatrix hessian;
   problem.hessian(q, hessian);
   const double curvature = velocity.dot(hessian * velocity);
-  const double force = gradient.dot(problem.inverse_mass().cwiseProduct(gradient));
+  const double force = gradient.dot(MassOperator(problem).solve(q, gradient));
   return problem.energy(q, p) +
          h * h * (correction.curvature * curvature + correction.force * force);
 }

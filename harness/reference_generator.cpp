@@ -12,6 +12,7 @@
 #include "harness/table.hpp"
 #include "integrators/high_order_coefficients.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -34,7 +35,8 @@ class Field {
         dof_(problem.dof()),
         non_separable_(problem.kind() == ProblemKind::kLagrangian) {
     // Only the separable kind has a constant mass (mass() throws on the others).
-    if (!non_separable_) inverse_mass_ = problem.inverse_mass().cast<Real>();
+    if (!non_separable_)
+      inverse_mass_ = MassOperator(problem).constant_inverse_diagonal().cast<Real>();
   }
   void operator()(Real t, const VecL& y, VecL& ydot) {
     y_double_ = y.cast<double>();

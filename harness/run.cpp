@@ -21,6 +21,7 @@
 #include "harness/structure_metrics.hpp"
 #include "integrators/general_step.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -122,7 +123,7 @@ class SeriesWriter {
     has_previous_ = true;
   }
   static void rates(const Problem& problem, const State& state, Vec& q_rate, Vec& p_rate) {
-    q_rate = problem.inverse_mass().cwiseProduct(state.p);
+    q_rate = MassOperator(problem).solve(state.q, state.p);
     problem.gradient(state.q, p_rate);
     p_rate = -p_rate;
   }

@@ -22,6 +22,7 @@
 #include "harness/reference.hpp"
 #include "harness/run_spec.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -397,7 +398,7 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
       } else if (lagrangian != nullptr) {
         state.p = lagrangian->momentum(state.q, second);  // p = ∂L/∂v = M(q)v + a(q)
       } else {
-        state.p = problem.mass().cwiseProduct(second);
+        state.p = MassOperator(problem).apply(state.q, second);
       }
     }
     trajectory.states.push_back(std::move(state));
@@ -410,7 +411,7 @@ Trajectory read_trajectory(const std::string& path, const Problem& problem, doub
     const Vec second =
         table.velocities
             ? (lagrangian != nullptr ? lagrangian->velocity(initial.q, initial.p)
-                                     : Vec(problem.inverse_mass().cwiseProduct(initial.p)))
+                                     : Vec(MassOperator(problem).solve(initial.q, initial.p)))
             : initial.p;
     for (double x : second) expected.push_back(x);
   }

@@ -19,6 +19,7 @@
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/spec.hpp"
 #include "tests/test_util.hpp"
 
@@ -122,8 +123,8 @@ TEST(Score, VelocityColumnsAndNpyGiveTheSameMetrics) {
     csv += '\n';
     std::vector<double> values;
     for (const State& s : run.trajectory.states) {
-      const Vec v = lagrangian ? lagrangian->velocity(s.q, s.p)
-                               : Vec(problem->inverse_mass().cwiseProduct(s.p));
+      const Vec v =
+          lagrangian ? lagrangian->velocity(s.q, s.p) : Vec(MassOperator(*problem).solve(s.q, s.p));
       csv += format_number(s.t);
       values.push_back(s.t);
       for (double x : s.q) csv += "," + format_number(x), values.push_back(x);

@@ -13,6 +13,7 @@
 
 #include "harness/metrics.hpp"
 #include "harness/run_spec.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -272,7 +273,7 @@ std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
   SparseMatrix hessian;
   problem.hessian(problem.initial_state().q, hessian);
   const Eigen::MatrixXd stiffness(hessian);
-  const Eigen::MatrixXd mass = problem.mass().asDiagonal();
+  const Eigen::MatrixXd mass = MassOperator(problem).constant_diagonal().asDiagonal();
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, mass);
   const Eigen::MatrixXd& shapes = solver.eigenvectors();  // VᵀMV = I
   // Modal coordinates: (x, y) = (VᵀM q, Vᵀp), inverse (q, p) = (V x, M V y).
@@ -290,8 +291,8 @@ std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
     const double y_y =
         shapes.col(j).transpose() * tangent.bottomRightCorner(n, n) * mass_shapes.col(j);
     DiscreteMode mode;
-    const double eigenvalue =
-        std::max(0.0, rayleigh_quotient(hessian, problem.mass(), shapes.col(j)));
+    const double eigenvalue = std::max(
+        0.0, rayleigh_quotient(hessian, MassOperator(problem).constant_diagonal(), shapes.col(j)));
     mode.omega = std::sqrt(eigenvalue);
     // The projected block inherits the rounding of every entry of DΦ (ε ‖K‖ against the mode's
     // own hω² in its lower left entry); the step of the mode's oscillator has only its own.

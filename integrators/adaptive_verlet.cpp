@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "integrators/adaptive.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -56,7 +57,7 @@ class AdaptiveVerlet final : public AdaptiveIntegrator {
   StepStatus controlled_step(const Problem& problem, State& state, double t_stop) {
     StepStatus status;
     if (!ready_to_step(problem, state, t_stop, status)) return status;
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     y_.resize(2 * q_.size());
     y_ << q_, p_;
     status = check_tolerances_above_roundoff(y_.data(), y_.size(), "too_much_accuracy",

@@ -8,6 +8,7 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -76,7 +77,7 @@ class AverageVectorField final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    const Vec& mass = problem.mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     // (h/2) Σ wᵢ ∇V(q₀ + ξᵢ h v̄), memoised on v̄ (the first residual repeats the scale's).
     bool memo_valid = false;
@@ -112,7 +113,7 @@ class AverageVectorField final : public Integrator {
       }
     };
 
-    Vec v = problem.inverse_mass().cwiseProduct(state.p);
+    Vec v = MassOperator(problem).solve(state.q, state.p);
     mean_impulse(v, impulse_);
     const double residual_scale = robust_norm(state.p) + robust_norm(impulse_);
     const NewtonResult result = newton_.solve(system, v, residual_scale);

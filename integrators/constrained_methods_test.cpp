@@ -10,6 +10,7 @@
 #include <string>
 
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -204,7 +205,7 @@ CarAxisDigits car_axis_digits(const Problem& problem, const std::string& spec, d
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!digits.out.status.ok) return digits;
   const State& end = digits.out.state;
-  const Vec v = problem.inverse_mass().cwiseProduct(end.p);
+  const Vec v = MassOperator(problem).solve(end.q, end.p);
   digits.position = scd(end.q, kCarAxisReference);
   digits.velocity = scd(v, kCarAxisReference + 4);
   digits.multiplier = scd(-problem.multipliers(3.0, end.q, end.p), kCarAxisReference + 8);

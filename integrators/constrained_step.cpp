@@ -11,6 +11,8 @@
 #include <cmath>
 #include <limits>
 
+#include "problems/mass_operator.hpp"
+
 namespace geomint {
 namespace {
 
@@ -90,7 +92,7 @@ ConstrainedStepResult solve_constrained_step(const Problem& problem, const Vec& 
   const long m = G0.rows();
   // ρ turns ‖F₂‖² (a velocity squared) into the units of E_k; any ρ ≥ 0 keeps the SQP direction a
   // descent direction of the merit, ρ > 0 makes the merit reward feasibility.
-  double rho = problem.mass().maxCoeff();
+  double rho = MassOperator(problem).max_diagonal(q_start);
   double threshold = std::max(options.tolerance, kRoundoffFloor) * residual_scale;
   result.threshold = threshold;
 
@@ -279,11 +281,11 @@ Vec project_momentum_to_tangent_space(const Problem& problem, double t, const Ve
   SparseMatrix jacobian;
   at.jacobian(q, jacobian);
   const Eigen::MatrixXd G = Eigen::MatrixXd(jacobian);
-  const Eigen::MatrixXd G_Minv = G * problem.inverse_mass().asDiagonal();
+  const Eigen::MatrixXd G_Minv = G * MassOperator(problem).constant_inverse_diagonal().asDiagonal();
   Vec rate = G_Minv * p;
   if (at.rheonomic) {
     Vec g_t, a_t;
-    at.constraints.constraint_time_terms(t, q, problem.inverse_mass().cwiseProduct(p), g_t, a_t);
+    at.constraints.constraint_time_terms(t, q, MassOperator(problem).solve(q, p), g_t, a_t);
     rate += g_t;  // G M⁻¹p + ∂g/∂t = 0 at t
   }
   const Vec nu = (G_Minv * G.transpose()).ldlt().solve(rate);

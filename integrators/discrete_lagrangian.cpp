@@ -18,6 +18,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -109,8 +110,8 @@ class DiscreteLagrangianVI final : public Integrator {
                               {newton_.options().tolerance, newton_.options().max_iterations},
                               counters_);
     }
-    const Vec& mass = problem.mass();
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double minus = forced ? forcing_.minus_weight() : 0.0;

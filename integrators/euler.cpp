@@ -12,6 +12,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -33,14 +34,14 @@ class ExplicitEuler final : public Integrator {
                           Eigen::MatrixXd& tangent) override {
     TangentBlock block(problem.dof());
     const Eigen::MatrixXd start_q = block.q;
-    block.drift(problem.inverse_mass(), h);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h);
     block.p -= h * (dense_hessian(problem, state.q) * start_q);
     tangent = block.stacked();
     return step(problem, state, h);
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    const Vec velocity = problem.inverse_mass().cwiseProduct(state.p);
+    const Vec velocity = MassOperator(problem).solve(state.q, state.p);
     eval_total_force(problem, state.q, velocity, state.t, force_);
     state.q += h * velocity;
     state.p += h * force_;
@@ -92,20 +93,22 @@ class ImplicitEuler final : public Integrator {
     if (!status.ok) return status;
     const int n = problem.dof();
     const Eigen::MatrixXd hessian = dense_hessian(problem, state.q);
-    const Eigen::MatrixXd matrix = Eigen::MatrixXd(problem.mass().asDiagonal()) + h * h * hessian;
+    Eigen::MatrixXd matrix;
+    MassOperator(problem).dense(state.q, matrix);
+    matrix += h * h * hessian;
     Eigen::MatrixXd rhs(n, 2 * n);
     rhs << -h * hessian, Eigen::MatrixXd::Identity(n, n);
     const Eigen::MatrixXd dv = matrix.partialPivLu().solve(rhs);
     TangentBlock block(n);
     block.q += h * dv;
-    block.p = problem.mass().asDiagonal() * dv;
+    block.p = MassOperator(problem).constant_diagonal().asDiagonal() * dv;
     tangent = block.stacked();
     return status;
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     if (problem.has(kFirstOrderOnly)) return step_first_order(problem, state, h);
-    const Vec& mass = problem.mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
     const double t_next = state.t + h;
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
 
@@ -113,7 +116,7 @@ class ImplicitEuler final : public Integrator {
     // the step. ‖F‖ at the end of the previous step is reused when the state was not changed
     // in between, which saves one force evaluation per step.
     if (!(std::isfinite(end_force_norm_) && end_q_.size() == state.q.size() && end_q_ == state.q)) {
-      eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
+      eval_total_force(problem, state.q, MassOperator(problem).solve(state.q, state.p), state.t,
                        force_);
       end_force_norm_ = robust_norm(force_);
     }
@@ -135,11 +138,11 @@ class ImplicitEuler final : public Integrator {
       jacobian = (h * h) * hessian_ + mass_matrix_;
       if (problem.has(kForce)) add_force_jacobian(problem, state.q, v, t_next, h, jacobian);
     };
-    decide_damping_symmetry(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t,
-                            damping_, damping_symmetric_);
+    decide_damping_symmetry(problem, state.q, MassOperator(problem).solve(state.q, state.p),
+                            state.t, damping_, damping_symmetric_);
     system.symmetric = !problem.has(kForce) || (problem.has(kForceJacobian) && *damping_symmetric_);
 
-    Vec velocity = problem.inverse_mass().cwiseProduct(state.p);
+    Vec velocity = MassOperator(problem).solve(state.q, state.p);
     const NewtonResult result = newton_.solve(system, velocity, residual_scale);
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;

@@ -10,6 +10,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -122,7 +123,7 @@ class GeneralizedLeapfrog final : public Integrator {
     problem.gradient(state.q, gradient);
     ++counters_.force_evals;
     state.p -= (h / 2) * gradient;
-    state.q += h * problem.inverse_mass().cwiseProduct(state.p);
+    state.q += h * MassOperator(problem).solve(state.q, state.p);
     problem.gradient(state.q, gradient);
     ++counters_.force_evals;
     state.p -= (h / 2) * gradient;

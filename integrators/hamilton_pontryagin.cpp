@@ -17,6 +17,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/parallel.hpp"
 
 namespace geomint {
@@ -162,7 +163,7 @@ class HamiltonPontryagin final : public Integrator,
     dissipation_potential_.reset();
     velocity_ = problem.kind() == ProblemKind::kLagrangian
                     ? problem.as_lagrangian()->velocity(state.q, state.p)
-                    : Vec(problem.inverse_mass().cwiseProduct(state.p));
+                    : Vec(MassOperator(problem).solve(state.q, state.p));
   }
 
   // The HP velocity v_{k+1} = (q_{k+1} − q_k)/h of the last step (p_{k+1} ≠ M v_{k+1} unless α =
@@ -172,8 +173,8 @@ class HamiltonPontryagin final : public Integrator,
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
     if (problem.kind() == ProblemKind::kLagrangian) return general_step(problem, state, h);
-    const Vec& mass = problem.mass();
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     minus_ = forced ? forcing_.minus_weight() : 0.0;
@@ -252,7 +253,7 @@ class HamiltonPontryagin final : public Integrator,
   }
 
   StepStatus solve(const Problem& problem, const State& state, bool coupled, Vec& v) {
-    const Vec& mass = problem.mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
     if (minus_ > 0.0) {
       decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
     }

@@ -11,6 +11,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -55,11 +56,11 @@ class ImplicitMidpoint final : public Integrator {
           *problem.as_lagrangian(), state, h,
           {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
     }
-    const Vec& mass = problem.mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double t_mid = state.t + h / 2;
-    Vec v = problem.inverse_mass().cwiseProduct(state.p);
+    Vec v = MassOperator(problem).solve(state.q, state.p);
     if (forced) decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
 
     // −(h/2)[−∇V(q̄) + F(q̄, v̄, t + h/2)], the implicit part of R, memoised on v̄ (the solver's

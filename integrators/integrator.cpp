@@ -9,6 +9,7 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/structures/charged_particle.hpp"
 #include "problems/structures/free_rigid_body.hpp"
 
@@ -218,7 +219,7 @@ AdvanceOutcome Integrator::advance(const Problem& problem, State& state, const S
 }
 
 void update_sparse_mass_matrix(const Problem& problem, Vec& diagonal, SparseMatrix& matrix) {
-  const Vec& mass = problem.mass();
+  const Vec& mass = MassOperator(problem).constant_diagonal();
   if (matrix.rows() != problem.dof() || diagonal != mass) {
     diagonal = mass;
     matrix = SparseMatrix(mass.asDiagonal());
@@ -426,7 +427,7 @@ void Integrator::eval_force(const Problem& problem, const Vec& q, const Vec& v, 
 StepStatus Integrator::solve_force_kick(const Problem& problem, const Vec& q, double t,
                                         const Vec& p_base, double weight, Vec& velocity,
                                         Vec& force) {
-  const Vec& inverse_mass = problem.inverse_mass();
+  const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
   eval_force(problem, q, velocity, t, force);
   double change = 0.0;
   for (int pass = 0; pass < kMaxForceKickIterations; ++pass) {

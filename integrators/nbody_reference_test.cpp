@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -30,7 +31,7 @@ struct Digits {
   double position, velocity;
 };
 Digits scd(const Problem& problem, const State& state) {
-  const Vec v = problem.inverse_mass().cwiseProduct(state.p);
+  const Vec v = MassOperator(problem).solve(state.q, state.p);
   double worst_q = 0, worst_v = 0;
   for (int body = 0; body < 7; ++body) {
     for (int axis = 0; axis < 2; ++axis) {

@@ -15,6 +15,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -92,8 +93,8 @@ class Newmark final : public Integrator {
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
-    const Vec& mass = problem.mass();
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool cache_hit = cached_problem_ == &problem && cached_t_ == state.t &&
                            cached_q_.size() == state.q.size() && cached_q_ == state.q &&
@@ -201,8 +202,8 @@ class Newmark final : public Integrator {
   StepStatus step_tangent(const Problem& problem, State& state, double h,
                           Eigen::MatrixXd& tangent) override {
     const int n = problem.dof();
-    const auto mass = problem.mass().asDiagonal();
-    const auto inverse_mass = problem.inverse_mass().asDiagonal();
+    const auto mass = MassOperator(problem).constant_diagonal().asDiagonal();
+    const auto inverse_mass = MassOperator(problem).constant_inverse_diagonal().asDiagonal();
     const Eigen::MatrixXd start_hessian = dense_hessian(problem, state.q);
     cached_problem_ = nullptr;  // the consistent a₀, not a carried one
     const StepStatus status = step(problem, state, h);
@@ -229,8 +230,8 @@ class Newmark final : public Integrator {
  private:
   // a = M⁻¹(−∇V(q) + F(q, M⁻¹p, t)).
   void acceleration(const Problem& problem, const State& state, Vec& a) {
-    eval_total_force(problem, state.q, problem.inverse_mass().cwiseProduct(state.p), state.t, a);
-    a = problem.inverse_mass().cwiseProduct(a);
+    eval_total_force(problem, state.q, MassOperator(problem).solve(state.q, state.p), state.t, a);
+    a = MassOperator(problem).solve(state.q, a);
   }
 
   void remember(const Problem& problem, const State& state) {

@@ -23,6 +23,7 @@
 #include "integrators/adaptive.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -288,14 +289,14 @@ class OdeintVelocityVerlet final : public Integrator {
       qv_.first.resize(dof);
       qv_.second.resize(dof);
       view(qv_.first) = state.q;
-      view(qv_.second) = problem.inverse_mass().cwiseProduct(state.p);
+      view(qv_.second) = MassOperator(problem).solve(state.q, state.p);
       stepper_.reset();  // recompute the acceleration at the new point
       cached_problem_ = &problem;
     }
     auto acceleration = [this, &problem](const StdVector& q, const StdVector&, StdVector& a,
                                          double) {
       eval_gradient(problem, view(q), gradient_);
-      view(a) = -problem.inverse_mass().cwiseProduct(gradient_);
+      view(a) = -MassOperator(problem).constant_inverse_diagonal().cwiseProduct(gradient_);
     };
     try {
       stepper_.do_step(acceleration, qv_, state.t, h);
@@ -304,7 +305,7 @@ class OdeintVelocityVerlet final : public Integrator {
       return StepStatus::failure("odeint_exception", error.what());
     }
     state.q = view(qv_.first);
-    state.p = problem.mass().cwiseProduct(view(qv_.second));
+    state.p = MassOperator(problem).apply(state.q, view(qv_.second));
     state.t += h;
     last_q_ = state.q;
     last_p_ = state.p;
@@ -344,7 +345,7 @@ class OdeintMcLachlan4 final : public Integrator {
     view(qp_.first) = state.q;
     view(qp_.second) = state.p;
     auto velocity = [&problem](const StdVector& p, StdVector& dqdt) {
-      view(dqdt) = problem.inverse_mass().cwiseProduct(view(p));
+      view(dqdt) = MassOperator(problem).constant_inverse_diagonal().cwiseProduct(view(p));
     };
     auto force = [this, &problem](const StdVector& q, StdVector& dpdt) {
       eval_gradient(problem, view(q), gradient_);

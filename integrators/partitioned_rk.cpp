@@ -9,6 +9,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -80,8 +81,8 @@ class ImplicitPartitionedRk final : public Integrator {
           {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
     }
     const int n = problem.dof();
-    const Vec& mass = problem.mass();
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& mass = MassOperator(problem).constant_diagonal();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     const bool forced = problem.has(kForce);
     const Vec q0 = state.q;
     const Vec p0 = state.p;
@@ -218,7 +219,8 @@ class ImplicitPartitionedRk final : public Integrator {
     Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(stages_ * n, stages_ * n);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(stages_ * n, 2 * n);
     for (int i = 0; i < stages_; ++i) {
-      matrix.block(i * n, i * n, n, n) += Eigen::MatrixXd(problem.mass().asDiagonal());
+      matrix.block(i * n, i * n, n, n) +=
+          Eigen::MatrixXd(MassOperator(problem).constant_diagonal().asDiagonal());
       rhs.block(i * n, n, n, n).setIdentity();
       for (int j = 0; j < stages_; ++j) {
         rhs.block(i * n, 0, n, n) -= (h * a_hat_(i, j)) * hessians[j];

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -20,7 +21,7 @@ class PenalisedProblem final : public Problem {
  public:
   PenalisedProblem(const Problem& base, double stiffness)
       : base_(base), constraints_(constraints_of(base)), stiffness_(stiffness) {
-    set_mass(base.mass());
+    set_mass(MassOperator(base).constant_diagonal());
     set_capabilities(base.capabilities() & (kHessian | kLinearMomentum | kAngularMomentum));
     set_defaults(base.default_dt(), base.default_t_end());
   }

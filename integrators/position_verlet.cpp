@@ -4,6 +4,7 @@
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -37,16 +38,16 @@ class PositionVerlet final : public ExplicitStepper<PositionVerlet> {
   StepStatus step_tangent(const Problem& problem, State& state, double h,
                           Eigen::MatrixXd& tangent) override {
     TangentBlock block(problem.dof());
-    block.drift(problem.inverse_mass(), h / 2);
-    const Vec half_q = state.q + (h / 2) * problem.inverse_mass().cwiseProduct(state.p);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h / 2);
+    const Vec half_q = state.q + (h / 2) * MassOperator(problem).solve(state.q, state.p);
     block.kick(dense_hessian(problem, half_q), h);
-    block.drift(problem.inverse_mass(), h / 2);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h / 2);
     tangent = block.stacked();
     return step(problem, state, h);
   }
 
   StepStatus advance_by(const Problem& problem, State& state, double h) {
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     const bool forced = problem.has(kForce);
     if (forced) velocity_ = inverse_mass.cwiseProduct(state.p);  // the guess for v½
     state.q += (h / 2) * inverse_mass.cwiseProduct(state.p);

@@ -8,6 +8,7 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "problems/mass_operator.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -165,7 +166,7 @@ class EnergyProjection final : public Integrator {
   // H = ½pᵀM⁻¹p + V(q), and the size |T| + |V| of its terms for the round-off tests.
   double energy(const Problem& problem, const Vec& q, const Vec& p) {
     ++own_.energy_evals;
-    const double kinetic = 0.5 * p.dot(problem.inverse_mass().cwiseProduct(p));
+    const double kinetic = 0.5 * p.dot(MassOperator(problem).solve(q, p));
     const double potential = problem.potential(q);
     energy_scale_ = std::abs(kinetic) + std::abs(potential);
     return kinetic + potential;
@@ -175,7 +176,7 @@ class EnergyProjection final : public Integrator {
                        Vec& grad_p) {
     ++own_.force_evals;
     problem.gradient(q, grad_q);
-    grad_p = problem.inverse_mass().cwiseProduct(p);
+    grad_p = MassOperator(problem).solve(q, p);
   }
 
   // The direction G⁻¹∇H = (M⁻¹∇V(q), p) of the mass metric G = diag(M, M⁻¹): scaling M and V by
@@ -186,7 +187,7 @@ class EnergyProjection final : public Integrator {
                             Vec& dir_p) {
     ++own_.force_evals;
     problem.gradient(q, dir_q);
-    dir_q = problem.inverse_mass().cwiseProduct(dir_q);
+    dir_q = MassOperator(problem).solve(q, dir_q);
     dir_p = p;
   }
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -62,7 +63,7 @@ class Rattle final : public Integrator {
 
   StepStatus step(const Problem& problem, State& state, double h) override {
     constraint_impulses_.reset();
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     eval_total_force(problem, state.q, inverse_mass.cwiseProduct(state.p), state.t, force_);
     Vec p_half = state.p + (h / 2) * force_;
     const Vec q_start = state.q;

@@ -6,6 +6,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -25,7 +26,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
   bool has_step_tangent(const Problem& problem) const override { return tangent_applies(problem); }
   StepStatus step_tangent(const Problem& problem, State& state, double h,
                           Eigen::MatrixXd& tangent) override {
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     const TangentBlock start(problem.dof());
     TangentBlock stage = start, sum = start;
     Vec stage_q = state.q, stage_p = state.p, gradient;
@@ -122,7 +123,7 @@ class Rk4 final : public ExplicitStepper<Rk4> {
   }
 
   void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
-    dq = problem.inverse_mass().cwiseProduct(p);
+    MassOperator(problem).solve(q, p, dq);
     eval_total_force(problem, q, dq, t, dp);
   }
 

@@ -11,6 +11,7 @@
 
 #include "integrators/adaptive.hpp"
 #include "integrators/rkn_coefficients.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -147,7 +148,7 @@ class Rkn final : public Integrator {
     } else {
       eval_gradient(problem, state.q, stages_.gradients_[0]);
     }
-    stages_.attempt(state.q, state.p, problem.inverse_mass(), h,
+    stages_.attempt(state.q, state.p, MassOperator(problem).constant_inverse_diagonal(), h,
                     [&](const Vec& q, Vec& g) { eval_gradient(problem, q, g); });
     state.q.swap(stages_.next_q_);
     state.p.swap(stages_.next_p_);
@@ -203,7 +204,7 @@ class RknAdaptive final : public AdaptiveIntegrator {
     StepStatus status;
     if (!ready_to_step(problem, state, t_stop, status)) return status;
     if (problem.has(kForce)) return force_refusal("rkn_adaptive", problem);
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     y_.resize(2 * q_.size());
     y_ << q_, p_;
     status =

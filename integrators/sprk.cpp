@@ -8,6 +8,7 @@
 
 #include "integrators/integrator.hpp"
 #include "integrators/sprk_coefficients.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -59,7 +60,7 @@ class Sprk final : public Integrator {
     }
     bool gradient_current =
         cached_problem_ == &problem && cached_q_.size() == state.q.size() && cached_q_ == state.q;
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     const double t0 = state.t;
     for (size_t i = 0; i < kick_.size(); ++i) {
       if (kick_[i] != 0) {

@@ -3,6 +3,7 @@
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -89,7 +90,8 @@ class StormerVerlet final : public Integrator {
     } else if (problem.has(kForce)) {
       status = forced_step(problem, state, h, cache_hit);
     } else {
-      kick_drift_kick(state.q, state.p, gradient_, problem.inverse_mass(), h, counted(problem));
+      kick_drift_kick(state.q, state.p, gradient_,
+                      MassOperator(problem).constant_inverse_diagonal(), h, counted(problem));
       state.t += h;
     }
     remember(problem, state);
@@ -104,7 +106,7 @@ class StormerVerlet final : public Integrator {
                           Eigen::MatrixXd& tangent) override {
     TangentBlock block(problem.dof());
     block.kick(dense_hessian(problem, state.q), h / 2);
-    block.drift(problem.inverse_mass(), h);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h);
     const StepStatus status = step(problem, state, h);
     block.kick(dense_hessian(problem, state.q), h / 2);
     tangent = block.stacked();
@@ -138,13 +140,14 @@ class StormerVerlet final : public Integrator {
     }
     prime_gradient(problem, state);
     const bool fixed = !visit && with_fixed_gradient(problem, [&](const auto& gradient) {
-      fixed_size_loop(gradient, problem.inverse_mass(), grid, state, gradient_);
+      fixed_size_loop(gradient, MassOperator(problem).constant_inverse_diagonal(), grid, state,
+                      gradient_);
       counters_.force_evals += grid.n;
       counters_.steps += grid.n;
       outcome.steps = grid.n;
     });
     if (!fixed) {
-      const Vec& inverse_mass = problem.inverse_mass();
+      const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
       outcome = run_grid(state, grid, visit, [&](double h) {
         kick_drift_kick(state.q, state.p, gradient_, inverse_mass, h, counted(problem));
         ++counters_.steps;
@@ -186,7 +189,7 @@ class StormerVerlet final : public Integrator {
   // One kick–drift–kick as increments (gradient_ = ∇V(q) on entry, ∇V(q⁺) on exit); forces as
   // in forced_step.
   StepStatus compensated_step(const Problem& problem, State& state, double h, bool cache_hit) {
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     const bool forced = problem.has(kForce);
     increment_p_ = -(h / 2) * gradient_;
     if (forced) {
@@ -221,7 +224,7 @@ class StormerVerlet final : public Integrator {
   CountedGradient counted(const Problem& problem) { return {this, &problem}; }
 
   StepStatus forced_step(const Problem& problem, State& state, double h, bool cache_hit) {
-    const Vec& inverse_mass = problem.inverse_mass();
+    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
     velocity_ = inverse_mass.cwiseProduct(state.p);
     eval_force(problem, state.q, velocity_, state.t, force_);
     // eval_force is not counted; it is a force-field evaluation of its own when the gradient

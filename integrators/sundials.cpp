@@ -25,6 +25,7 @@
 #include "integrators/adaptive.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -624,7 +625,7 @@ class Ida final : public SundialsIntegrator {
       h = std::abs(h);
       q_ = y.head(n);
       constraints_->constraint_jacobian_at(t, q_, G_);
-      const Vec& inverse_mass = problem_->inverse_mass();
+      const Vec& inverse_mass = MassOperator(*problem_).constant_inverse_diagonal();
       Vec on_p = Vec::Zero(m), on_q = Vec::Zero(m);
       for (int col = 0; col < G_.outerSize(); ++col) {
         for (SparseMatrix::InnerIterator it(G_, col); it; ++it) {
@@ -689,7 +690,7 @@ class Ida final : public SundialsIntegrator {
     const double upper = 0.001 * std::abs(t_stop - t_);
     const double q_rate_norm = std::sqrt(yp.head(dof_).cwiseProduct(weights).squaredNorm() / n_);
     const double ida_step = q_rate_norm * upper > 0.5 ? 0.5 / q_rate_norm : upper;
-    const Vec q_second = problem_->inverse_mass().cwiseProduct(yp.segment(dof_, dof_));
+    const Vec q_second = MassOperator(*problem_).solve(y.head(dof_), yp.segment(dof_, dof_));
     const double q_second_norm = std::sqrt(q_second.cwiseProduct(weights).squaredNorm() / dof_);
     if (!(q_second_norm > 0) || !std::isfinite(q_second_norm)) return 0;
     const double error_step = std::min(upper, 1.0 / std::sqrt(q_second_norm));
@@ -722,7 +723,7 @@ class Ida final : public SundialsIntegrator {
       const Problem& problem = *problem_;
       q_ = y.head(n);
       p_ = y.segment(n, n);
-      const Vec v = problem.inverse_mass().cwiseProduct(p_);
+      const Vec v = MassOperator(problem).solve(q_, p_);
       problem.gradient(q_, force_);
       force_ = -force_;
       if (problem.has(kForce)) {
@@ -734,7 +735,7 @@ class Ida final : public SundialsIntegrator {
       rate_.resize(2 * n);
       rate_.head(n) = v;
       if (index_ == 2) {
-        rate_.head(n) -= problem.inverse_mass().cwiseProduct(G_.transpose() * y.tail(m));
+        rate_.head(n) -= MassOperator(problem).solve(q_, G_.transpose() * y.tail(m));
       }
       rate_.tail(n) = force_;
       if (!rate_.allFinite()) return 1;

@@ -4,6 +4,7 @@
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -28,17 +29,17 @@ class SymplecticEulerA final : public ExplicitStepper<SymplecticEulerA> {
                           Eigen::MatrixXd& tangent) override {
     TangentBlock block(problem.dof());
     block.kick(dense_hessian(problem, state.q), h);
-    block.drift(problem.inverse_mass(), h);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h);
     tangent = block.stacked();
     return step(problem, state, h);
   }
 
   // Kick then drift (ExplicitStepper runs it for step() and advance()).
   void advance_by(const Problem& problem, State& state, double h) {
-    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    velocity_ = MassOperator(problem).solve(state.q, state.p);
     eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
-    state.q += h * problem.inverse_mass().cwiseProduct(state.p);
+    state.q += h * MassOperator(problem).solve(state.q, state.p);
     state.t += h;
     ++counters_.steps;
   }
@@ -66,7 +67,7 @@ class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
   StepStatus step_tangent(const Problem& problem, State& state, double h,
                           Eigen::MatrixXd& tangent) override {
     TangentBlock block(problem.dof());
-    block.drift(problem.inverse_mass(), h);
+    block.drift(MassOperator(problem).constant_inverse_diagonal(), h);
     const StepStatus status = step(problem, state, h);
     block.kick(dense_hessian(problem, state.q), h);
     tangent = block.stacked();
@@ -75,7 +76,7 @@ class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
 
   // Drift then kick (ExplicitStepper runs it for step() and advance()).
   void advance_by(const Problem& problem, State& state, double h) {
-    velocity_ = problem.inverse_mass().cwiseProduct(state.p);
+    velocity_ = MassOperator(problem).solve(state.q, state.p);
     state.q += h * velocity_;
     state.t += h;
     eval_total_force(problem, state.q, velocity_, state.t, force_);

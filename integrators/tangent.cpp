@@ -2,6 +2,7 @@
 #include "integrators/tangent.hpp"
 
 #include "problems/lagrangian.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 
@@ -32,8 +33,9 @@ Eigen::MatrixXd quadrature_del_tangent(const Problem& problem, const Vec& q0, co
                                        const Vec& v, double h,
                                        const std::vector<QuadratureNode>& nodes) {
   const long n = q0.size();
-  const auto mass = problem.mass().asDiagonal();
-  Eigen::MatrixXd solve_matrix = Eigen::MatrixXd(mass);
+  const MassOperator mass(problem);
+  Eigen::MatrixXd solve_matrix;
+  mass.dense(q0, solve_matrix);
   Eigen::MatrixXd q_coupling = Eigen::MatrixXd::Zero(n, n);  // ∂R/∂q₀
   std::vector<Eigen::MatrixXd> hessians;
   for (const QuadratureNode& node : nodes) {
@@ -49,7 +51,8 @@ Eigen::MatrixXd quadrature_del_tangent(const Problem& problem, const Vec& q0, co
   TangentBlock block(static_cast<int>(n));
   Eigen::MatrixXd dq0 = block.q;
   block.q += h * dv;
-  block.p = mass * dv;
+  block.p = dv;
+  mass.apply_columns(q0, block.p);
   for (size_t j = 0; j < nodes.size(); ++j) {
     block.p -= (h * nodes[j].w * nodes[j].a) * (hessians[j] * (dq0 + (nodes[j].a * h) * dv));
   }

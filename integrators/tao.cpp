@@ -6,6 +6,7 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint {
 namespace {
@@ -51,13 +52,10 @@ class Tao final : public Integrator {
       const double fastest = problem.has(kOmegaMax) ? problem.omega_max(state.q) : 0.0;
       omega_ = std::isfinite(fastest) && fastest > 0.0 ? kDefaultCoupling * fastest : 20.0;
     }
-    if (const LagrangianSystem* general = problem.as_lagrangian()) {
-      DenseMatrix mass;
-      general->mass_matrix(state.q, mass);
-      weight_ = mass.diagonal();
-    } else {
-      weight_ = problem.mass();
-    }
+    // W = diag M(q₀) through the mass operator, for either kind.
+    DenseMatrix mass;
+    MassOperator(problem).dense(state.q, mass);
+    weight_ = mass.diagonal();
   }
 
   StepStatus step(const Problem& problem, State& state, double h) override {
@@ -89,7 +87,7 @@ class Tao final : public Integrator {
       v = general->velocity(q, p);
       general->lagrangian_q(q, v, L_q);
     } else {
-      v = problem.inverse_mass().cwiseProduct(p);
+      v = MassOperator(problem).solve(q, p);
       problem.gradient(q, L_q);
       L_q = -L_q;
     }

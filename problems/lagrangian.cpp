@@ -6,6 +6,8 @@
 #include <Eigen/LU>
 #include <stdexcept>
 
+#include "problems/mass_operator.hpp"
+
 namespace geomint {
 
 void LagrangianSystem::gyroscopic(const Vec& q, Vec& a) const { a = Vec::Zero(q.size()); }
@@ -14,6 +16,18 @@ void LagrangianSystem::gyroscopic_jacobian(const Vec& q, DenseMatrix& A) const {
 }
 void LagrangianSystem::gyroscopic_hessian(const Vec& q, const Vec&, DenseMatrix& a_qq) const {
   a_qq = DenseMatrix::Zero(q.size(), q.size());
+}
+
+void LagrangianSystem::apply_mass(const Vec& q, const Vec& v, Vec& Mv) const {
+  DenseMatrix M;
+  mass_matrix(q, M);
+  Mv = M * v;
+}
+
+void LagrangianSystem::solve_mass(const Vec& q, const Vec& p, Vec& v) const {
+  DenseMatrix M;
+  mass_matrix(q, M);
+  v = M.llt().solve(p);
 }
 
 double LagrangianSystem::lagrangian(const Vec& q, const Vec& v) const {
@@ -43,11 +57,11 @@ Vec LagrangianSystem::momentum(const Vec& q, const Vec& v) const {
 }
 
 Vec LagrangianSystem::velocity(const Vec& q, const Vec& p) const {
-  DenseMatrix M;
-  mass_matrix(q, M);
   Vec a;
   gyroscopic(q, a);
-  return M.llt().solve(p - a);
+  Vec v;
+  solve_mass(q, p - a, v);
+  return v;
 }
 
 void LagrangianSystem::lagrangian_vq(const Vec& q, const Vec& v, DenseMatrix& L_vq) const {
@@ -100,6 +114,12 @@ void LagrangianSystem::hamiltonian_vector_field_jacobian(const Vec& q, const Vec
 
 void SeparableLagrangian::mass_matrix(const Vec&, DenseMatrix& M) const {
   M = problem_.mass().asDiagonal();
+}
+void SeparableLagrangian::apply_mass(const Vec&, const Vec& v, Vec& Mv) const {
+  Mv = MassOperator(problem_).constant_diagonal().cwiseProduct(v);
+}
+void SeparableLagrangian::solve_mass(const Vec&, const Vec& p, Vec& v) const {
+  v = MassOperator(problem_).constant_inverse_diagonal().cwiseProduct(p);
 }
 void SeparableLagrangian::kinetic_gradient(const Vec& q, const Vec&, Vec& T_q) const {
   T_q = Vec::Zero(q.size());

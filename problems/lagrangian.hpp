@@ -41,6 +41,11 @@ class LagrangianSystem {
   virtual double potential(const Vec& q) const = 0;
   virtual void gradient(const Vec& q, Vec& g) const = 0;
   virtual void potential_hessian(const Vec& q, DenseMatrix& K) const = 0;
+  // The mass as an operator (problems/mass_operator.hpp, what methods call): Mv = M(q)v and
+  // v = M(q)⁻¹p. Defaults: mass_matrix and a dense Cholesky solve. A problem whose M(q) has
+  // structure (sparse, or an O(n) recursion) overrides them and need never form M.
+  virtual void apply_mass(const Vec& q, const Vec& v, Vec& Mv) const;
+  virtual void solve_mass(const Vec& q, const Vec& p, Vec& v) const;
 
   // ---- The Lagrangian and its derivatives, assembled from the primitives ----
   double lagrangian(const Vec& q, const Vec& v) const;
@@ -78,6 +83,8 @@ class SeparableLagrangian final : public LagrangianSystem {
   double potential(const Vec& q) const override { return problem_.potential(q); }
   void gradient(const Vec& q, Vec& g) const override { problem_.gradient(q, g); }
   void potential_hessian(const Vec& q, DenseMatrix& K) const override;
+  void apply_mass(const Vec& q, const Vec& v, Vec& Mv) const override;
+  void solve_mass(const Vec& q, const Vec& p, Vec& v) const override;
 
  private:
   const Problem& problem_;

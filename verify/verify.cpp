@@ -12,6 +12,7 @@
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 
 namespace geomint::verify {
 namespace {
@@ -282,7 +283,7 @@ CheckResult constraint_kept(const MethodFactory& method, const ProblemPtr& probl
   // the speed (set by gravity, length per 100 default steps, when released from rest).
   const double length = initial.q.lpNorm<Eigen::Infinity>();
   const double speed =
-      std::max(problem->inverse_mass().cwiseProduct(initial.p).lpNorm<Eigen::Infinity>(),
+      std::max(MassOperator(*problem).solve(initial.q, initial.p).lpNorm<Eigen::Infinity>(),
                length / (problem->default_dt() * 100));
   const double unit = length / speed;
   const RunResult run = run_untimed(problem, method, unit / steps_per_unit, unit * units);
