@@ -6,6 +6,7 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/step_implementation.hpp"
 #include "problems/mass_operator.hpp"
 
 namespace geomint {
@@ -58,7 +59,9 @@ class Tao final : public Integrator {
     weight_ = mass.diagonal();
   }
 
+  // The one step for the separable and the general kind (they differ only in evaluate()).
   StepStatus step(const Problem& problem, State& state, double h) override {
+    mark_step_implementation();
     if (x_.size() != state.q.size()) reset(problem, state, h);
     const LagrangianSystem* general = problem.as_lagrangian();
     if (order_ == 2) {
