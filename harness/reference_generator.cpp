@@ -34,7 +34,7 @@ class Field {
       : problem_(problem),
         dof_(problem.dof()),
         non_separable_(problem.kind() == ProblemKind::kLagrangian) {
-    // Only the separable kind has a constant mass (mass() throws on the others).
+    // Only the separable kind has a constant diagonal mass (the operator throws on the others).
     if (!non_separable_)
       inverse_mass_ = MassOperator(problem).constant_inverse_diagonal().cast<Real>();
   }
