@@ -497,7 +497,6 @@ RunResult run_one(const RunSpec& spec) {
   throw_input_errors(spec.validate());
   const Problem* problem = spec.problem.get();
   const RunConfig& config = spec.config;
-  const std::string& method_spec = spec.method.spec();
   auto integrator = spec.method.make();
   const MethodInfo& info = spec.method.info();
   const bool adaptive = spec.method.adaptive();
@@ -529,9 +528,7 @@ RunResult run_one(const RunSpec& spec) {
                                            .metrics = config.extra_metrics,
                                            .dt = config.dt,
                                            .diverge_factor = config.diverge_factor,
-                                           .integrator = integrator.get(),
-                                           .method_spec = &method_spec,
-                                           .ran_spec = &ran_spec,
+                                           .method = &spec.method,
                                            .reference = reference});
   std::unique_ptr<SeriesWriter> series;
   if (!config.series_path.empty()) {
