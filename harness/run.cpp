@@ -515,7 +515,7 @@ RunResult run_one(const RunSpec& spec) {
   // A reference applies when its rows reach t_end (error_max/error_final, valid_time).
   std::shared_ptr<const ReferenceSolution> reference;
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
-    const std::string path = reference_path(config.reference_dir, problem->spec());
+    const std::string path = reference_path(config.reference_dir, *problem);
     if (std::filesystem::exists(path)) {
       auto loaded = load_reference(path, *problem);  // InputError when malformed
       if (loaded->row_at(problem->initial_state().t + config.t_end) >= 0) {

@@ -68,7 +68,7 @@ void validate_references(const std::vector<std::string>& problems, const std::st
   for (const auto& spec : problems) {
     const auto problem = specs.problem(spec);
     if (problem->has(kExact)) continue;
-    const std::string path = reference_path(RunConfig{}.reference_dir, problem->spec());
+    const std::string path = reference_path(RunConfig{}.reference_dir, *problem);
     if (!checked.insert(path).second || !std::filesystem::exists(path)) continue;
     try {
       load_reference(path, *problem);

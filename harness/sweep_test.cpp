@@ -206,7 +206,8 @@ TEST(SweepSpecs, EachSpecIsParsedOncePerSweep) {
          "table_columns = [\"label\", \"problem\", \"method\", \"symplecticity_defect\", "
          "\"mode_freq_err_max\", \"modified_energy_err_max\", \"symplecticity_defect_map\", "
          "\"lyapunov_max\", \"megno\", \"valid_time\"]\n"
-         "[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic:omega=2\", \"kepler:e=0.3\"]\n"
+         "[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic:omega=2\", \"kepler:e=0.3\", "
+         "\"henon_heiles\"]\n"
          "methods = [\"stormer_verlet\", \"implicit_midpoint\"]\ndt = 0.05\nt_end = 0.5\n"
          "timing_repeats = 1\nquick_t_end = 0.25\n"
          "[[orders]]\nlabel = \"o\"\nproblems = [\"harmonic:omega=2\"]\n"
@@ -228,15 +229,15 @@ TEST(SweepSpecs, EachSpecIsParsedOncePerSweep) {
   set_spec_parse_hook(nullptr);
   EXPECT_EQ(failed, 0);
   const CsvTable summary = read_csv_file((dir / "summary.csv").string());
-  ASSERT_EQ(summary.rows.size(), 4u);
+  ASSERT_EQ(summary.rows.size(), 6u);
   // The observers ran (their columns are filled), so their parses were counted too.
   EXPECT_NE(summary.rows[0].at("symplecticity_defect"), "");
   EXPECT_NE(summary.rows[0].at("modified_energy_err_max"), "");
   EXPECT_NE(summary.rows[0].at("symplecticity_defect_map"), "");
   EXPECT_NE(summary.rows[0].at("lyapunov_max"), "");
   const std::lock_guard<std::mutex> lock(parse_count_mutex);
-  for (const std::string text :
-       {"harmonic:omega=2", "kepler:e=0.3", "harmonic", "stormer_verlet", "implicit_midpoint"}) {
+  for (const std::string text : {"harmonic:omega=2", "kepler:e=0.3", "henon_heiles", "harmonic",
+                                 "stormer_verlet", "implicit_midpoint"}) {
     EXPECT_EQ(parse_counts[text], 1) << "'" << text << "'";
   }
   for (const auto& [text, count] : parse_counts) EXPECT_LE(count, 1) << "'" << text << "'";
