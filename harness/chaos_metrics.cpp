@@ -175,20 +175,10 @@ std::string chaos_tangent_not_applicable(const Integrator& method, const Problem
   return map_defect_not_applicable(method, problem, 1.0);
 }
 
-std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
-                                              const Problem& problem,
+std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& method, const Problem& problem,
                                               const std::vector<std::string>& names) {
   if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
-  const MethodFactory factory(method_spec);
-  return make_chaos_observer(factory, problem, names, chaos_tangent(factory.prototype(), problem));
-}
-
-std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
-                                              const Problem& problem,
-                                              const std::vector<std::string>& names,
-                                              ChaosTangent kind) {
-  if (!requested(names, metric::lyapunov_max) && !requested(names, metric::megno)) return nullptr;
-  return make_chaos_observer(MethodFactory(method_spec), problem, names, kind);
+  return make_chaos_observer(method, problem, names, chaos_tangent(method.prototype(), problem));
 }
 
 std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& factory, const Problem& problem,
@@ -214,8 +204,8 @@ std::unique_ptr<Observer> make_valid_time_observer(
 }
 
 void add_chaos_observer(const ObserverContext& context, ObserverList& observers) {
-  if (context.ran_spec == nullptr) return;
-  if (auto observer = make_chaos_observer(*context.ran_spec, context.problem, context.metrics)) {
+  if (context.method == nullptr) return;
+  if (auto observer = make_chaos_observer(*context.method, context.problem, context.metrics)) {
     observers.push_back(std::move(observer));
   }
 }

@@ -62,16 +62,11 @@ class ChaosSums {
 // (0: the linearised step, 1: finite differences of the computed map). The tangent is taken from
 // a fresh reset at every step point, as symplecticity_defect does, so the run is not disturbed.
 // A tangent step that fails or overflows ends the sums: the metrics are NaN.
-std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
-                                              const Problem& problem,
+// The integrator that takes the tangents is made from `method`.
+std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& method, const Problem& problem,
                                               const std::vector<std::string>& names);
 
 // The same with the tangent chosen (tests compare the two; nullptr where `kind` cannot be used).
-std::unique_ptr<Observer> make_chaos_observer(const std::string& method_spec,
-                                              const Problem& problem,
-                                              const std::vector<std::string>& names,
-                                              ChaosTangent kind);
-// The same from a parsed method: the integrator that takes the tangents is made from `method`.
 std::unique_ptr<Observer> make_chaos_observer(const MethodFactory& method, const Problem& problem,
                                               const std::vector<std::string>& names,
                                               ChaosTangent kind);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint {
@@ -44,7 +45,8 @@ class InvertedOscillator final : public Problem {
 // The observer driven by a plain fixed-step loop, as run_one drives it.
 std::map<std::string, double> observe_run(const Problem& problem, const std::string& method_spec,
                                           double h, long steps, ChaosTangent kind) {
-  auto observer = make_chaos_observer(method_spec, problem, {"lyapunov_max", "megno"}, kind);
+  auto observer =
+      make_chaos_observer(MethodFactory(method_spec), problem, {"lyapunov_max", "megno"}, kind);
   EXPECT_NE(observer, nullptr);
   std::map<std::string, double> metrics;
   if (!observer) return metrics;

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "harness/record.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/toml_reader.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
@@ -66,8 +67,8 @@ std::string node_text(const toml::node& node, const std::string& where) {
 
 // Canonical spec of a method or problem, so that defaults written or omitted compare equal.
 std::string canonical_spec(const std::string& column, const std::string& text) {
-  if (column == "method") return make_integrator(text)->spec();
-  return make_problem(text)->spec();
+  if (column == "method") return MethodFactory(text).spec();
+  return parse_problem(text)->spec();
 }
 
 bool is_spec_column(const std::string& column) { return column == "method" || column == "problem"; }

@@ -293,11 +293,6 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
   return best;
 }
 
-MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
-                                   const State& state, double h) {
-  return symplecticity_defect_map(MethodFactory(method_spec), problem, state, h);
-}
-
 MapDefect symplecticity_defect_map(const MethodFactory& factory, const Problem& problem,
                                    const State& state, double h) {
   const auto method = factory.make();
@@ -404,13 +399,6 @@ class MapDefectObserver : public Observer {
 
 }  // namespace
 
-std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
-                                                   const Problem& problem, double h,
-                                                   const std::vector<std::string>& names) {
-  if (!requested(names, metric::symplecticity_defect_map)) return nullptr;
-  return make_map_defect_observer(MethodFactory(method_spec), problem, h, names);
-}
-
 std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names) {
@@ -420,9 +408,9 @@ std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
 }
 
 void add_map_defect_observer(const ObserverContext& context, ObserverList& observers) {
-  if (context.ran_spec == nullptr) return;
-  if (auto observer = make_map_defect_observer(*context.ran_spec, context.problem, context.dt,
-                                               context.metrics)) {
+  if (context.method == nullptr) return;
+  if (auto observer =
+          make_map_defect_observer(*context.method, context.problem, context.dt, context.metrics)) {
     observers.push_back(std::move(observer));
   }
 }

@@ -87,8 +87,6 @@ ManifoldMap computed_manifold_map(Integrator& method, const Problem& problem, co
 // ‖JU‖²))/‖UᵀΩU‖_F; on an unconstrained problem (U = I) both are the formulas above.
 MapDefect symplecticity_defect_map(const MethodFactory& method, const Problem& problem,
                                    const State& state, double h);
-MapDefect symplecticity_defect_map(const std::string& method_spec, const Problem& problem,
-                                   const State& state, double h);
 // The same for a given integrator (reset at every perturbed start).
 MapDefect symplecticity_defect_map(Integrator& method, const Problem& problem, const State& state,
                                    double h);
@@ -104,9 +102,6 @@ double map_defect_of_jacobian(const Eigen::MatrixXd& jacobian);
 // p + 1 for a non-symplectic map of order p) when both stand above ten times their error
 // estimate and the method is not adaptive.
 std::unique_ptr<Observer> make_map_defect_observer(const MethodFactory& method,
-                                                   const Problem& problem, double h,
-                                                   const std::vector<std::string>& names);
-std::unique_ptr<Observer> make_map_defect_observer(const std::string& method_spec,
                                                    const Problem& problem, double h,
                                                    const std::vector<std::string>& names);
 

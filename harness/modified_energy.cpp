@@ -144,30 +144,19 @@ class ModifiedEnergyObserver : public Observer {
 
 }  // namespace
 
-std::unique_ptr<Observer> make_modified_energy_observer(const Integrator& method,
-                                                        const Problem& problem, double h,
-                                                        const std::vector<std::string>& names) {
-  if (!requested(names, metric::modified_energy_err_max)) {
-    return nullptr;
-  }
-  return make_modified_energy_observer(MethodFactory(method.spec()), problem, h, names);
-}
-
 std::unique_ptr<Observer> make_modified_energy_observer(const MethodFactory& method,
                                                         const Problem& problem, double h,
                                                         const std::vector<std::string>& names) {
-  if (std::find(names.begin(), names.end(), "modified_energy_err_max") == names.end()) {
-    return nullptr;
-  }
+  if (!requested(names, metric::modified_energy_err_max)) return nullptr;
   if (!modified_energy_not_applicable(method.prototype(), problem, h).empty()) return nullptr;
   return std::make_unique<ModifiedEnergyObserver>(
       method, *modified_energy_correction(method.info().name), h);
 }
 
 void add_modified_energy_observer(const ObserverContext& context, ObserverList& observers) {
-  if (context.integrator == nullptr) return;
-  if (auto observer = make_modified_energy_observer(*context.integrator, context.problem,
-                                                    context.dt, context.metrics)) {
+  if (context.method == nullptr) return;
+  if (auto observer = make_modified_energy_observer(*context.method, context.problem, context.dt,
+                                                    context.metrics)) {
     observers.push_back(std::move(observer));
   }
 }

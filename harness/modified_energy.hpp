@@ -45,10 +45,5 @@ double modified_energy(const ModifiedEnergyCorrection& correction, const Problem
 std::unique_ptr<Observer> make_modified_energy_observer(const MethodFactory& method,
                                                         const Problem& problem, double h,
                                                         const std::vector<std::string>& names);
-// The same for the method of a given integrator (its spec is parsed once when the metric is asked
-// for).
-std::unique_ptr<Observer> make_modified_energy_observer(const Integrator& method,
-                                                        const Problem& problem, double h,
-                                                        const std::vector<std::string>& names);
 
 }  // namespace geomint

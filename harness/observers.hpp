@@ -28,6 +28,7 @@ class Observer {
 };
 
 struct ReferenceSolution;
+class MethodFactory;
 
 // What an observer factory (harness/metrics.def) may look at: the problem, the optional metrics
 // asked for, the step, the divergence rule and, on a run, its method and reference.
@@ -40,11 +41,10 @@ struct ObserverContext {
   // once per step point), a state-norm rule any other run whose max(|q|∞, |p|∞) exceeds
   // kDivergedStateNorm.
   double diverge_factor = 0;
-  // The metric pass's integrator and its spec as given and as run (spec_on); nullptr: no metric
-  // that reads the method applies.
-  const Integrator* integrator = nullptr;
-  const std::string* method_spec = nullptr;
-  const std::string* ran_spec = nullptr;
+  // The run's parsed method: observers that step on their own make fresh integrators from it
+  // (never re-parsing its spec); nullptr: no metric that reads the method applies. On a
+  // non-separable problem it runs what the row's spec_on() names (integrators/general_step.hpp).
+  const MethodFactory* method = nullptr;
   // A loaded reference whose rows reach t_end (error_max/error_final, valid_time), or nullptr.
   std::shared_ptr<const ReferenceSolution> reference = nullptr;
 };

@@ -139,18 +139,6 @@ std::vector<std::string> order_study_errors(const Problem& problem, const Method
   return errors;
 }
 
-void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
-                          double dt0, long levels, double t_end) {
-  throw_input_errors(order_study_errors(*parse_problem(problem_spec), MethodFactory(method_spec),
-                                        dt0, levels, t_end));
-}
-
-OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
-                       int levels, double t_end, double diverge_factor) {
-  return order_study(parse_problem(problem_spec), MethodFactory(method_spec), dt0, levels, t_end,
-                     diverge_factor);
-}
-
 OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const MethodFactory& method,
                        double dt0, int levels, double t_end, double diverge_factor) {
   throw_input_errors(order_study_errors(*problem, method, dt0, levels, t_end));
@@ -179,8 +167,7 @@ OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const Meth
   // (Richardson-style self-convergence).
   std::shared_ptr<const ReferenceSolution> reference_file;
   if (exact && !problem->has(kExact)) {
-    reference_file =
-        load_reference(reference_path(RunConfig{}.reference_dir, problem->spec()), *problem);
+    reference_file = load_reference(reference_path(RunConfig{}.reference_dir, *problem), *problem);
   }
   const auto reference_at = [&](double t) -> State {
     if (!exact) return study.runs.back().final_state;

@@ -54,9 +54,6 @@ constexpr int kMaxOrderLevels = 30;
 // whether the method applies to the problem.
 std::vector<std::string> order_study_errors(const Problem& problem, const MethodFactory& method,
                                             double dt0, long levels, double t_end);
-// The same from spec strings (parsed here), as one InputError.
-void validate_order_study(const std::string& problem_spec, const std::string& method_spec,
-                          double dt0, long levels, double t_end);
 
 // Runs the ladder dt0·2⁻ᵏ, k = 0..levels−1, without timing (one problem object, a fresh
 // integrator from `method` per level), and fits error_final (or, for problems without an exact
@@ -66,8 +63,5 @@ void validate_order_study(const std::string& problem_spec, const std::string& me
 OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const MethodFactory& method,
                        double dt0, int levels, double t_end,
                        double diverge_factor = kDefaultDivergeFactor);
-// The same from spec strings (the scene reader, tests).
-OrderStudy order_study(const std::string& problem_spec, const std::string& method_spec, double dt0,
-                       int levels, double t_end, double diverge_factor = kDefaultDivergeFactor);
 
 }  // namespace geomint

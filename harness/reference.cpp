@@ -51,9 +51,8 @@ class ReferenceErrorObserver : public Observer {
 
 }  // namespace
 
-std::string reference_path(const std::string& dir, const std::string& problem_spec) {
-  const auto problem = make_problem(problem_spec);
-  std::string name = sanitize_for_path(problem->spec());
+std::string reference_path(const std::string& dir, const Problem& problem) {
+  std::string name = sanitize_for_path(problem.spec());
   // File systems refuse names over 255 bytes, which a long spec (rod_chain:n=64 lists 64
   // angles) exceeds: keep a readable prefix and make it unique with a hash of the whole name.
   // Every shorter name, and so every committed reference, is unchanged.

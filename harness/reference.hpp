@@ -17,7 +17,7 @@ namespace geomint {
 inline constexpr const char* kReferenceDir = "results/references";
 
 // <dir>/<sanitized canonical problem spec>.csv
-std::string reference_path(const std::string& dir, const std::string& problem_spec);
+std::string reference_path(const std::string& dir, const Problem& problem);
 
 // A loaded reference: rows (t, q, p) at the output times.
 struct ReferenceSolution {

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "harness/paths.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/table.hpp"
 #include "integrators/high_order_coefficients.hpp"
 #include "problems/lagrangian.hpp"
@@ -157,7 +158,7 @@ std::string number17(double value) { return fmt::format("{:.17g}", value); }
 }  // namespace
 
 ReferenceSummary generate_reference(const ReferenceOptions& options) {
-  const auto problem = make_problem(options.problem_spec);
+  const auto problem = parse_problem(options.problem_spec);
   if (problem->has(kFirstOrderOnly)) {
     // The generator integrates (q, p) with ∇V; a first-order problem carries its reference instead.
     throw InputError(fmt::format(
@@ -201,8 +202,8 @@ ReferenceSummary generate_reference(const ReferenceOptions& options) {
   }
 
   ReferenceSummary summary;
-  summary.path = options.out_path.empty() ? reference_path(kReferenceDir, options.problem_spec)
-                                          : options.out_path;
+  summary.path =
+      options.out_path.empty() ? reference_path(kReferenceDir, *problem) : options.out_path;
   check_output_file(summary.path, options.out_path.empty() ? "reference file" : "--out");
   const auto start = std::chrono::steady_clock::now();
   long check_steps = 0;

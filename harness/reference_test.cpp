@@ -33,7 +33,7 @@ ReferenceSummary generate(const std::string& problem_spec, double t_end, double 
   options.t_end = t_end;
   options.output_every = every;
   options.dt = dt;
-  options.out_path = reference_path(dir.string(), problem_spec);
+  options.out_path = reference_path(dir.string(), *make_problem(problem_spec));
   options.command_line = "reference_test";
   return generate_reference(options);
 }
@@ -83,12 +83,12 @@ INSTANTIATE_TEST_SUITE_P(Problems, ExactProblem,
 // reference path: a readable prefix and a hash, distinct for distinct specs (it was an internal
 // error, "File name too long", in every run of such a problem).
 TEST(Reference, LongSpecsHaveShortDistinctPaths) {
-  const std::string a = reference_path("dir", "rod_chain:n=64");
-  const std::string b = reference_path("dir", "rod_chain:n=64,theta=1.5");
+  const std::string a = reference_path("dir", *make_problem("rod_chain:n=64"));
+  const std::string b = reference_path("dir", *make_problem("rod_chain:n=64,theta=1.5"));
   EXPECT_LE(std::filesystem::path(a).filename().string().size(), 255u);
   EXPECT_NE(a, b);
-  EXPECT_EQ(a, reference_path("dir", "rod_chain:n=64"));
-  EXPECT_EQ(reference_path("dir", "kepler:e=0.6"), "dir/kepler_e_0.6.csv");
+  EXPECT_EQ(a, reference_path("dir", *make_problem("rod_chain:n=64")));
+  EXPECT_EQ(reference_path("dir", *make_problem("kepler:e=0.6")), "dir/kepler_e_0.6.csv");
   RunConfig config;
   config.dt = 0.01;
   config.t_end = 0.02;

@@ -498,7 +498,6 @@ RunResult run_one(const RunSpec& spec) {
   throw_input_errors(spec.validate());
   const Problem* problem = spec.problem.get();
   const RunConfig& config = spec.config;
-  const std::string& method_spec = spec.method.spec();
   auto integrator = spec.method.make();
   const MethodInfo& info = spec.method.info();
   const bool adaptive = spec.method.adaptive();
@@ -517,7 +516,7 @@ RunResult run_one(const RunSpec& spec) {
   // A reference applies when its rows reach t_end (error_max/error_final, valid_time).
   std::shared_ptr<const ReferenceSolution> reference;
   if (!problem->has(kExact) && !config.reference_dir.empty()) {
-    const std::string path = reference_path(config.reference_dir, problem->spec());
+    const std::string path = reference_path(config.reference_dir, *problem);
     if (std::filesystem::exists(path)) {
       auto loaded = load_reference(path, *problem);  // InputError when malformed
       if (loaded->row_at(problem->initial_state().t + config.t_end) >= 0) {
@@ -530,9 +529,7 @@ RunResult run_one(const RunSpec& spec) {
                                            .metrics = config.extra_metrics,
                                            .dt = config.dt,
                                            .diverge_factor = config.diverge_factor,
-                                           .integrator = integrator.get(),
-                                           .method_spec = &method_spec,
-                                           .ran_spec = &ran_spec,
+                                           .method = &spec.method,
                                            .reference = reference});
   std::unique_ptr<SeriesWriter> series;
   if (!config.series_path.empty()) {

@@ -16,6 +16,20 @@ std::shared_ptr<const Problem> parse_problem(const std::string& spec_text) {
   return make_problem(spec_text);
 }
 
+std::shared_ptr<const Problem> SpecBook::problem(const std::string& text) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  auto found = problems_.find(text);
+  if (found == problems_.end()) found = problems_.emplace(text, parse_problem(text)).first;
+  return found->second;
+}
+
+const MethodFactory& SpecBook::method(const std::string& text) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  auto found = methods_.find(text);
+  if (found == methods_.end()) found = methods_.emplace(text, MethodFactory(text)).first;
+  return found->second;
+}
+
 RunSpec RunSpec::parse(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config) {
   auto problem = parse_problem(problem_spec);

@@ -3,7 +3,9 @@
 // scene reader; RunSpec::validate() lists every error at once, as Ceres' Solver::Options::IsValid.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,23 @@ class MethodFactory {
 // The problem object a spec names (InputError for an unknown problem, key or value). Shared: runs
 // of one problem (the levels of an order study, the repeats of a timing pass) read one object.
 std::shared_ptr<const Problem> parse_problem(const std::string& spec_text);
+
+// The objects of the spec texts a scene names, each text parsed once: the scene reader fills it
+// while it checks the scene, and the sweep's runs, order studies, stability searches and
+// table.md's short labels read the same objects (a problem is shared read-only, a method is a
+// factory of fresh integrators). Safe to use from the sweep's worker threads.
+class SpecBook {
+ public:
+  // The problem or method of `text`, parsed on first use (InputError as parse_problem and
+  // MethodFactory throw it; a text that fails is not kept, so asking again gives the same error).
+  std::shared_ptr<const Problem> problem(const std::string& text);
+  const MethodFactory& method(const std::string& text);
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const Problem>> problems_;
+  std::map<std::string, MethodFactory> methods_;  // std::map: references stay valid
+};
 
 struct RunSpec {
   std::shared_ptr<const Problem> problem;

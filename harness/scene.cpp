@@ -26,17 +26,18 @@ void check_positive(double value, const std::string& where, const std::string& k
   }
 }
 
-// Constructs every spec once so that a typo fails before any run starts.
+// Parses every spec into the scene's book (once: the sweep runs these objects) so that a typo
+// fails before any run starts.
 void validate_specs(const std::vector<std::string>& problems,
                     const std::vector<std::string>& methods, const std::string& where,
-                    bool* all_adaptive) {
+                    SpecBook& specs, bool* all_adaptive) {
   try {
-    for (const auto& spec : problems) make_problem(spec);
+    for (const auto& spec : problems) specs.problem(spec);
     *all_adaptive = true;
     for (const auto& spec : methods) {
-      // Every spec is constructed (a `&&` here once skipped the specs after the first
+      // Every spec is parsed (a `&&` here once skipped the specs after the first
       // fixed-step method, and a typo then aborted the sweep in a worker thread).
-      const bool adaptive = (make_integrator(spec)->info().flags & kAdaptive) != 0;
+      const bool adaptive = specs.method(spec).adaptive();
       *all_adaptive = *all_adaptive && adaptive;
     }
   } catch (const InputError& error) {
@@ -63,11 +64,11 @@ void check_label(const std::string& label, const std::string& where) {
 // The reference files the runs and order studies will read (harness/run.cpp), loaded now: a
 // malformed one is bad input of the scene, not an error row in every run that meets it.
 void validate_references(const std::vector<std::string>& problems, const std::string& where,
-                         std::set<std::string>& checked) {
+                         SpecBook& specs, std::set<std::string>& checked) {
   for (const auto& spec : problems) {
-    const auto problem = make_problem(spec);
+    const auto problem = specs.problem(spec);
     if (problem->has(kExact)) continue;
-    const std::string path = reference_path(RunConfig{}.reference_dir, problem->spec());
+    const std::string path = reference_path(RunConfig{}.reference_dir, *problem);
     if (!checked.insert(path).second || !std::filesystem::exists(path)) continue;
     try {
       load_reference(path, *problem);
@@ -186,8 +187,8 @@ Scene load_scene(const std::string& path, bool quick) {
     for (const RunBlock* candidate : {&block, &quick_block}) {
       const char* prefix = candidate == &block ? "" : "quick_";
       bool all_adaptive = false;
-      validate_specs(candidate->problems, candidate->methods, where, &all_adaptive);
-      validate_references(candidate->problems, where, references);
+      validate_specs(candidate->problems, candidate->methods, where, *scene.specs, &all_adaptive);
+      validate_references(candidate->problems, where, *scene.specs, references);
       if (candidate->dts.empty() && !all_adaptive) {
         throw InputError(
             fmt::format("{}: missing required key 'dt' (needed by fixed-step methods)", where));
@@ -225,8 +226,8 @@ Scene load_scene(const std::string& path, bool quick) {
     reader.finish();
     check_diverge_factor(block.diverge_factor, where);
     bool all_adaptive = false;
-    validate_specs(block.problems, block.methods, where, &all_adaptive);
-    validate_references(block.problems, where, references);
+    validate_specs(block.problems, block.methods, where, *scene.specs, &all_adaptive);
+    validate_references(block.problems, where, *scene.specs, references);
     check_positive(block.dt0, where, "dt0");
     check_positive(block.t_end, where, "t_end");
     // The finest level of either configuration must respect the step limit.
@@ -270,16 +271,16 @@ Scene load_scene(const std::string& path, bool quick) {
     quick_number(reader, "quick_rel_tol", where, &quick_options.rel_tol);
     reader.finish();
     bool all_adaptive = false;
-    validate_specs(block.problems, block.methods, where, &all_adaptive);
+    validate_specs(block.problems, block.methods, where, *scene.specs, &all_adaptive);
     for (const StabilityOptions* candidate : {&options, &quick_options}) {
       validate_stability_options(*candidate, where);
       for (const auto& problem : block.problems) {
-        check_stability_budget(problem, *candidate, where);
+        check_stability_budget(*scene.specs->problem(problem), problem, *candidate, where);
       }
     }
     if (quick) options = quick_options;
     for (const auto& method : block.methods) {
-      if (make_integrator(method)->info().flags & kAdaptive) {
+      if (scene.specs->method(method).adaptive()) {
         throw InputError(
             fmt::format("{}: method '{}' is adaptive: a stability search needs a "
                         "fixed-step method",

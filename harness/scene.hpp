@@ -3,10 +3,12 @@
 // (TOML → Scene, through harness/toml_reader.hpp); harness/sweep.hpp runs a Scene.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/stability.hpp"
 
 namespace geomint {
@@ -42,6 +44,9 @@ struct Scene {
   std::vector<RunBlock> runs;
   std::vector<OrderBlock> orders;
   std::vector<StabilityBlock> stability;  // [[stability]]: largest stable h*omega per method
+  // The problem and method objects of the blocks' specs, each parsed once (load_scene fills it;
+  // a Scene built in code gets its specs parsed on first use by the sweep). Shared by copies.
+  std::shared_ptr<SpecBook> specs = std::make_shared<SpecBook>();
 };
 
 // Parses and validates a scene file: unknown or missing keys, wrong types, integers out of range,

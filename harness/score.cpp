@@ -472,7 +472,7 @@ RunRecord score_trajectory(const Problem& problem, const Trajectory& trajectory,
   // The reference as run_one picks it: one whose rows reach the last time.
   std::shared_ptr<const ReferenceSolution> reference;
   if (!problem.has(kExact) && !config.reference_dir.empty()) {
-    const std::string path = reference_path(config.reference_dir, problem.spec());
+    const std::string path = reference_path(config.reference_dir, problem);
     if (std::filesystem::exists(path)) {
       auto loaded = load_reference(path, problem);
       if (loaded->row_at(t0 + t_end) >= 0) {

@@ -82,8 +82,8 @@ void resolve(const Problem& problem, const StabilityOptions& options, double* ho
 
 }  // namespace
 
-double predicted_homega_limit(const std::string& method_spec) {
-  return MethodFactory(method_spec).prototype().predicted_linear_stability().homega_limit;
+double predicted_homega_limit(const MethodFactory& method) {
+  return method.prototype().predicted_linear_stability().homega_limit;
 }
 
 void validate_stability_options(const StabilityOptions& options, const std::string& where) {
@@ -121,11 +121,6 @@ void validate_stability_options(const StabilityOptions& options, const std::stri
     throw InputError(fmt::format("{}: 'rel_tol' must be in (0, 1)", where));
 }
 
-void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
-                            const std::string& where) {
-  check_stability_budget(*parse_problem(problem_spec), problem_spec, options, where);
-}
-
 void check_stability_budget(const Problem& problem, const std::string& problem_spec,
                             const StabilityOptions& options, const std::string& where) {
   double horizon = 0, h_lo = 0, h_hi = 0;
@@ -152,11 +147,6 @@ void check_stability_budget(const Problem& problem, const std::string& problem_s
         where, problem_spec, in_h ? "h_min" : "homega_min", in_h ? "h_max" : "homega_max",
         options.scan_points_per_decade, std::ceil(points), kMaxStabilityScanPoints));
   }
-}
-
-StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
-                                 const StabilityOptions& options) {
-  return stability_search(*parse_problem(problem_spec), MethodFactory(method_spec), options);
 }
 
 StabilityResult stability_search(const Problem& problem_ref, const MethodFactory& method,

@@ -50,14 +50,11 @@ struct StabilityResult {
 // (non-monotone stability). Throws InputError for adaptive methods, bad ranges or bad specs.
 StabilityResult stability_search(const Problem& problem, const MethodFactory& method,
                                  const StabilityOptions& options);
-// The same from spec strings (the scene reader, tests).
-StabilityResult stability_search(const std::string& problem_spec, const std::string& method_spec,
-                                 const StabilityOptions& options);
 
 // The linear-theory limit of h·ω on the harmonic oscillator for a method spec, as the method
 // predicts it (Integrator::predicted_linear_stability): +inf for unconditionally stable methods,
 // 0 for explicit Euler (never stable), NaN when the method has no prediction.
-double predicted_homega_limit(const std::string& method_spec);
+double predicted_homega_limit(const MethodFactory& method);
 
 // Caps on the work of one search: steps per run (at the bottom of the range, the longest run)
 // and points of the geometric scan.
@@ -70,9 +67,7 @@ void validate_stability_options(const StabilityOptions& options, const std::stri
 // Resolves the range and horizon for `problem_spec` (InputError when the problem has no
 // omega_max and the block asks in h·ω or periods) and checks them against the caps above, so a
 // search that would run for days is rejected when the scene is loaded.
-void check_stability_budget(const std::string& problem_spec, const StabilityOptions& options,
-                            const std::string& where);
-// The same for a problem object; `problem_spec` is the spelling the messages name.
+// `problem_spec` is the spelling the messages name.
 void check_stability_budget(const Problem& problem, const std::string& problem_spec,
                             const StabilityOptions& options, const std::string& where);
 

@@ -8,11 +8,18 @@
 #include <filesystem>
 #include <fstream>
 
+#include "harness/run_spec.hpp"
 #include "harness/sweep.hpp"
 #include "integrators/integrator.hpp"
 
 namespace geomint {
 namespace {
+
+// A search from the specs the test names.
+StabilityResult search(const std::string& problem, const std::string& method,
+                       const StabilityOptions& options) {
+  return stability_search(*parse_problem(problem), MethodFactory(method), options);
+}
 
 StabilityOptions fast_options() {
   StabilityOptions options;
@@ -24,7 +31,7 @@ StabilityOptions fast_options() {
 }
 
 TEST(Stability, StormerVerletLimitIsTwo) {
-  const auto result = stability_search("harmonic:omega=3", "stormer_verlet", fast_options());
+  const auto result = search("harmonic:omega=3", "stormer_verlet", fast_options());
   EXPECT_EQ(result.status, "bracketed");
   EXPECT_NEAR(result.homega_limit, 2.0, 1e-3);
   EXPECT_EQ(result.predicted, 2.0);
@@ -33,12 +40,12 @@ TEST(Stability, StormerVerletLimitIsTwo) {
 TEST(Stability, SymplecticEulerReachesTwoDespiteItsDegenerateInvariant) {
   // Close to hω = 2 the conserved quadratic form makes H/H₀ = 1/(1 − hω/2) while bounded: the
   // growth factor must not mistake this for instability.
-  const auto result = stability_search("harmonic", "symplectic_euler_a", fast_options());
+  const auto result = search("harmonic", "symplectic_euler_a", fast_options());
   EXPECT_NEAR(result.homega_limit, 2.0, 1e-3);
 }
 
 TEST(Stability, ExplicitEulerIsUnstableForEveryStep) {
-  const auto result = stability_search("harmonic", "explicit_euler", fast_options());
+  const auto result = search("harmonic", "explicit_euler", fast_options());
   EXPECT_EQ(result.status, "unstable_at_min");
   EXPECT_EQ(result.homega_limit, 0.0);
   EXPECT_EQ(result.predicted, 0.0);
@@ -46,7 +53,7 @@ TEST(Stability, ExplicitEulerIsUnstableForEveryStep) {
 
 TEST(Stability, ImplicitMidpointIsStableUpToTheTopOfTheRange) {
   for (const char* method : {"implicit_midpoint", "hp:alpha=0.5", "implicit_euler"}) {
-    const auto result = stability_search("harmonic", method, fast_options());
+    const auto result = search("harmonic", method, fast_options());
     EXPECT_EQ(result.status, "stable_to_max") << method;
     EXPECT_EQ(result.homega_limit, 200.0) << method;
     EXPECT_TRUE(std::isinf(result.predicted)) << method;
@@ -55,22 +62,22 @@ TEST(Stability, ImplicitMidpointIsStableUpToTheTopOfTheRange) {
 
 TEST(Stability, AlphaRuleFollowsOneOverDistanceFromOneHalf) {
   for (const double alpha : {0.25, 0.75}) {
-    const auto result =
-        stability_search("harmonic", "hp:alpha=" + format_number(alpha), fast_options());
+    const auto result = search("harmonic", "hp:alpha=" + format_number(alpha), fast_options());
     EXPECT_NEAR(result.homega_limit, 1 / std::abs(0.5 - alpha), 4e-3) << alpha;
   }
-  EXPECT_NEAR(stability_search("harmonic", "rk4", fast_options()).homega_limit, 2 * std::sqrt(2.0),
-              3e-3);
+  EXPECT_NEAR(search("harmonic", "rk4", fast_options()).homega_limit, 2 * std::sqrt(2.0), 3e-3);
 }
 
 TEST(Stability, PredictionsFromTheCanonicalSpec) {
-  EXPECT_EQ(predicted_homega_limit("hp:alpha=0.1"), 2.5);
-  EXPECT_EQ(predicted_homega_limit("del:rule=trapezoid"), 2.0);
-  EXPECT_TRUE(std::isinf(predicted_homega_limit("del")));
-  EXPECT_NEAR(predicted_homega_limit("del:rule=symmetric_alpha,alpha=0.25"), 4.0, 1e-15);
-  EXPECT_NEAR(predicted_homega_limit("newmark:beta=0.1,gamma=0.5"), 1 / std::sqrt(0.15), 1e-15);
-  EXPECT_TRUE(std::isinf(predicted_homega_limit("newmark:beta=0.25,gamma=0.5")));
-  EXPECT_TRUE(std::isnan(predicted_homega_limit("odeint_mclachlan4")));
+  EXPECT_EQ(predicted_homega_limit(MethodFactory("hp:alpha=0.1")), 2.5);
+  EXPECT_EQ(predicted_homega_limit(MethodFactory("del:rule=trapezoid")), 2.0);
+  EXPECT_TRUE(std::isinf(predicted_homega_limit(MethodFactory("del"))));
+  EXPECT_NEAR(predicted_homega_limit(MethodFactory("del:rule=symmetric_alpha,alpha=0.25")), 4.0,
+              1e-15);
+  EXPECT_NEAR(predicted_homega_limit(MethodFactory("newmark:beta=0.1,gamma=0.5")),
+              1 / std::sqrt(0.15), 1e-15);
+  EXPECT_TRUE(std::isinf(predicted_homega_limit(MethodFactory("newmark:beta=0.25,gamma=0.5"))));
+  EXPECT_TRUE(std::isnan(predicted_homega_limit(MethodFactory("odeint_mclachlan4"))));
 }
 
 // Every method of the registry, in every configuration the registry tests, predicts its linear
@@ -92,7 +99,7 @@ TEST(Stability, EveryMethodPredictsItsLimitOrSaysWhyNot) {
     // problems only: the harmonic search cannot run it.
     if (!applicable(*integrator, *make_problem("harmonic")).ok) continue;
     ++compared;
-    const auto result = stability_search("harmonic", spec, options);
+    const auto result = search("harmonic", spec, options);
     EXPECT_EQ(result.predicted, prediction.homega_limit) << spec;
     if (std::isinf(prediction.homega_limit)) {
       EXPECT_EQ(result.status, "stable_to_max") << spec;
@@ -110,15 +117,15 @@ TEST(Stability, BadInputNamesTheKey) {
   StabilityOptions options = fast_options();
   options.homega_max = options.homega_min / 2;
   try {
-    stability_search("harmonic", "rk4", options);
+    search("harmonic", "rk4", options);
     FAIL() << "expected InputError";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("homega_max"), std::string::npos) << error.what();
   }
-  EXPECT_THROW(stability_search("harmonic", "cvode_bdf", fast_options()), InputError);
+  EXPECT_THROW(search("harmonic", "cvode_bdf", fast_options()), InputError);
   options = fast_options();
   options.growth = 0.5;
-  EXPECT_THROW(stability_search("harmonic", "rk4", options), InputError);
+  EXPECT_THROW(search("harmonic", "rk4", options), InputError);
 }
 
 // A scene with one [[stability]] block: parsed, run by the sweep, written to stability.csv.

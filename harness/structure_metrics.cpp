@@ -176,11 +176,6 @@ double symplecticity_defect(const Eigen::MatrixXd& tangent) {
          std::max(1.0, size * size);
 }
 
-double symplecticity_defect(const std::string& method_spec, const Problem& problem,
-                            const State& state, double h) {
-  return symplecticity_defect(MethodFactory(method_spec), problem, state, h);
-}
-
 double symplecticity_defect(const MethodFactory& factory, const Problem& problem,
                             const State& state, double h) {
   const auto method = factory.make();
@@ -256,11 +251,6 @@ double rayleigh_quotient(const SparseMatrix& stiffness, const Vec& mass, const V
 
 }  // namespace
 
-std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
-                                                const Problem& problem, double h) {
-  return discrete_normal_modes(MethodFactory(method_spec), problem, h);
-}
-
 std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
                                                 const Problem& problem, double h) {
   const auto method = factory.make();
@@ -312,14 +302,6 @@ std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& factory,
   return modes;
 }
 
-void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
-                             const std::vector<std::string>& names,
-                             std::map<std::string, double>& metrics) {
-  if (!requested(names, metric::mode_freq_err_max) && !requested(names, metric::mode_damping_max))
-    return;
-  add_normal_mode_metrics(MethodFactory(method_spec), problem, h, names, metrics);
-}
-
 void add_normal_mode_metrics(const MethodFactory& factory, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics) {
@@ -362,10 +344,10 @@ namespace {
 // trajectory: computed in finish() from the problem's initial state, whatever the run did.
 class StepMapObserver : public Observer {
  public:
-  StepMapObserver(const Problem& problem, std::string method_spec, double h,
+  StepMapObserver(const Problem& problem, MethodFactory method, double h,
                   std::vector<std::string> names, bool defect)
       : problem_(problem),
-        method_spec_(std::move(method_spec)),
+        method_(std::move(method)),
         h_(h),
         names_(std::move(names)),
         defect_(defect) {}
@@ -374,14 +356,14 @@ class StepMapObserver : public Observer {
   void finish(std::map<std::string, double>& metrics) const override {
     if (defect_) {
       metrics[metric::symplecticity_defect.key()] =
-          symplecticity_defect(method_spec_, problem_, problem_.initial_state(), h_);
+          symplecticity_defect(method_, problem_, problem_.initial_state(), h_);
     }
-    add_normal_mode_metrics(method_spec_, problem_, h_, names_, metrics);
+    add_normal_mode_metrics(method_, problem_, h_, names_, metrics);
   }
 
  private:
   const Problem& problem_;
-  std::string method_spec_;
+  MethodFactory method_;
   double h_;
   std::vector<std::string> names_;
   bool defect_;
@@ -389,22 +371,21 @@ class StepMapObserver : public Observer {
 
 }  // namespace
 
-std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
-                                                 const std::string& method_spec,
+std::unique_ptr<Observer> make_step_map_observer(const MethodFactory& method,
                                                  const Problem& problem, double h,
                                                  const std::vector<std::string>& names) {
   const bool defect = requested(names, metric::symplecticity_defect) &&
-                      symplecticity_defect_applies(method, problem);
+                      symplecticity_defect_applies(method.prototype(), problem);
   const bool modes =
       requested(names, metric::mode_freq_err_max) || requested(names, metric::mode_damping_max);
   if (!defect && !modes) return nullptr;
-  return std::make_unique<StepMapObserver>(problem, method_spec, h, names, defect);
+  return std::make_unique<StepMapObserver>(problem, method, h, names, defect);
 }
 
 void add_step_map_observer(const ObserverContext& context, ObserverList& observers) {
-  if (context.integrator == nullptr) return;
-  if (auto observer = make_step_map_observer(*context.integrator, *context.method_spec,
-                                             context.problem, context.dt, context.metrics)) {
+  if (context.method == nullptr) return;
+  if (auto observer =
+          make_step_map_observer(*context.method, context.problem, context.dt, context.metrics)) {
     observers.push_back(std::move(observer));
   }
 }

@@ -32,8 +32,6 @@ void check_optional_metrics(const std::vector<std::string>& names, const std::st
 // off, docs/USAGE.md "Optional structure metrics") is measured by tests/structure_metrics_test.cpp.
 double symplecticity_defect(const MethodFactory& method, const Problem& problem, const State& state,
                             double h);
-double symplecticity_defect(const std::string& method_spec, const Problem& problem,
-                            const State& state, double h);
 // The same defect of a given 2n×2n DΦ.
 double symplecticity_defect(const Eigen::MatrixXd& tangent);
 
@@ -71,22 +69,16 @@ std::string normal_modes_not_applicable(const Integrator& method, const Problem&
 // one). Empty when not applicable or the step fails.
 std::vector<DiscreteMode> discrete_normal_modes(const MethodFactory& method, const Problem& problem,
                                                 double h);
-std::vector<DiscreteMode> discrete_normal_modes(const std::string& method_spec,
-                                                const Problem& problem, double h);
 // mode_freq_err_max = max over modes with ω > 0 of |ω̃ − ω|/ω, mode_damping_max = max |ρ − 1|;
 // added to `metrics` when asked for in `names` and applicable.
 void add_normal_mode_metrics(const MethodFactory& method, const Problem& problem, double h,
                              const std::vector<std::string>& names,
                              std::map<std::string, double>& metrics);
-void add_normal_mode_metrics(const std::string& method_spec, const Problem& problem, double h,
-                             const std::vector<std::string>& names,
-                             std::map<std::string, double>& metrics);
 
 // The observer of the requested metrics of `method`'s one-step map on `problem` with step h
 // (symplecticity_defect when it applies, mode_freq_err_max, mode_damping_max), computed when the
-// run finishes; nullptr when none is requested. `method_spec` builds the fresh integrators.
-std::unique_ptr<Observer> make_step_map_observer(const Integrator& method,
-                                                 const std::string& method_spec,
+// run finishes; nullptr when none is requested. `method` makes the fresh integrators.
+std::unique_ptr<Observer> make_step_map_observer(const MethodFactory& method,
                                                  const Problem& problem, double h,
                                                  const std::vector<std::string>& names);
 

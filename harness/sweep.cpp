@@ -181,10 +181,10 @@ std::string series_name(const RunBlock& block, const std::string& problem,
 // the name's defaults ("hp:alpha=0" for the canonical "hp:alpha=0,force_at=midpoint,..."). The
 // label must name the same configuration: when it does not rebuild the canonical spec (a
 // default that depends on another option), or the spec is unknown to this build, the canonical
-// spec is shown as it is.
-std::string short_spec(const std::string& column, const std::string& canonical) {
+// spec is shown as it is. `specs` holds the objects already parsed (the scene's).
+std::string short_spec(const std::string& column, const std::string& canonical, SpecBook& specs) {
   const auto canonical_of = [&](const std::string& text) {
-    return column == "method" ? make_integrator(text)->spec() : make_problem(text)->spec();
+    return column == "method" ? specs.method(text).spec() : specs.problem(text)->spec();
   };
   try {
     const Spec spec = Spec::parse(canonical);
@@ -204,11 +204,11 @@ std::string short_spec(const std::string& column, const std::string& canonical) 
   }
 }
 
-std::vector<Row> with_short_specs(std::vector<Row> rows) {
+std::vector<Row> with_short_specs(std::vector<Row> rows, SpecBook& specs) {
   for (Row& row : rows) {
     for (const char* column : {"method", "problem"}) {
       const auto found = row.find(column);
-      if (found != row.end()) found->second = short_spec(column, found->second);
+      if (found != row.end()) found->second = short_spec(column, found->second, specs);
     }
   }
   return rows;
@@ -216,15 +216,10 @@ std::vector<Row> with_short_specs(std::vector<Row> rows) {
 
 // A message that quotes the method's canonical spec, with the short label table.md shows
 // instead: the reason a row was skipped reads "method 'hp'", not every default of hp.
-std::string short_specs_in(std::string message, const std::string& method) {
-  std::string canonical;
-  try {
-    canonical = make_integrator(method)->spec();
-  } catch (const InputError&) {
-    return message;
-  }
+std::string short_specs_in(std::string message, const MethodFactory& method, SpecBook& specs) {
+  const std::string& canonical = method.spec();
   const std::string from = "'" + canonical + "'";
-  const std::string to = "'" + short_spec("method", canonical) + "'";
+  const std::string to = "'" + short_spec("method", canonical, specs) + "'";
   for (auto at = message.find(from); at != std::string::npos; at = message.find(from, at)) {
     message.replace(at, from.size(), to);
     at += to.size();
@@ -287,7 +282,7 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
             job.config.series_section = block.series_section;
             if (block.series_section >= 0) {
               try {
-                check_series_section(*make_problem(problem), block.series_section);
+                check_series_section(*scene.specs->problem(problem), block.series_section);
               } catch (const InputError& error) {
                 throw InputError(fmt::format("[[runs]] '{}': {}", block.label, error.what()));
               }
@@ -504,6 +499,7 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;
   auto& stability_jobs = plan.stability_jobs;
+  SpecBook& specs = *scene.specs;
   const bool sharded = options.shard_count > 0;
   const ShardId shard{options.shard_index, options.shard_count};
   // The shards of one sweep write disjoint files and share the folder; anything else owns it.
@@ -546,11 +542,13 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     if (i < jobs.size()) {
       Job& job = jobs[i];
       try {
-        RunSpec spec = RunSpec::parse(job.problem, job.method, job.config);
+        // The objects load_scene parsed (a Scene built in code: parsed here, once per spec).
+        RunSpec spec{specs.problem(job.problem), specs.method(job.method), job.config};
         if (const auto reason = inapplicable(spec)) {
           // A scene's problems × methods product may pair an unconstrained method with a
           // constrained problem (or the reverse): a row that says why, not a run.
-          job.record = error_record(job.problem, job.method, short_specs_in(*reason, job.method));
+          job.record =
+              error_record(job.problem, job.method, short_specs_in(*reason, spec.method, specs));
           job.record.status = "skipped";
           job.ok = false;
           job.record.label = job.label;
@@ -569,8 +567,9 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
     } else {
       OrderJob& job = order_jobs[i - jobs.size()];
       try {
-        job.study = order_study(job.problem, job.method, job.block->dt0, job.block->levels,
-                                job.block->t_end, job.block->diverge_factor);
+        job.study =
+            order_study(specs.problem(job.problem), specs.method(job.method), job.block->dt0,
+                        job.block->levels, job.block->t_end, job.block->diverge_factor);
       } catch (const std::exception& error) {
         job.study = OrderStudy{};
         job.study.record = error_record<OrderRecord>(job.problem, job.method, error.what());
@@ -582,7 +581,8 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   parallel_for(stability_units.size(), options.jobs, [&](size_t unit) {
     StabilityJob& job = stability_jobs[stability_units[unit]];
     try {
-      job.row = stability_search(job.problem, job.method, *job.options).row;
+      job.row =
+          stability_search(*specs.problem(job.problem), specs.method(job.method), *job.options).row;
     } catch (const std::exception& error) {
       // E.g. a problem without omega_max given an h*omega range: a row, not a crashed thread.
       job.row = to_row(error_record(job.problem, job.method, error.what()));
@@ -774,7 +774,8 @@ void run_timing_only(const Scene& scene, const SweepOptions& options) {
 }
 
 std::vector<Row> rows_with_short_specs(std::vector<Row> rows) {
-  return with_short_specs(std::move(rows));
+  SpecBook specs;
+  return with_short_specs(std::move(rows), specs);
 }
 
 TableCitation table_citation(const std::vector<std::pair<std::string, std::string>>& lines,
@@ -868,19 +869,19 @@ std::string scene_markdown(const Scene& scene, const SceneTables& tables,
     const auto columns = scene.table_columns.empty()
                              ? column_union(tables.summary, standard_columns())
                              : scene.table_columns;
-    markdown +=
-        "## Runs (summary.csv)\n\n" + to_markdown(with_short_specs(tables.summary), columns) + "\n";
+    markdown += "## Runs (summary.csv)\n\n" +
+                to_markdown(with_short_specs(tables.summary, *scene.specs), columns) + "\n";
   }
   if (!tables.order.empty()) {
     markdown +=
         "## Fitted convergence orders (order.csv)\n\n" +
-        to_markdown(with_short_specs(tables.order),
+        to_markdown(with_short_specs(tables.order, *scene.specs),
                     {"problem", "method", "order", "declared_order", "points_used", "message"}) +
         "\n";
   }
   if (!tables.stability.empty()) {
     markdown += "## Largest stable h*omega (stability.csv)\n\n" +
-                to_markdown(with_short_specs(tables.stability),
+                to_markdown(with_short_specs(tables.stability, *scene.specs),
                             {"label", "problem", "method", "homega_max_measured", "predicted",
                              "rel_diff", "status", "message"},
                             6) +

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 
 #include "harness/report.hpp"
 #include "harness/table.hpp"
@@ -181,6 +183,65 @@ TEST(TomlReader, MessagesNameBlockAndKey) {
   }
   EXPECT_THROW(block.integer("k", true, 0, 2, 5), InputError);
   EXPECT_THROW(block.string("missing", true), InputError);
+}
+
+// Every spec text a sweep reads is parsed once (scene.hpp's SpecBook): checking the scene, its
+// runs with the optional metrics whose observers step the method themselves, the timing pass,
+// an order study, a stability search and table.md's short labels all read the same objects.
+// Counted where the registries parse (problems/spec.hpp's test hook).
+std::mutex parse_count_mutex;
+std::map<std::string, int> parse_counts;
+
+void count_parse(const std::string& text) {
+  const std::lock_guard<std::mutex> lock(parse_count_mutex);
+  ++parse_counts[text];
+}
+
+TEST(SweepSpecs, EachSpecIsParsedOncePerSweep) {
+  const fs::path dir = fs::path(testing::TempDir()) / "geomint_sweep_parse_once";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml")
+      << "title = \"t\"\n"
+         "table_columns = [\"label\", \"problem\", \"method\", \"symplecticity_defect\", "
+         "\"mode_freq_err_max\", \"modified_energy_err_max\", \"symplecticity_defect_map\", "
+         "\"lyapunov_max\", \"megno\", \"valid_time\"]\n"
+         "[[runs]]\nlabel = \"a\"\nproblems = [\"harmonic:omega=2\", \"kepler:e=0.3\", "
+         "\"henon_heiles\"]\n"
+         "methods = [\"stormer_verlet\", \"implicit_midpoint\"]\ndt = 0.05\nt_end = 0.5\n"
+         "timing_repeats = 1\nquick_t_end = 0.25\n"
+         "[[orders]]\nlabel = \"o\"\nproblems = [\"harmonic:omega=2\"]\n"
+         "methods = [\"stormer_verlet\"]\ndt0 = 0.1\nlevels = 3\nt_end = 1.0\n"
+         "[[stability]]\nlabel = \"s\"\nproblems = [\"harmonic\"]\nmethods = [\"stormer_verlet\"]\n"
+         "homega_max = 10.0\nperiods = 10.0\nmin_steps = 100\n";
+  {
+    const std::lock_guard<std::mutex> lock(parse_count_mutex);
+    parse_counts.clear();
+  }
+  set_spec_parse_hook(&count_parse);
+  const Scene scene = load_scene((dir / "scene.toml").string(), false);
+  SweepOptions options;
+  options.out_dir = dir.string();
+  options.progress = false;
+  options.jobs = 2;
+  options.command_line = "geomint sweep scene.toml";
+  const int failed = run_sweep(scene, options);
+  set_spec_parse_hook(nullptr);
+  EXPECT_EQ(failed, 0);
+  const CsvTable summary = read_csv_file((dir / "summary.csv").string());
+  ASSERT_EQ(summary.rows.size(), 6u);
+  // The observers ran (their columns are filled), so their parses were counted too.
+  EXPECT_NE(summary.rows[0].at("symplecticity_defect"), "");
+  EXPECT_NE(summary.rows[0].at("modified_energy_err_max"), "");
+  EXPECT_NE(summary.rows[0].at("symplecticity_defect_map"), "");
+  EXPECT_NE(summary.rows[0].at("lyapunov_max"), "");
+  const std::lock_guard<std::mutex> lock(parse_count_mutex);
+  for (const std::string text : {"harmonic:omega=2", "kepler:e=0.3", "henon_heiles", "harmonic",
+                                 "stormer_verlet", "implicit_midpoint"}) {
+    EXPECT_EQ(parse_counts[text], 1) << "'" << text << "'";
+  }
+  for (const auto& [text, count] : parse_counts) EXPECT_LE(count, 1) << "'" << text << "'";
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -88,6 +88,7 @@ const IntegratorEntry& find_method(const Spec& spec) {
 }  // namespace
 
 std::unique_ptr<Integrator> make_integrator(const std::string& spec_text) {
+  notify_spec_parse(spec_text);
   const Spec spec = Spec::parse(spec_text);
   const IntegratorEntry& entry = find_method(spec);
   Params params(spec, fmt::format("method '{}'", spec.name));

@@ -61,6 +61,7 @@ std::unique_ptr<Problem> with_initial_state_file(std::unique_ptr<Problem> proble
                                                  const std::string& path);
 
 std::unique_ptr<Problem> make_problem(const std::string& spec_text) {
+  notify_spec_parse(spec_text);
   Spec spec = Spec::parse(spec_text);
   // `initial=FILE.csv` belongs to every problem: it replaces the start after construction.
   std::string initial_file;

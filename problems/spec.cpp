@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -27,7 +28,15 @@ bool valid_identifier(const std::string& s) {
   return true;
 }
 
+std::atomic<SpecParseHook> spec_parse_hook{nullptr};
+
 }  // namespace
+
+void set_spec_parse_hook(SpecParseHook hook) { spec_parse_hook.store(hook); }
+
+void notify_spec_parse(const std::string& text) {
+  if (const SpecParseHook hook = spec_parse_hook.load()) hook(text);
+}
 
 Spec Spec::parse(const std::string& text) {
   Spec spec;

@@ -28,6 +28,14 @@ struct Spec {
   static Spec parse(const std::string& text);
 };
 
+// A test hook: when set, called with the text of every problem and method spec that make_problem
+// and make_integrator parse, on the thread that parses it (harness/sweep_test.cpp counts
+// the parses of a sweep with it). nullptr (the default): nothing is called.
+using SpecParseHook = void (*)(const std::string& text);
+void set_spec_parse_hook(SpecParseHook hook);
+// Called by make_problem and make_integrator with the text they parse.
+void notify_spec_parse(const std::string& text);
+
 // The extra parameter sets a registry entry lists for the registry-driven tests
 // (integrators/registry.def, problems/registry.def): "a=1;a=2,b=3" -> {"a=1", "a=2,b=3"}.
 std::vector<std::string> split_variants(const std::string& text);

@@ -136,7 +136,8 @@ TEST(ConstrainedKkt, OrderOnTheCartesianPendulum) {
            {"hp:solver=newton", 2.0},
            {"del:rule=midpoint", 2.0},
            {"composition:base=hp_midpoint", 4.0}}) {
-    const OrderStudy study = order_study(problem, method, 0.1, 6, 10.0);
+    const OrderStudy study =
+        order_study(parse_problem(problem), MethodFactory(method), 0.1, 6, 10.0);
     ASSERT_TRUE(std::isfinite(study.fit.order)) << method << ": " << study.fit.note;
     EXPECT_NEAR(study.fit.order, order, order == 2.0 ? 0.15 : 0.3) << method;
   }

@@ -191,7 +191,8 @@ TEST(Constraints, DeclaredOrderOnTheConicalSphericalPendulum) {
   for (const auto& method : constraint_keeping_methods()) {
     const int declared = make_integrator(method)->info().order;
     const double dt0 = declared >= 6 ? 0.4 : declared >= 4 ? 0.2 : 0.1;
-    const OrderStudy study = order_study(problem, method, dt0, declared >= 6 ? 5 : 7, 10.0);
+    const OrderStudy study = order_study(parse_problem(problem), MethodFactory(method), dt0,
+                                         declared >= 6 ? 5 : 7, 10.0);
     ASSERT_TRUE(std::isfinite(study.fit.order)) << method << ": " << study.fit.note;
     EXPECT_NEAR(study.fit.order, declared, declared == 2 ? 0.15 : 0.3)
         << method << " (points " << to_row(study.record).at("points_used") << ")";
@@ -210,7 +211,8 @@ TEST_P(SeparateOrders, QPAndMultiplierOrdersOnTheCartesianPendulum) {
   const std::string problem = "cartesian_pendulum:theta0=1.2,mass=2,length=1.5,gravity=3";
   const int declared = make_integrator(method)->info().order;
   const double dt0 = declared >= 6 ? 0.4 : declared >= 4 ? 0.2 : 0.1;
-  const OrderStudy study = order_study(problem, method, dt0, declared >= 6 ? 4 : 5, 1.0);
+  const OrderStudy study =
+      order_study(parse_problem(problem), MethodFactory(method), dt0, declared >= 6 ? 4 : 5, 1.0);
   const OrderRecord& record = study.record;
   ASSERT_TRUE(record.order_q && record.order_p) << record.message.value_or("");
   EXPECT_NEAR(*record.order_q, declared, 0.3);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 
 namespace geomint {
@@ -25,7 +26,7 @@ const std::vector<std::string> kProblems = {
 
 MapDefect defect_at_start(const std::string& method, const std::string& problem_spec, double h) {
   const auto problem = make_problem(problem_spec);
-  return symplecticity_defect_map(method, *problem, problem->initial_state(), h);
+  return symplecticity_defect_map(MethodFactory(method), *problem, problem->initial_state(), h);
 }
 
 // Every declared-symplectic method in the registry (fixed-step, unconstrained) on both problems:
@@ -69,8 +70,8 @@ TEST(MapDefect, DeclaredFlagAgreesWithTheComputedMapForEveryFixedStepMethod) {
     // rkn:table=dprkn6 measures 9.6e-10 against a floor of 1.9e-9, so it is measured at h = 0.2.
     const bool high_order_explicit =
         !(method->info().flags & kSymplectic) && method->info().order >= 6;
-    const MapDefect value = symplecticity_defect_map(spec, *problem, problem->initial_state(),
-                                                     high_order_explicit ? 0.2 : 0.05);
+    const MapDefect value = symplecticity_defect_map(
+        MethodFactory(spec), *problem, problem->initial_state(), high_order_explicit ? 0.2 : 0.05);
     if (method->info().flags & kSymplectic) {
       EXPECT_LE(value.defect, value.fd_error) << spec;
       ++symplectic;

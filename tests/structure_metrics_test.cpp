@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 
 namespace geomint {
 namespace {
@@ -28,7 +29,7 @@ constexpr double kDefectFloor = 1e-14;
 
 double defect(const std::string& method, const std::string& problem_spec, double h) {
   const auto problem = make_problem(problem_spec);
-  return symplecticity_defect(method, *problem, problem->initial_state(), h);
+  return symplecticity_defect(MethodFactory(method), *problem, problem->initial_state(), h);
 }
 
 RunRecord run_with(const std::string& problem, const std::string& method, double dt, double t_end,
@@ -52,7 +53,8 @@ TEST(SymplecticityDefect, DeclaredSymplecticMethodsSitAtTheFloor) {
         !symplecticity_defect_applies(*method, *problem)) {
       continue;
     }
-    const double value = symplecticity_defect(spec, *problem, problem->initial_state(), 0.05);
+    const double value =
+        symplecticity_defect(MethodFactory(spec), *problem, problem->initial_state(), 0.05);
     std::printf("%-50s defect %.3g\n", spec.c_str(), value);
     EXPECT_LE(value, kDefectFloor) << spec;
     ++checked;
@@ -108,7 +110,8 @@ TEST(SymplecticityDefect, IsNotApplicableWithoutALinearisedStep) {
   const auto kepler = make_problem("kepler");
   for (const std::string spec : {"odeint_velocity_verlet", "adaptive_verlet", "cvode_bdf"}) {
     EXPECT_NE(symplecticity_defect_not_applicable(*make_integrator(spec), *kepler), "") << spec;
-    EXPECT_TRUE(std::isnan(symplecticity_defect(spec, *kepler, kepler->initial_state(), 0.05)));
+    EXPECT_TRUE(std::isnan(
+        symplecticity_defect(MethodFactory(spec), *kepler, kepler->initial_state(), 0.05)));
   }
   EXPECT_NE(symplecticity_defect_not_applicable(*make_integrator("stormer_verlet"),
                                                 *make_problem("damped_oscillator")),
@@ -144,7 +147,7 @@ TEST(NormalModes, DiscreteFrequenciesFollowTheClosedForms) {
       {"explicit_euler", [](double h, double w) { return std::atan(h * w) / h; },
        [](double h, double w) { return std::sqrt(1 + h * h * w * w); }}};
   for (const Case& c : cases) {
-    const std::vector<DiscreteMode> modes = discrete_normal_modes(c.spec, *chain, h);
+    const std::vector<DiscreteMode> modes = discrete_normal_modes(MethodFactory(c.spec), *chain, h);
     ASSERT_EQ(modes.size(), 5u) << c.spec;
     EXPECT_LE(modes.front().omega, 1e-7) << "the free chain's translation";
     for (const DiscreteMode& mode : modes) {
@@ -175,7 +178,8 @@ TEST(NormalModes, SlowModesOfALongChainToFullRelativePrecision) {
     const bool fixed = ends != "free";
     const auto chain = make_problem("spring_chain:n=199,mass=0.7,stiffness=1.3,ends=" + ends);
     for (const std::string method : {"stormer_verlet", "implicit_midpoint"}) {
-      const std::vector<DiscreteMode> modes = discrete_normal_modes(method, *chain, h);
+      const std::vector<DiscreteMode> modes =
+          discrete_normal_modes(MethodFactory(method), *chain, h);
       ASSERT_EQ(modes.size(), static_cast<size_t>(kMasses)) << method;
       double worst_omega = 0, worst_discrete = 0;
       for (int i = 0; i < kMasses; ++i) {

@@ -27,6 +27,7 @@
 #include "harness/reference.hpp"
 #include "harness/reference_generator.hpp"
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/shard_files.hpp"
 #include "harness/stability.hpp"
 #include "harness/table.hpp"
@@ -188,7 +189,8 @@ TEST(TableRoundTrip, StabilityRows) {
   options.periods = 10;
   options.min_steps = 100;
   options.growth = 1 + kThird;
-  const StabilityResult result = stability_search("harmonic", "stormer_verlet", options);
+  const StabilityResult result =
+      stability_search(*parse_problem("harmonic"), MethodFactory("stormer_verlet"), options);
   const fs::path dir = scratch("stability");
   const std::string path = (dir / "stability.csv").string();
   write_file_atomic(path, to_csv({result.row}, column_union({result.row}, stability_columns()),

@@ -13,7 +13,8 @@ namespace geomint {
 namespace {
 
 double fitted_order(const std::string& method) {
-  const OrderStudy study = order_study("pendulum:theta0=1.5", method, 0.1, 7, 5.0);
+  const OrderStudy study =
+      order_study(parse_problem("pendulum:theta0=1.5"), MethodFactory(method), 0.1, 7, 5.0);
   return study.fit.order;
 }
 

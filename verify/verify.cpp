@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "harness/map_defect.hpp"
+#include "harness/metrics.hpp"
 #include "harness/order.hpp"
 #include "harness/run.hpp"
 #include "harness/run_spec.hpp"
@@ -111,8 +112,8 @@ CheckResult energy_without_drift(const MethodFactory& factory, const ProblemPtr&
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
     return result;
   }
-  const double drift = run.record.metrics.at("energy_drift");
-  const double err_max = run.record.metrics.at("energy_err_max");
+  const double drift = run.record.metrics.at(metric::energy_drift.key());
+  const double err_max = run.record.metrics.at(metric::energy_err_max.key());
   result.measured = std::abs(drift) * t_end / err_max;
   result.passed = result.measured < result.bound && err_max < 0.1;
   result.detail = fmt::format(
@@ -292,8 +293,8 @@ CheckResult constraint_kept(const MethodFactory& method, const ProblemPtr& probl
     result.detail = "the run failed: " + run.record.message.value_or(run.record.status);
     return result;
   }
-  const double position = run.record.metrics.at("constraint_err_max") / length;
-  const double velocity = run.record.metrics.at("constraint_vel_err_max") / speed;
+  const double position = run.record.metrics.at(metric::constraint_err_max.key()) / length;
+  const double velocity = run.record.metrics.at(metric::constraint_vel_err_max.key()) / speed;
   result.measured = std::max(position, velocity);
   result.passed = result.measured <= bound;
   result.detail =

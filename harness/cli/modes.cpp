@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "harness/cli/verbs.hpp"
+#include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/problem.hpp"
@@ -19,16 +20,15 @@ struct ModesOptions {
 
 int run_modes(const ModesOptions& options, const Context& context) {
   if (!(options.dt > 0)) throw InputError(fmt::format("--dt must be > 0 (got {})", options.dt));
-  const auto problem = make_problem(options.problem_spec);
-  const auto method = make_integrator(options.method_spec);
-  const Applicability can_run = applicable(*method, *problem);
+  const auto problem = parse_problem(options.problem_spec);
+  const MethodFactory method(options.method_spec);
+  const Applicability can_run = applicable(method.prototype(), *problem);
   if (!can_run.ok) throw InputError(can_run.reason);
-  const std::string why_not = normal_modes_not_applicable(*method, *problem);
+  const std::string why_not = normal_modes_not_applicable(method.prototype(), *problem);
   if (!why_not.empty()) {
-    throw InputError(fmt::format("modes: {} on {}: {}", method->spec(), problem->spec(), why_not));
+    throw InputError(fmt::format("modes: {} on {}: {}", method.spec(), problem->spec(), why_not));
   }
-  const std::vector<DiscreteMode> table =
-      discrete_normal_modes(options.method_spec, *problem, options.dt);
+  const std::vector<DiscreteMode> table = discrete_normal_modes(method, *problem, options.dt);
   if (table.empty()) {
     fmt::print(stderr, "{}: modes: the step failed\n", context.program);
     return kExitFailed;

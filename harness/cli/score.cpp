@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "harness/cli/verbs.hpp"
+#include "harness/metrics.hpp"
 #include "harness/paths.hpp"
 #include "harness/run_spec.hpp"
 #include "harness/table.hpp"
@@ -79,8 +80,8 @@ int run_score(const ScoreOptions& options, const Context& context) {
     const auto cell = [&](const std::string& key) {
       return row.count(key) ? row.at(key) : std::string("-");
     };
-    inform(context,
-           fmt::format("{}: dt={} error_final={}", record.method, cell("dt"), cell("error_final")));
+    inform(context, fmt::format("{}: dt={} error_final={}", record.method, cell("dt"),
+                                cell(metric::error_final.key())));
   }
   if (!std::isfinite(fit->order)) {
     fmt::print(stderr, "{}: no order fit: {}\n", context.program, fit->note);
