@@ -12,6 +12,7 @@
 
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
+#include "problems/structures/kepler_orbit.hpp"
 
 namespace geomint {
 namespace {
@@ -67,7 +68,7 @@ double eccentric_anomaly(double mean_anomaly, double e) {
   throw std::logic_error("kepler: Newton iteration for Kepler's equation did not converge");
 }
 
-class Kepler final : public Problem {
+class Kepler final : public Problem, public KeplerOrbitStructure {
  public:
   explicit Kepler(double e) : e_(e), minor_axis_(std::sqrt((1 - e) * (1 + e))) {
     set_mass(Vec::Ones(2));
@@ -117,6 +118,14 @@ class Kepler final : public Problem {
   Vec angular_momentum(const Vec& q, const Vec& p) const override {
     return Vec::Constant(1, q[0] * p[1] - q[1] * p[0]);
   }
+  const void* structure(const StructureKey& key) const override {
+    if (auto* s = offer<KeplerOrbitStructure>(key, this)) return s;
+    return Problem::structure(key);
+  }
+  // Unit masses and μ = 1: x and v are q and p.
+  Eigen::Vector3d eccentricity_vector(const Vec& q, const Vec& p) const override {
+    return geomint::eccentricity_vector({q[0], q[1], 0}, {p[0], p[1], 0}, 1.0);
+  }
   // The fastest rate on the orbit, the angular velocity at perihelion L/r² = √((1+e)/(1−e)³),
   // which also bounds the linearised tangential frequency r^(−3/2) there; independent of q
   // because a fixed step has to resolve the whole orbit.
@@ -128,7 +137,7 @@ class Kepler final : public Problem {
 };
 
 // Polar coordinates q = (r, φ), p = (p_r, p_φ) = (ṙ, r²φ̇); unit mass and μ = 1 as Kepler.
-class KeplerPolar final : public Problem, public LagrangianSystem {
+class KeplerPolar final : public Problem, public LagrangianSystem, public KeplerOrbitStructure {
  public:
   const LagrangianSystem* as_lagrangian() const override { return this; }
   explicit KeplerPolar(double e) : cartesian_(e), e_(e) {
@@ -179,6 +188,17 @@ class KeplerPolar final : public Problem, public LagrangianSystem {
   }
   double period() const override { return 2 * kPi; }
   Vec angular_momentum(const Vec&, const Vec& p) const override { return Vec::Constant(1, p[1]); }
+  const void* structure(const StructureKey& key) const override {
+    if (auto* s = offer<KeplerOrbitStructure>(key, this)) return s;
+    return Problem::structure(key);
+  }
+  // x = r r̂ and v = ṙ r̂ + rφ̇ φ̂ with ṙ = p_r, rφ̇ = p_φ/r.
+  Eigen::Vector3d eccentricity_vector(const Vec& q, const Vec& p) const override {
+    const Eigen::Vector3d radial(std::cos(q[1]), std::sin(q[1]), 0);
+    const Eigen::Vector3d angular(-radial[1], radial[0], 0);
+    return geomint::eccentricity_vector(q[0] * radial, p[0] * radial + (p[1] / q[0]) * angular,
+                                        1.0);
+  }
   // The observable that crosses 0 upwards once per orbit, as Kepler's x: r cos φ.
   double period_observable(const Vec& q, const Vec&) const override {
     return q[0] * std::cos(q[1]);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "problems/problem.hpp"
+#include "problems/structures/kepler_orbit.hpp"
 
 namespace geomint {
 namespace {
@@ -120,7 +121,7 @@ void to_centre_of_mass_frame(NBodyData& data) {
 }
 
 template <int Dim>
-class NBody final : public Problem {
+class NBody final : public Problem, public KeplerOrbitStructure {
  public:
   using Point = Eigen::Matrix<double, Dim, 1>;
 
@@ -226,6 +227,21 @@ class NBody final : public Problem {
       }
       return Vec::Constant(1, total);
     }
+  }
+
+  // Two bodies move on a Kepler orbit relative to each other; more do not.
+  const void* structure(const StructureKey& key) const override {
+    if (bodies_ == 2) {
+      if (auto* s = offer<KeplerOrbitStructure>(key, this)) return s;
+    }
+    return Problem::structure(key);
+  }
+  // x = x₂ − x₁, v = p₂/m₂ − p₁/m₁, μ = G(m₁ + m₂).
+  Eigen::Vector3d eccentricity_vector(const Vec& q, const Vec& p) const override {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+    x.template head<Dim>() = body(q, 1) - body(q, 0);
+    v.template head<Dim>() = body(p, 1) / masses_[1] - body(p, 0) / masses_[0];
+    return geomint::eccentricity_vector(x, v, gravity_ * (masses_[0] + masses_[1]));
   }
 
   // The second body's first coordinate relative to the centre of mass, which moves uniformly in

@@ -131,7 +131,8 @@ Verb add_run(CLI::App& app) {
                       "mode_freq_err_max, mode_damping_max, symplecticity_defect_map (with "
                       "symplecticity_defect_map_fd_err and symplecticity_defect_map_slope), "
                       "lyapunov_max, megno (with megno_final and chaos_tangent_fd), valid_time "
-                      "(with valid_time_reached)");
+                      "(with valid_time_reached), toda_invariants_err_max, lrl_err_max, "
+                      "loop_action_err (with loop_action_points)");
   command->add_option("--initial", options->initial_path, kInitialStateHelp);
   return {"run", command, [options, command](const Context& context) {
             RunOptions given = *options;
