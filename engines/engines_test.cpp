@@ -7,6 +7,7 @@
 #include <random>
 
 #include "engines/mujoco.hpp"
+#include "engines/ode.hpp"
 #include "engines/planar_chain.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/lagrangian.hpp"
@@ -163,6 +164,70 @@ TEST(MujocoApplicability, RefusesOtherProblemsNamingThoseThatApply) {
   }
   for (const auto& spec : kChainSpecs) EXPECT_TRUE(applicable(*method, *make_problem(spec)).ok);
   EXPECT_EQ(method->provider().label(), "engine:MuJoCo");
+}
+
+// ODE keeps the chain in maximal coordinates (one body per rod), so it has no joint-space mass
+// matrix: its kinetic energy at random velocities stands in, since the quadratic form determines
+// M(θ); the potential as for MuJoCo, and the state survives the trip into the bodies and back.
+TEST(OdeFidelity, KineticAndPotentialEnergyAreTheProblemsAndTheStateRoundTrips) {
+  for (const auto& spec : kChainSpecs) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    std::string why;
+    const auto chain = planar_chain_of(*problem, why);
+    ASSERT_TRUE(chain) << why;
+    for (const auto& defaults : {false, true}) {
+      OdeChain engine(*chain, {"world", defaults});
+      const Vec down = Vec::Zero(problem->dof());
+      engine.set_state(down, down);
+      const double engine_down = engine.potential();
+      const double problem_down = problem->potential(down);
+      for (const auto& [q, v] : test_states(*problem)) {
+        engine.set_state(q, v);
+        const DenseMatrix M = problem_mass_matrix(*problem, q);
+        EXPECT_LE(relative_difference(engine.kinetic(), 0.5 * v.dot(M * v)), 1e-9);
+        const double V = problem->potential(q) - problem_down;
+        EXPECT_LE(std::abs(engine.potential() - engine_down - V),
+                  1e-9 * std::max(std::abs(problem_down), std::abs(V)));
+        Vec q_back, v_back;
+        engine.get_state(q_back, v_back);
+        EXPECT_LE((q_back - q).norm(), 1e-12 * (1 + q.norm()));
+        EXPECT_LE((v_back - v).norm(), 1e-12 * (1 + v.norm()));
+      }
+    }
+  }
+}
+
+// ODE's step is no textbook scheme in the problem's coordinates (a constraint solve on the bodies'
+// velocities, then a drift of every body), so the pendulum test identifies its order instead:
+// halving h roughly halves the error of both steppers (first order).
+TEST(OdeIdentification, BothSteppersAreFirstOrderOnThePendulum) {
+  const auto problem = make_problem("pendulum:omega0=2.5,theta0=1.2,v0=0.3");
+  const double t_end = 1.0;
+  const State exact = problem->exact(t_end);
+  for (const std::string spec : {"ode:step=world", "ode:step=quick"}) {
+    SCOPED_TRACE(spec);
+    std::vector<double> errors;
+    for (const int steps : {400, 800, 1600}) {
+      const State state = run_steps(spec, *problem, t_end / steps, steps);
+      errors.push_back(std::abs(state.q[0] - exact.q[0]));
+    }
+    for (int k = 1; k < 3; ++k) {
+      const double order = std::log2(errors[k - 1] / errors[k]);
+      EXPECT_GT(order, 0.8) << errors[k - 1] << " " << errors[k];
+      EXPECT_LT(order, 1.3) << errors[k - 1] << " " << errors[k];
+    }
+  }
+}
+
+TEST(OdeApplicability, RefusesOtherProblemsNamingThoseThatApply) {
+  const auto method = make_integrator("ode:step=quick");
+  const Applicability verdict = applicable(*method, *make_problem("kepler"));
+  EXPECT_FALSE(verdict.ok);
+  EXPECT_NE(verdict.reason.find("rod_chain:coordinates=joint"), std::string::npos)
+      << verdict.reason;
+  for (const auto& spec : kChainSpecs) EXPECT_TRUE(applicable(*method, *make_problem(spec)).ok);
+  EXPECT_EQ(method->provider().label(), "engine:ODE");
 }
 
 }  // namespace

@@ -756,7 +756,8 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
                                                       {"odeint_mclachlan4", "library:Boost.Odeint"},
                                                       {"adaptive_verlet", "geomint"},
                                                       {"rkn_adaptive", "geomint"},
-                                                      {"mujoco", "engine:MuJoCo"}};
+                                                      {"mujoco", "engine:MuJoCo"},
+                                                      {"ode", "engine:ODE"}};
   for (const auto& entry : integrator_registry()) {
     if (!entry.builtin) continue;
     SCOPED_TRACE(entry.name);

@@ -172,6 +172,11 @@ const std::vector<Case>& cases() {
       {"MujocoOnCartesianRodChain",
        "run --problem rod_chain --method mujoco:integrator=rk4 --dt 0.01 --t-end 1", 2,
        "(rod_chain:coordinates=joint)"},
+      {"OdeUnknownStep", "run --problem pendulum --method ode:step=dense --dt 0.1 --t-end 1", 2,
+       "(allowed: world, quick)"},
+      {"OdeOnAProblemItDoesNotModel",
+       "run --problem spherical_pendulum --method ode --dt 0.1 --t-end 1", 2,
+       "problems that apply: pendulum, double_pendulum, rod_chain:coordinates=joint"},
       // --- holonomic constraints (applicable()): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,

@@ -239,6 +239,9 @@ const std::map<std::string, std::string> kNoIterationLimit = {
     {"gsl_msbdf", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
     {"gsl_rk4imp", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
     {"mujoco", "MuJoCo's implicit integrator solves one linear system per step (no iteration)"},
+    {"ode",
+     "ODE's dWorldStep solves the joint forces directly; dWorldQuickStep's fixed sweep count "
+     "is no option of the method"},
 };
 
 // Configurations whose step equations one iteration solves exactly, so a limit of one binds
