@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstring>
+#include <mutex>
 
 namespace geomint::engines {
 namespace {
@@ -77,7 +78,10 @@ const std::vector<std::string>& mujoco_integrators() {
 
 MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
     : xml_(chain_xml(chain, options)) {
-  mju_user_warning = &record_mujoco_warning;
+  // Installed once: the hook is one global of the library, and sweeps build models on several
+  // threads.
+  static std::once_flag hook_installed;
+  std::call_once(hook_installed, [] { mju_user_warning = &record_mujoco_warning; });
   // The model is compiled from memory: a virtual file system holding the one MJCF file (mjVFS
   // is large, so it lives on the heap).
   auto vfs = std::make_unique<mjVFS>();
