@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "engines/bullet.hpp"
 #include "engines/mujoco.hpp"
 #include "engines/ode.hpp"
 #include "engines/planar_chain.hpp"
@@ -228,6 +229,64 @@ TEST(OdeApplicability, RefusesOtherProblemsNamingThoseThatApply) {
       << verdict.reason;
   for (const auto& spec : kChainSpecs) EXPECT_TRUE(applicable(*method, *make_problem(spec)).ok);
   EXPECT_EQ(method->provider().label(), "engine:ODE");
+}
+
+// Bullet's btMultiBody has no mass-matrix or energy getter: its potential and kinetic energy come
+// from its own kinematics (localPosToWorld, the kinetic energy by a central difference along the
+// joint rates), against the problem's at the same states.
+TEST(BulletFidelity, KineticAndPotentialEnergyAreTheProblems) {
+  for (const auto& spec : kChainSpecs) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    std::string why;
+    const auto chain = planar_chain_of(*problem, why);
+    ASSERT_TRUE(chain) << why;
+    BulletChain engine(*chain, {"euler", false});
+    const Vec down = Vec::Zero(problem->dof());
+    engine.set_state(down, down);
+    const double engine_down = engine.potential();
+    const double problem_down = problem->potential(down);
+    for (const auto& [q, v] : test_states(*problem)) {
+      engine.set_state(q, v);
+      const DenseMatrix M = problem_mass_matrix(*problem, q);
+      EXPECT_LE(relative_difference(engine.kinetic(), 0.5 * v.dot(M * v)), 1e-9);
+      const double V = problem->potential(q) - problem_down;
+      EXPECT_LE(std::abs(engine.potential() - engine_down - V),
+                1e-9 * std::max(std::abs(problem_down), std::abs(V)));
+      Vec q_back, v_back;
+      engine.get_state(q_back, v_back);
+      EXPECT_LE((q_back - q).norm(), 1e-12 * (1 + q.norm()));
+      EXPECT_LE((v_back - v).norm(), 1e-12 * (1 + v.norm()));
+    }
+  }
+}
+
+TEST(BulletIdentification, EachIntegratorIsItsTextbookSchemeToRoundOff) {
+  const auto problem = make_problem("pendulum:omega0=2.5,theta0=1.2,v0=0.3");
+  constexpr double h = 0.01;
+  constexpr int kSteps = 1000;
+  const std::vector<Identification> schemes = {
+      {"bullet:integrator=euler", "symplectic_euler_a",
+       "semi-implicit (symplectic) Euler, kick then drift"},
+      {"bullet:integrator=rk4", "rk4", "classical Runge–Kutta on (θ, θ̇)"},
+  };
+  for (const auto& [engine_spec, geomint_spec, scheme] : schemes) {
+    SCOPED_TRACE(engine_spec + " is " + scheme + " (" + geomint_spec + ")");
+    const State engine = run_steps(engine_spec, *problem, h, kSteps);
+    const State reference = run_steps(geomint_spec, *problem, h, kSteps);
+    EXPECT_LE(std::abs(engine.q[0] - reference.q[0]), 1e-12 * std::abs(reference.q[0]));
+    EXPECT_LE(std::abs(engine.p[0] - reference.p[0]), 1e-12 * std::abs(reference.p[0]));
+  }
+}
+
+TEST(BulletApplicability, RefusesOtherProblemsNamingThoseThatApply) {
+  const auto method = make_integrator("bullet");
+  const Applicability verdict = applicable(*method, *make_problem("kepler"));
+  EXPECT_FALSE(verdict.ok);
+  EXPECT_NE(verdict.reason.find("rod_chain:coordinates=joint"), std::string::npos)
+      << verdict.reason;
+  for (const auto& spec : kChainSpecs) EXPECT_TRUE(applicable(*method, *make_problem(spec)).ok);
+  EXPECT_EQ(method->provider().label(), "engine:Bullet");
 }
 
 }  // namespace

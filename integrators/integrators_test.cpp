@@ -757,7 +757,8 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
                                                       {"adaptive_verlet", "geomint"},
                                                       {"rkn_adaptive", "geomint"},
                                                       {"mujoco", "engine:MuJoCo"},
-                                                      {"ode", "engine:ODE"}};
+                                                      {"ode", "engine:ODE"},
+                                                      {"bullet", "engine:Bullet"}};
   for (const auto& entry : integrator_registry()) {
     if (!entry.builtin) continue;
     SCOPED_TRACE(entry.name);

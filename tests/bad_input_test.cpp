@@ -177,6 +177,9 @@ const std::vector<Case>& cases() {
       {"OdeOnAProblemItDoesNotModel",
        "run --problem spherical_pendulum --method ode --dt 0.1 --t-end 1", 2,
        "problems that apply: pendulum, double_pendulum, rod_chain:coordinates=joint"},
+      {"BulletUnknownIntegrator",
+       "run --problem pendulum --method bullet:integrator=implicit --dt 0.1 --t-end 1", 2,
+       "(allowed: euler, rk4)"},
       // --- holonomic constraints (applicable()): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
