@@ -5,12 +5,12 @@
 include(CMakePackageConfigHelpers)
 set(GEOMINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/geomint)
 
-foreach(folder problems integrators harness verify)
+foreach(folder problems integrators engines harness verify)
   install(DIRECTORY ${CMAKE_SOURCE_DIR}/${folder}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/geomint/${folder}
           FILES_MATCHING PATTERN "*.hpp" PATTERN "*.def")
 endforeach()
 
-install(TARGETS geomint_problems geomint_integrators geomint_harness geomint_verify
+install(TARGETS geomint_problems geomint_integrators geomint_engines geomint_harness geomint_verify
         EXPORT geomintTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -160,6 +160,9 @@ TEST(GeneralStep, DoublePendulumOrdersMatchTheDeclaredOnes) {
     const auto method = make_integrator(spec);
     const MethodInfo info = method->info();
     if ((info.flags & kAdaptive) || !applicable(*method, *problem).ok) continue;
+    // The engines' steps are fitted on this problem in engines/engines_test.cpp (MuJoCo's RK4 is
+    // not yet asymptotic in p at h = 0.05: error ratio 3.8, then 11.6 and 14.1).
+    if (method->provider().kind == MethodProvider::Kind::kEngine) continue;
     std::vector<double> steps, q_errors, p_errors;
     for (int level = 0; level < (info.order >= 5 ? 3 : 4); ++level) {
       const double h = 0.05 / (1 << level);

@@ -26,6 +26,7 @@ namespace {
 // The provider column of registry.def.
 MethodProvider by_geomint() { return MethodProvider::geomint(); }
 MethodProvider by_library(const char* name) { return MethodProvider::library_named(name); }
+MethodProvider by_engine(const char* name) { return {MethodProvider::Kind::kEngine, name}; }
 
 std::vector<IntegratorEntry>& mutable_integrator_registry() {
   static std::vector<IntegratorEntry> entries = {
@@ -306,6 +307,11 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         "problem '{}' is a first-order ODE y' = f(t, y) only; methods "
                         "that apply: {}",
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
+  }
+  // A method that models only some problems (a physics engine's chain) says which.
+  if (const auto* listed = dynamic_cast<const RunsListedProblems*>(&method)) {
+    std::string refusal = listed->problem_refusal(problem);
+    if (!refusal.empty()) return {false, std::move(refusal)};
   }
   if (needs.structure != nullptr) {
     return {false, structure_refusal(method, problem, *needs.structure)};

@@ -323,6 +323,14 @@ struct Applicability {
   std::string reason;
 };
 Applicability applicable(const Integrator& method, const Problem& problem);
+// A method that runs only the problems it can build a model of (the physics-engine methods,
+// engines/) derives from this too: applicable() asks it first and refuses with its reason (which
+// names the problems that apply) when that is not empty.
+class RunsListedProblems {
+ public:
+  virtual ~RunsListedProblems() = default;
+  virtual std::string problem_refusal(const Problem& problem) const = 0;
+};
 // The registry test specs whose methods handle holonomic constraints (for messages and tests).
 std::vector<std::string> constrained_methods();
 // The registry test specs whose methods run first-order-only problems (kFirstOrderCapable).

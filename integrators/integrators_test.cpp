@@ -755,13 +755,18 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
                                                       {"gsl_msbdf", "library:GSL"},
                                                       {"odeint_mclachlan4", "library:Boost.Odeint"},
                                                       {"adaptive_verlet", "geomint"},
-                                                      {"rkn_adaptive", "geomint"}};
+                                                      {"rkn_adaptive", "geomint"},
+                                                      {"mujoco", "engine:MuJoCo"},
+                                                      {"ode", "engine:ODE"},
+                                                      {"bullet", "engine:Bullet"}};
   for (const auto& entry : integrator_registry()) {
     if (!entry.builtin) continue;
     SCOPED_TRACE(entry.name);
     const MethodProvider& provider = method_provider(entry.name);
     EXPECT_TRUE(provider.kind == MethodProvider::Kind::kGeomint ||
-                (provider.kind == MethodProvider::Kind::kLibrary && !provider.library.empty()));
+                ((provider.kind == MethodProvider::Kind::kLibrary ||
+                  provider.kind == MethodProvider::Kind::kEngine) &&
+                 !provider.library.empty()));
     EXPECT_EQ(make_integrator(entry.name)->provider(), provider);
     EXPECT_EQ(integrator_maker(entry.name)()->provider(), provider);
     const auto anchor = anchors.find(entry.name);

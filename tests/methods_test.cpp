@@ -21,10 +21,14 @@ namespace {
 // (integrators/constrained_methods_test.cpp): the problems here have no constraints; the
 // free-rigid-body splitting on the rigid bodies (integrators/lie_poisson_test.cpp), the Boris
 // pusher on the charged particle (integrators/boris_test.cpp).
+// The physics-engine methods (engines/) run only the problems they build a model of, none of the
+// ladders below but the pendulum; engines/engines_test.cpp tests their orders and schemes there.
 std::vector<std::string> fixed_step_methods() {
   std::vector<std::string> out;
   for (const auto& spec : integrator_test_specs()) {
-    if (!(make_integrator(spec)->info().flags &
+    const auto method = make_integrator(spec);
+    if (method->provider().kind == MethodProvider::Kind::kEngine) continue;
+    if (!(method->info().flags &
           (kAdaptive | kConstraintsOnly | kFreeRigidBodyOnly | kChargedParticleOnly))) {
       out.push_back(spec);
     }
@@ -234,6 +238,10 @@ const std::map<std::string, std::string> kNoIterationLimit = {
     {"odeint_rosenbrock4", "linearly implicit (Rosenbrock): one linear solve per stage"},
     {"gsl_msbdf", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
     {"gsl_rk4imp", "GSL odeiv2 fixes its iteration count inside the stepper (no option)"},
+    {"mujoco", "MuJoCo's implicit integrator solves one linear system per step (no iteration)"},
+    {"ode",
+     "ODE's dWorldStep solves the joint forces directly; dWorldQuickStep's fixed sweep count "
+     "is no option of the method"},
 };
 
 // Configurations whose step equations one iteration solves exactly, so a limit of one binds

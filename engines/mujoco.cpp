@@ -1,0 +1,247 @@
+// The `mujoco` method: MuJoCo's own mj_step on the planar chain a problem is
+// (engines/planar_chain.hpp), its state read back as the problem's (θ, p = M(θ)θ̇).
+#include "engines/mujoco.hpp"
+
+#include <fmt/format.h>
+#include <mujoco/mujoco.h>
+
+#include <array>
+#include <cstring>
+#include <mutex>
+
+namespace geomint::engines {
+namespace {
+
+// MuJoCo reports warnings through one global hook and a counter per kind in mjData; the hook
+// keeps the text of the last one (per thread: sweeps step several models at once), which the
+// step turns into its status message.
+thread_local std::string last_mujoco_warning;
+void record_mujoco_warning(const char* message) { last_mujoco_warning = message; }
+
+const char* warning_name(int warning) {
+  static const std::array<const char*, mjNWARNING> names = {
+      "mjWARN_INERTIA", "mjWARN_CONTACTFULL", "mjWARN_CNSTRFULL", "mjWARN_VGEOMFULL",
+      "mjWARN_BADQPOS", "mjWARN_BADQVEL",     "mjWARN_BADQACC",   "mjWARN_BADCTRL"};
+  return names[warning];
+}
+
+// MuJoCo refuses a moving body whose inertia components are not all above mjMINVAL (1e-15), so a
+// point mass m at the end of a rod of length l gets the rotational inertia 1e-14·m·l² (at least
+// 10·mjMINVAL): a relative change of 1e-14 in its share of the mass matrix, far below the
+// fidelity tests' 1e-9 and at round-off in the identification tests (docs/ENGINES.md).
+double point_mass_inertia(double mass, double length) {
+  return std::max(10 * mjMINVAL, 1e-14 * mass * length * length);
+}
+
+std::string chain_xml(const PlanarChain& chain, const MujocoOptions& options) {
+  const std::string integrator = options.integrator == "rk4"        ? "RK4"
+                                 : options.integrator == "implicit" ? "implicit"
+                                                                    : "Euler";
+  // Clean: no contact or constraint machinery, no passive forces (the joints carry neither
+  // damping, stiffness nor armature, written out below), energies computed for the tests.
+  const std::string flags = options.shipped_defaults
+                                ? R"(<flag energy="enable"/>)"
+                                : R"(<flag contact="disable" constraint="disable" )"
+                                  R"(passive="disable" energy="enable"/>)";
+  const std::string joint_extras =
+      options.shipped_defaults ? "" : R"( damping="0" stiffness="0" armature="0" frictionloss="0")";
+  std::string xml = fmt::format(
+      "<mujoco model=\"geomint_chain\">\n"
+      "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
+      "  <option timestep=\"0.01\" integrator=\"{}\" gravity=\"0 0 {:.17g}\">{}</option>\n"
+      "  <worldbody>\n",
+      integrator, -chain.gravity, flags);
+  // Rod i hangs along −z from its joint; the axis −y makes a positive angle swing the rod
+  // towards +x, the problems' convention x = Σ lᵢ sin θᵢ.
+  std::string closing;
+  for (int i = 0; i < chain.links(); ++i) {
+    const double l = chain.length[i];
+    const double inertia = point_mass_inertia(chain.mass[i], l);
+    const double offset = i == 0 ? 0.0 : chain.length[i - 1];
+    xml += fmt::format(
+        "<body pos=\"0 0 {:.17g}\"><joint type=\"hinge\" axis=\"0 -1 0\"{}/>"
+        "<inertial pos=\"0 0 {:.17g}\" mass=\"{:.17g}\" diaginertia=\"{:.17g} {:.17g} "
+        "{:.17g}\"/>\n",
+        -offset, joint_extras, -l, chain.mass[i], inertia, inertia, inertia);
+    closing += "</body>";
+  }
+  xml += closing + "\n  </worldbody>\n</mujoco>\n";
+  return xml;
+}
+
+}  // namespace
+
+const std::vector<std::string>& mujoco_integrators() {
+  static const std::vector<std::string> names = {"euler", "rk4", "implicit"};
+  return names;
+}
+
+MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
+    : xml_(chain_xml(chain, options)) {
+  // Installed once: the hook is one global of the library, and sweeps build models on several
+  // threads.
+  static std::once_flag hook_installed;
+  std::call_once(hook_installed, [] { mju_user_warning = &record_mujoco_warning; });
+  // The model is compiled from memory: a virtual file system holding the one MJCF file (mjVFS
+  // is large, so it lives on the heap).
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const char* file_name = "geomint_chain.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), file_name, static_cast<int>(xml_.size())) != 0) {
+    throw InputError("mujoco: cannot create the model file in MuJoCo's virtual file system");
+  }
+  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), file_name)], xml_.data(), xml_.size());
+  std::array<char, 1000> error{};
+  model_ = mj_loadXML(file_name, vfs.get(), error.data(), static_cast<int>(error.size()));
+  mj_deleteVFS(vfs.get());
+  if (model_ == nullptr) {
+    throw InputError(fmt::format("mujoco: MuJoCo refused the model of {} links: {}", chain.links(),
+                                 error.data()));
+  }
+  data_ = mj_makeData(model_);
+}
+
+MujocoChain::~MujocoChain() {
+  if (data_ != nullptr) mj_deleteData(data_);
+  if (model_ != nullptr) mj_deleteModel(model_);
+}
+
+void MujocoChain::set_state(const Vec& theta, const Vec& theta_dot) {
+  absolute_to_relative(theta, relative_);
+  absolute_to_relative(theta_dot, relative_rate_);
+  for (int i = 0; i < model_->nq; ++i) {
+    data_->qpos[i] = relative_[i];
+    data_->qvel[i] = relative_rate_[i];
+  }
+  // Positions, mass matrix and energies at this state (mj_step recomputes them anyway).
+  mj_forward(model_, data_);
+}
+
+void MujocoChain::get_state(Vec& theta, Vec& theta_dot) const {
+  const Eigen::Map<const Vec> qpos(data_->qpos, model_->nq);
+  const Eigen::Map<const Vec> qvel(data_->qvel, model_->nv);
+  relative_to_absolute(qpos, theta);
+  relative_to_absolute(qvel, theta_dot);
+}
+
+DenseMatrix MujocoChain::mass_matrix_absolute() const {
+  const int n = model_->nv;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> relative(n, n);
+  mj_fullM(model_, relative.data(), data_->qM);
+  // T = ½φ̇ᵀM_φφ̇ with φ̇ = Dθ̇ (D the difference matrix): M_θ = DᵀM_φD.
+  DenseMatrix difference = DenseMatrix::Identity(n, n);
+  for (int i = 1; i < n; ++i) difference(i, i - 1) = -1;
+  return difference.transpose() * relative * difference;
+}
+
+double MujocoChain::potential() const { return data_->energy[0]; }
+double MujocoChain::kinetic() const { return data_->energy[1]; }
+
+StepStatus MujocoChain::step(double h) {
+  model_->opt.timestep = h;
+  std::array<int, mjNWARNING> before{};
+  for (int i = 0; i < mjNWARNING; ++i) before[i] = data_->warning[i].number;
+  mj_step(model_, data_);
+  for (int i = 0; i < mjNWARNING; ++i) {
+    if (data_->warning[i].number != before[i]) {
+      return StepStatus::failure(
+          fmt::format("mujoco_{}", warning_name(i)),
+          fmt::format("MuJoCo warning {} in mj_step: {}", warning_name(i), last_mujoco_warning));
+    }
+  }
+  return StepStatus::success();
+}
+
+namespace {
+
+// The method: the problem's state goes into MuJoCo's qpos/qvel only when it is not the state the
+// previous step wrote (a fresh run, a reversibility check), so a run follows MuJoCo's own
+// trajectory without a round trip through p = M(θ)θ̇ per step.
+class MujocoMethod final : public Integrator, public RunsListedProblems {
+ public:
+  explicit MujocoMethod(MujocoOptions options) : options_(std::move(options)) {}
+
+  MethodInfo info() const override {
+    if (options_.integrator == "rk4") {
+      return {"mujoco", 4, kExplicit | kGeneralLagrangian,
+              "MuJoCo 2.2.2 mjINT_RK4 (mj_RungeKutta)"};
+    }
+    // euler and implicit both update the velocity first, then the position with it; implicit
+    // also treats damping implicitly (there is none in these problems).
+    return {"mujoco", 1,
+            (options_.integrator == "implicit" ? kImplicit : kExplicit) | kGeneralLagrangian,
+            options_.integrator == "implicit" ? "MuJoCo 2.2.2 mjINT_IMPLICIT (mj_implicit)"
+                                              : "MuJoCo 2.2.2 mjINT_EULER (mj_Euler)"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    // Without damping MuJoCo's Euler and implicit steps are symplectic Euler (hω < 2); RK4's
+    // real-axis bound is 2√2.
+    return StabilityPrediction::limit(options_.integrator == "rk4" ? 2 * std::sqrt(2.0) : 2.0);
+  }
+
+  std::string problem_refusal(const Problem& problem) const override {
+    std::string why;
+    if (planar_chain_of(problem, why)) return "";
+    return fmt::format(
+        "method 'mujoco' builds a MuJoCo model of planar hinge chains only: {}; "
+        "problems that apply: {}",
+        why, fmt::join(chain_problem_specs(), ", "));
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    std::string why;
+    const auto chain = planar_chain_of(problem, why);
+    if (!chain) throw std::logic_error(problem_refusal(problem));
+    engine_ = std::make_unique<MujocoChain>(*chain, options_);
+    written_q_.resize(0);
+    written_p_.resize(0);
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    if (!engine_) reset(problem, state, h);
+    // (Eigen compares vectors of equal size only; after reset() nothing has been written.)
+    const bool engine_holds_state = written_q_.size() == state.q.size() &&
+                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
+                                    state.p == written_p_;
+    if (!engine_holds_state) {
+      engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
+    }
+    const StepStatus status = engine_->step(h);
+    ++counters_.steps;
+    if (!status.ok) return status;
+    engine_->get_state(state.q, velocity_);
+    state.p = chain_momentum(problem, state.q, velocity_);
+    state.t += h;
+    written_q_ = state.q;
+    written_p_ = state.p;
+    return status;
+  }
+
+ private:
+  MujocoOptions options_;
+  std::unique_ptr<MujocoChain> engine_;
+  Vec written_q_, written_p_, velocity_;
+};
+
+}  // namespace
+
+}  // namespace geomint::engines
+
+namespace geomint {
+
+std::unique_ptr<Integrator> make_mujoco(Params& params) {
+  engines::MujocoOptions options;
+  options.integrator =
+      params.choice("integrator", "euler", engines::mujoco_integrators(),
+                    "MuJoCo's integrator (mjtIntegrator): euler (semi-implicit), rk4, implicit "
+                    "(implicit in velocity)");
+  options.shipped_defaults =
+      params.choice("defaults", "clean", {"clean", "shipped"},
+                    "clean: everything the problem lacks switched off; shipped: MuJoCo's own "
+                    "defaults") == "shipped";
+  return std::make_unique<engines::MujocoMethod>(std::move(options));
+}
+
+}  // namespace geomint

@@ -1,0 +1,53 @@
+// A planar hinge chain as a MuJoCo 2.2.2 model (MJCF generated in memory, loaded through a virtual
+// file system): the engine side of the `mujoco` method, exposed for the fidelity tests.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "engines/planar_chain.hpp"
+#include "integrators/integrator.hpp"
+#include "problems/lagrangian.hpp"
+
+struct mjModel_;
+struct mjData_;
+
+namespace geomint::engines {
+
+struct MujocoOptions {
+  std::string integrator = "euler";  // mjtIntegrator: euler | rk4 | implicit
+  bool shipped_defaults = false;     // false: everything the problem lacks switched off
+};
+
+// The integrators MuJoCo 2.2.2 offers (mjtIntegrator in mujoco/mjmodel.h), in its order.
+const std::vector<std::string>& mujoco_integrators();
+
+class MujocoChain {
+ public:
+  // Throws InputError when MuJoCo refuses the model (its message).
+  MujocoChain(const PlanarChain& chain, const MujocoOptions& options);
+  ~MujocoChain();
+  MujocoChain(const MujocoChain&) = delete;
+  MujocoChain& operator=(const MujocoChain&) = delete;
+
+  // The problem's absolute angles and rates in, and out.
+  void set_state(const Vec& theta, const Vec& theta_dot);
+  void get_state(Vec& theta, Vec& theta_dot) const;
+  // At the state last set: MuJoCo's joint-space mass matrix (mj_fullM) mapped to absolute
+  // angles, its potential (zero with every rod hanging down) and its kinetic energy.
+  DenseMatrix mass_matrix_absolute() const;
+  double potential() const;
+  double kinetic() const;
+  // One mj_step of length h; a warning MuJoCo raises in it (bad qacc, qpos, qvel: its
+  // instability detector, which would also reset the state) is a failed status naming it.
+  StepStatus step(double h);
+  const std::string& xml() const { return xml_; }
+
+ private:
+  mjModel_* model_ = nullptr;
+  mjData_* data_ = nullptr;
+  std::string xml_;
+  Vec relative_, relative_rate_;
+};
+
+}  // namespace geomint::engines

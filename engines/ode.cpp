@@ -1,0 +1,268 @@
+// The `ode` method: the Open Dynamics Engine's own world step (dWorldStep, or dWorldQuickStep's
+// iterative solver) on the planar chain a problem is, in maximal coordinates: one rigid body per
+// rod, hinge joints, the state read back from the bodies as the problem's (θ, p = M(θ)θ̇).
+#include "engines/ode.hpp"
+
+#include <fmt/format.h>
+#include <ode/ode.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <mutex>
+#include <numbers>
+
+namespace geomint::engines {
+namespace {
+
+// ODE reports errors and debug messages through global handlers whose default aborts the
+// process; the handlers keep the text (per thread) and the step turns it into a failed status.
+thread_local std::string last_ode_message;
+void record_ode_message(int errnum, const char* format, va_list arguments) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, format, arguments);
+  last_ode_message = fmt::format("ODE message {}: {}", errnum, text);
+}
+
+// ODE is initialised once per process and its per-thread data once per thread (sweeps build
+// chains on worker threads).
+void init_ode_for_this_thread() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    dInitODE2(0);
+    dSetMessageHandler(&record_ode_message);
+    dSetErrorHandler(&record_ode_message);
+    dSetDebugHandler(&record_ode_message);
+  });
+  thread_local const bool allocated = dAllocateODEDataForThread(dAllocateMaskAll) != 0;
+  (void)allocated;
+}
+
+// dWorldQuickStep visits the joints in an order drawn from ODE's one global random generator, so
+// two runs of the same spec would differ in the last bits. Each quick step reseeds it first, under
+// a lock that keeps concurrent runs from sharing the sequence: a run is then a function of its
+// spec (a row re-run from its method spec reproduces it).
+std::mutex quick_step_mutex;
+constexpr unsigned long kQuickStepSeed = 0;
+
+}  // namespace
+
+const std::vector<std::string>& ode_steps() {
+  static const std::vector<std::string> names = {"world", "quick"};
+  return names;
+}
+
+// Rod i carries the point masses of the chain as two end masses: `near` at node i − 1 and `far`
+// at node i. Node i's mass is split half and half between the rods that meet there (the last
+// node's is all on the last rod); the pivot end of rod 1 gets a mass too, which moves nothing and
+// gives rod 1 a positive rotational inertia. Each body's kinetic and potential energy is then
+// exactly that of its share of the point masses: the chain is the problem's, not an
+// approximation (tested).
+OdeChain::OdeChain(const PlanarChain& chain, const OdeOptions& options)
+    : options_(options), links_(chain.links()) {
+  init_ode_for_this_thread();
+  world_ = dWorldCreate();
+  dWorldSetGravity(world_, 0, 0, -chain.gravity);
+  if (!options.shipped_defaults) {
+    // Hard joints (CFM = 0) without the Baumgarte correction (ERP = 0), which feeds position
+    // errors back as velocity; no damping, sleeping or speed clamp (their defaults, written out).
+    dWorldSetCFM(world_, 0);
+    dWorldSetERP(world_, 0);
+    dWorldSetAutoDisableFlag(world_, 0);
+    dWorldSetLinearDamping(world_, 0);
+    dWorldSetAngularDamping(world_, 0);
+    dWorldSetMaxAngularSpeed(world_, dInfinity);
+  }
+  for (int i = 0; i < links_; ++i) {
+    Link link;
+    link.length = chain.length[i];
+    link.far = i + 1 < links_ ? chain.mass[i] / 2 : chain.mass[i];
+    link.near = i == 0 ? link.far : chain.mass[i - 1] / 2;
+    const double total = link.near + link.far;
+    // About the centre of mass: near·far/total·l² perpendicular to the rod; the rod axis gets the
+    // same (a hinge chain never turns about it).
+    const double inertia = link.near * link.far / total * link.length * link.length;
+    dMass mass;
+    dMassSetParameters(&mass, total, 0, 0, 0, inertia, inertia, inertia, 0, 0, 0);
+    link.body = dBodyCreate(world_);
+    dBodySetMass(link.body, &mass);
+    link.joint = dJointCreateHinge(world_, nullptr);
+    dJointAttach(link.joint, link.body, i == 0 ? nullptr : links_data_.back().body);
+    links_data_.push_back(link);
+  }
+  set_state(Vec::Zero(links_), Vec::Zero(links_));
+}
+
+OdeChain::~OdeChain() {
+  if (world_ != nullptr) dWorldDestroy(world_);
+}
+
+void OdeChain::set_state(const Vec& theta, const Vec& theta_dot) {
+  double node_x = 0, node_z = 0, node_vx = 0, node_vz = 0;
+  for (int i = 0; i < links_; ++i) {
+    Link& link = links_data_[i];
+    const double s = std::sin(theta[i]), c = std::cos(theta[i]);
+    const double to_centre = link.far / (link.near + link.far) * link.length;
+    dMatrix3 rotation;
+    dRFromAxisAndAngle(rotation, 0, -1, 0, theta[i]);
+    dBodySetRotation(link.body, rotation);
+    dBodySetPosition(link.body, node_x + to_centre * s, 0, node_z - to_centre * c);
+    dBodySetLinearVel(link.body, node_vx + to_centre * theta_dot[i] * c, 0,
+                      node_vz + to_centre * theta_dot[i] * s);
+    dBodySetAngularVel(link.body, 0, -theta_dot[i], 0);
+    // The joint sits at node i − 1; its axis −y turns the rod towards +x for θ > 0.
+    dJointSetHingeAnchor(link.joint, node_x, 0, node_z);
+    dJointSetHingeAxis(link.joint, 0, -1, 0);
+    node_x += link.length * s;
+    node_z -= link.length * c;
+    node_vx += link.length * theta_dot[i] * c;
+    node_vz += link.length * theta_dot[i] * s;
+  }
+  angles_ = theta;
+}
+
+void OdeChain::get_state(Vec& theta, Vec& theta_dot) {
+  theta.resize(links_);
+  theta_dot.resize(links_);
+  dVector3 previous{0, 0, 0, 0}, previous_velocity{0, 0, 0, 0};
+  for (int i = 0; i < links_; ++i) {
+    const Link& link = links_data_[i];
+    const double to_far = -link.near / (link.near + link.far) * link.length;
+    dVector3 node, velocity;
+    dBodyGetRelPointPos(link.body, 0, 0, to_far, node);
+    dBodyGetRelPointVel(link.body, 0, 0, to_far, velocity);
+    const double rx = node[0] - previous[0], rz = node[2] - previous[2];
+    const double vx = velocity[0] - previous_velocity[0], vz = velocity[2] - previous_velocity[2];
+    // The angle of the rod as it moved: the branch of atan2 nearest the previous angle, so whole
+    // turns are kept.
+    const double raw = std::atan2(rx, -rz);
+    theta[i] = raw + 2 * std::numbers::pi * std::round((angles_[i] - raw) / (2 * std::numbers::pi));
+    const double c = std::cos(theta[i]), s = std::sin(theta[i]);
+    theta_dot[i] = (vx * c + vz * s) / std::hypot(rx, rz);
+    for (int k = 0; k < 3; ++k) previous[k] = node[k], previous_velocity[k] = velocity[k];
+  }
+  angles_ = theta;
+}
+
+double OdeChain::kinetic() const {
+  double energy = 0;
+  for (const Link& link : links_data_) {
+    dMass mass;
+    dBodyGetMass(link.body, &mass);
+    const dReal* v = dBodyGetLinearVel(link.body);
+    const dReal* w = dBodyGetAngularVel(link.body);
+    // The inertia is isotropic, so ωᵀIω needs no rotation to the world frame.
+    energy += 0.5 * mass.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
+              0.5 * mass.I[0] * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  }
+  return energy;
+}
+
+double OdeChain::potential() const {
+  dVector3 gravity;
+  dWorldGetGravity(world_, gravity);
+  double energy = 0;
+  for (const Link& link : links_data_) {
+    dMass mass;
+    dBodyGetMass(link.body, &mass);
+    energy -= mass.mass * gravity[2] * dBodyGetPosition(link.body)[2];
+  }
+  return energy;
+}
+
+StepStatus OdeChain::step(double h) {
+  last_ode_message.clear();
+  int ok = 0;
+  if (options_.step == "quick") {
+    const std::lock_guard<std::mutex> lock(quick_step_mutex);
+    dRandSetSeed(kQuickStepSeed);
+    ok = dWorldQuickStep(world_, h);
+  } else {
+    ok = dWorldStep(world_, h);
+  }
+  if (!ok || !last_ode_message.empty()) {
+    return StepStatus::failure("ode_step", last_ode_message.empty()
+                                               ? std::string("ODE's step returned failure")
+                                               : last_ode_message);
+  }
+  return StepStatus::success();
+}
+
+namespace {
+
+class OdeMethod final : public Integrator, public RunsListedProblems {
+ public:
+  explicit OdeMethod(OdeOptions options) : options_(std::move(options)) {}
+
+  MethodInfo info() const override {
+    return {"ode", 1, kImplicit | kGeneralLagrangian,
+            options_.step == "quick" ? "ODE 0.16 dWorldQuickStep (projected Gauss–Seidel)"
+                                     : "ODE 0.16 dWorldStep (dense LCP)"};
+  }
+
+  StabilityPrediction predicted_linear_stability() const override {
+    return StabilityPrediction::none(
+        "a maximal-coordinate step with a constraint solve: no linear theory in the problem's "
+        "coordinates");
+  }
+
+  std::string problem_refusal(const Problem& problem) const override {
+    std::string why;
+    if (planar_chain_of(problem, why)) return "";
+    return fmt::format(
+        "method 'ode' builds ODE bodies and hinges of planar chains only: {}; "
+        "problems that apply: {}",
+        why, fmt::join(chain_problem_specs(), ", "));
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    std::string why;
+    const auto chain = planar_chain_of(problem, why);
+    if (!chain) throw std::logic_error(problem_refusal(problem));
+    engine_ = std::make_unique<OdeChain>(*chain, options_);
+    written_q_.resize(0);
+    written_p_.resize(0);
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    if (!engine_) reset(problem, state, h);
+    const bool engine_holds_state = written_q_.size() == state.q.size() &&
+                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
+                                    state.p == written_p_;
+    if (!engine_holds_state) {
+      engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
+    }
+    const StepStatus status = engine_->step(h);
+    ++counters_.steps;
+    if (!status.ok) return status;
+    engine_->get_state(state.q, velocity_);
+    state.p = chain_momentum(problem, state.q, velocity_);
+    state.t += h;
+    written_q_ = state.q;
+    written_p_ = state.p;
+    return status;
+  }
+
+ private:
+  OdeOptions options_;
+  std::unique_ptr<OdeChain> engine_;
+  Vec written_q_, written_p_, velocity_;
+};
+
+}  // namespace
+}  // namespace geomint::engines
+
+namespace geomint {
+
+std::unique_ptr<Integrator> make_ode(Params& params) {
+  engines::OdeOptions options;
+  options.step = params.choice("step", "world", engines::ode_steps(),
+                               "world: dWorldStep (dense LCP); quick: dWorldQuickStep (iterative)");
+  options.shipped_defaults =
+      params.choice("defaults", "clean", {"clean", "shipped"},
+                    "clean: CFM = ERP = 0, no damping or sleeping; shipped: ODE's own defaults "
+                    "(ERP 0.2, CFM 1e-10)") == "shipped";
+  return std::make_unique<engines::OdeMethod>(std::move(options));
+}
+
+}  // namespace geomint

@@ -1,0 +1,55 @@
+// A planar hinge chain as ODE 0.16 bodies and hinge joints (maximal coordinates): the engine side
+// of the `ode` method, exposed for the fidelity tests.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engines/planar_chain.hpp"
+#include "integrators/integrator.hpp"
+
+struct dxWorld;
+struct dxBody;
+struct dxJoint;
+
+namespace geomint::engines {
+
+struct OdeOptions {
+  std::string step = "world";     // world: dWorldStep; quick: dWorldQuickStep
+  bool shipped_defaults = false;  // false: CFM = ERP = 0, no damping, sleeping or clamp
+};
+
+// ODE's steppers, as the `step=` option names them.
+const std::vector<std::string>& ode_steps();
+
+class OdeChain {
+ public:
+  OdeChain(const PlanarChain& chain, const OdeOptions& options);
+  ~OdeChain();
+  OdeChain(const OdeChain&) = delete;
+  OdeChain& operator=(const OdeChain&) = delete;
+
+  // The problem's absolute angles and rates into the bodies' positions, orientations and
+  // velocities, and back (the angle on the branch nearest the last one set or read).
+  void set_state(const Vec& theta, const Vec& theta_dot);
+  void get_state(Vec& theta, Vec& theta_dot);
+  // Σ ½m|v|² + ½ωᵀIω and Σ m g z of the bodies (zero at the pivot's height).
+  double kinetic() const;
+  double potential() const;
+  StepStatus step(double h);
+
+ private:
+  struct Link {
+    dxBody* body = nullptr;
+    dxJoint* joint = nullptr;
+    double length = 0, near = 0, far = 0;
+  };
+  OdeOptions options_;
+  int links_ = 0;
+  dxWorld* world_ = nullptr;
+  std::vector<Link> links_data_;
+  Vec angles_;
+};
+
+}  // namespace geomint::engines
