@@ -755,12 +755,15 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
                                                       {"gsl_msbdf", "library:GSL"},
                                                       {"odeint_mclachlan4", "library:Boost.Odeint"},
                                                       {"adaptive_verlet", "geomint"},
+                                                      {"exec", "user"},
                                                       {"rkn_adaptive", "geomint"}};
   for (const auto& entry : integrator_registry()) {
     if (!entry.builtin) continue;
     SCOPED_TRACE(entry.name);
     const MethodProvider& provider = method_provider(entry.name);
+    // A built-in entry is geomint's, a named library's, or runs the user's own code (`exec`).
     EXPECT_TRUE(provider.kind == MethodProvider::Kind::kGeomint ||
+                provider.kind == MethodProvider::Kind::kUser ||
                 (provider.kind == MethodProvider::Kind::kLibrary && !provider.library.empty()));
     EXPECT_EQ(make_integrator(entry.name)->provider(), provider);
     EXPECT_EQ(integrator_maker(entry.name)()->provider(), provider);
