@@ -27,6 +27,7 @@ namespace {
 MethodProvider by_geomint() { return MethodProvider::geomint(); }
 MethodProvider by_library(const char* name) { return MethodProvider::library_named(name); }
 MethodProvider by_engine(const char* name) { return {MethodProvider::Kind::kEngine, name}; }
+MethodProvider by_user() { return MethodProvider::user(); }
 
 std::vector<IntegratorEntry>& mutable_integrator_registry() {
   static std::vector<IntegratorEntry> entries = {
@@ -124,6 +125,10 @@ IntegratorMaker integrator_maker(const std::string& spec_text) {
 std::vector<std::string> integrator_test_specs() {
   std::vector<std::string> specs;
   for (const auto& entry : integrator_registry()) {
+    // An entry that runs nowhere without the user's own parameters (`exec` needs the user's
+    // program) has no spec to test here; its own tests run it (tests/exec).
+    Params params(Spec{entry.name, {}}, entry.name);
+    if (!entry.factory(params)->refusal().empty()) continue;
     specs.push_back(entry.name);
     for (const auto& variant : entry.variants) specs.push_back(entry.name + ":" + variant);
   }
@@ -293,6 +298,7 @@ std::string lagrangian_kind_refusal(const Integrator& method, const Problem& pro
 }  // namespace
 
 Applicability applicable(const Integrator& method, const Problem& problem) {
+  if (std::string why = method.refusal(); !why.empty()) return {false, std::move(why)};
   const MethodNeeds needs = method_needs(method.info());
   // A free rigid body gives such a method all it reads (moments and the (Q, Π) view), be it the
   // first-order rigid_body_euler or the constrained rigid_body; a charged particle gives the

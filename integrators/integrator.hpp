@@ -247,6 +247,10 @@ class Integrator {
   // fixed-step method without an override fails the registry test in harness/stability_test.cpp.
   virtual StabilityPrediction predicted_linear_stability() const;
 
+  // Why this method cannot run on any problem as configured ("" when it can): the bare `exec`
+  // entry, which has no command to run. applicable() checks it first.
+  virtual std::string refusal() const { return ""; }
+
   // The linearised step (docs/USAGE.md "Optional structure metrics"; integrators/tangent.hpp):
   // whether step_tangent() gives the exact DΦ of this method on `problem`. The default says no;
   // methods that implement it say yes on unforced, unconstrained problems with a Hessian
@@ -399,7 +403,8 @@ struct MethodRegistrar {
 };
 
 // Default specs to exercise in registry-driven tests and `geomint list`: one per entry, plus
-// extra configurations an entry declares worth testing (e.g. hp with both solvers).
+// extra configurations an entry declares worth testing (e.g. hp with both solvers). Entries whose
+// bare spec refuses every problem (Integrator::refusal(): `exec` without a command) are left out.
 std::vector<std::string> integrator_test_specs();
 
 }  // namespace geomint

@@ -756,6 +756,7 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
                                                       {"odeint_mclachlan4", "library:Boost.Odeint"},
                                                       {"adaptive_verlet", "geomint"},
                                                       {"rkn_adaptive", "geomint"},
+                                                      {"exec", "user"},
                                                       {"mujoco", "engine:MuJoCo"},
                                                       {"ode", "engine:ODE"},
                                                       {"bullet", "engine:Bullet"}};
@@ -763,7 +764,9 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
     if (!entry.builtin) continue;
     SCOPED_TRACE(entry.name);
     const MethodProvider& provider = method_provider(entry.name);
+    // A built-in entry is geomint's, a named library's, or runs the user's own code (`exec`).
     EXPECT_TRUE(provider.kind == MethodProvider::Kind::kGeomint ||
+                provider.kind == MethodProvider::Kind::kUser ||
                 ((provider.kind == MethodProvider::Kind::kLibrary ||
                   provider.kind == MethodProvider::Kind::kEngine) &&
                  !provider.library.empty()));
