@@ -21,7 +21,10 @@ namespace {
 namespace fs = std::filesystem;
 
 int run_geomint(const std::string& arguments, std::string* output) {
-  const std::string command = std::string(GEOMINT_BINARY) + " " + arguments + " 2>&1";
+  // Appended, not `std::string(...) + " " + ...`: gcc 12 warns falsely (-Warray-bounds) on the
+  // inlined rvalue operator+ when <string> comes from the precompiled header.
+  std::string command = GEOMINT_BINARY;
+  command.append(" ").append(arguments).append(" 2>&1");
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return -1;
   std::array<char, 4096> buffer;
