@@ -36,10 +36,12 @@ class SymplecticEulerA final : public ExplicitStepper<SymplecticEulerA> {
 
   // Kick then drift (ExplicitStepper runs it for step() and advance()).
   void advance_by(const Problem& problem, State& state, double h) {
-    velocity_ = MassOperator(problem).solve(state.q, state.p);
+    const MassOperator mass(problem);
+    mass.solve(state.q, state.p, velocity_);  // into the member: no allocation per step
     eval_total_force(problem, state.q, velocity_, state.t, force_);
     state.p += h * force_;
-    state.q += h * MassOperator(problem).solve(state.q, state.p);
+    mass.solve(state.q, state.p, velocity_);
+    state.q += h * velocity_;
     state.t += h;
     ++counters_.steps;
   }
@@ -76,7 +78,7 @@ class SymplecticEulerB final : public ExplicitStepper<SymplecticEulerB> {
 
   // Drift then kick (ExplicitStepper runs it for step() and advance()).
   void advance_by(const Problem& problem, State& state, double h) {
-    velocity_ = MassOperator(problem).solve(state.q, state.p);
+    MassOperator(problem).solve(state.q, state.p, velocity_);  // into the member: no allocation
     state.q += h * velocity_;
     state.t += h;
     eval_total_force(problem, state.q, velocity_, state.t, force_);
