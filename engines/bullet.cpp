@@ -118,9 +118,10 @@ StepStatus BulletChain::step(double h) {
 
 namespace {
 
-class BulletMethod final : public Integrator, public RunsListedProblems {
+class BulletMethod final : public ChainEngineMethod<BulletChain, BulletOptions> {
  public:
-  explicit BulletMethod(BulletOptions options) : options_(std::move(options)) {}
+  explicit BulletMethod(BulletOptions options)
+      : ChainEngineMethod(std::move(options), "builds a btMultiBody of planar hinge chains only") {}
 
   MethodInfo info() const override {
     return options_.integrator == "rk4"
@@ -133,49 +134,6 @@ class BulletMethod final : public Integrator, public RunsListedProblems {
   StabilityPrediction predicted_linear_stability() const override {
     return StabilityPrediction::limit(options_.integrator == "rk4" ? 2 * std::sqrt(2.0) : 2.0);
   }
-
-  std::string problem_refusal(const Problem& problem) const override {
-    std::string why;
-    if (planar_chain_of(problem, why)) return "";
-    return fmt::format(
-        "method 'bullet' builds a btMultiBody of planar hinge chains only: {}; "
-        "problems that apply: {}",
-        why, fmt::join(chain_problem_specs(), ", "));
-  }
-
-  void reset(const Problem& problem, const State& state, double h) override {
-    Integrator::reset(problem, state, h);
-    std::string why;
-    const auto chain = planar_chain_of(problem, why);
-    if (!chain) throw std::logic_error(problem_refusal(problem));
-    engine_ = std::make_unique<BulletChain>(*chain, options_);
-    written_q_.resize(0);
-    written_p_.resize(0);
-  }
-
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    if (!engine_) reset(problem, state, h);
-    const bool engine_holds_state = written_q_.size() == state.q.size() &&
-                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
-                                    state.p == written_p_;
-    if (!engine_holds_state) {
-      engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
-    }
-    const StepStatus status = engine_->step(h);
-    ++counters_.steps;
-    if (!status.ok) return status;
-    engine_->get_state(state.q, velocity_);
-    state.p = chain_momentum(problem, state.q, velocity_);
-    state.t += h;
-    written_q_ = state.q;
-    written_p_ = state.p;
-    return status;
-  }
-
- private:
-  BulletOptions options_;
-  std::unique_ptr<BulletChain> engine_;
-  Vec written_q_, written_p_, velocity_;
 };
 
 }  // namespace

@@ -154,12 +154,13 @@ StepStatus MujocoChain::step(double h) {
 
 namespace {
 
-// The method: the problem's state goes into MuJoCo's qpos/qvel only when it is not the state the
-// previous step wrote (a fresh run, a reversibility check), so a run follows MuJoCo's own
-// trajectory without a round trip through p = M(θ)θ̇ per step.
-class MujocoMethod final : public Integrator, public RunsListedProblems {
+// MuJoCo's own step on a planar chain (ChainEngineMethod writes the state into qpos/qvel only
+// when the harness changed it).
+class MujocoMethod final : public ChainEngineMethod<MujocoChain, MujocoOptions> {
  public:
-  explicit MujocoMethod(MujocoOptions options) : options_(std::move(options)) {}
+  explicit MujocoMethod(MujocoOptions options)
+      : ChainEngineMethod(std::move(options), "builds a MuJoCo model of planar hinge chains only") {
+  }
 
   MethodInfo info() const override {
     if (options_.integrator == "rk4") {
@@ -179,50 +180,6 @@ class MujocoMethod final : public Integrator, public RunsListedProblems {
     // real-axis bound is 2√2.
     return StabilityPrediction::limit(options_.integrator == "rk4" ? 2 * std::sqrt(2.0) : 2.0);
   }
-
-  std::string problem_refusal(const Problem& problem) const override {
-    std::string why;
-    if (planar_chain_of(problem, why)) return "";
-    return fmt::format(
-        "method 'mujoco' builds a MuJoCo model of planar hinge chains only: {}; "
-        "problems that apply: {}",
-        why, fmt::join(chain_problem_specs(), ", "));
-  }
-
-  void reset(const Problem& problem, const State& state, double h) override {
-    Integrator::reset(problem, state, h);
-    std::string why;
-    const auto chain = planar_chain_of(problem, why);
-    if (!chain) throw std::logic_error(problem_refusal(problem));
-    engine_ = std::make_unique<MujocoChain>(*chain, options_);
-    written_q_.resize(0);
-    written_p_.resize(0);
-  }
-
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    if (!engine_) reset(problem, state, h);
-    // (Eigen compares vectors of equal size only; after reset() nothing has been written.)
-    const bool engine_holds_state = written_q_.size() == state.q.size() &&
-                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
-                                    state.p == written_p_;
-    if (!engine_holds_state) {
-      engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
-    }
-    const StepStatus status = engine_->step(h);
-    ++counters_.steps;
-    if (!status.ok) return status;
-    engine_->get_state(state.q, velocity_);
-    state.p = chain_momentum(problem, state.q, velocity_);
-    state.t += h;
-    written_q_ = state.q;
-    written_p_ = state.p;
-    return status;
-  }
-
- private:
-  MujocoOptions options_;
-  std::unique_ptr<MujocoChain> engine_;
-  Vec written_q_, written_p_, velocity_;
 };
 
 }  // namespace

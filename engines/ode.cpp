@@ -189,9 +189,11 @@ StepStatus OdeChain::step(double h) {
 
 namespace {
 
-class OdeMethod final : public Integrator, public RunsListedProblems {
+class OdeMethod final : public ChainEngineMethod<OdeChain, OdeOptions> {
  public:
-  explicit OdeMethod(OdeOptions options) : options_(std::move(options)) {}
+  explicit OdeMethod(OdeOptions options)
+      : ChainEngineMethod(std::move(options),
+                          "builds ODE bodies and hinges of planar chains only") {}
 
   MethodInfo info() const override {
     return {"ode", 1, kImplicit | kGeneralLagrangian,
@@ -204,49 +206,6 @@ class OdeMethod final : public Integrator, public RunsListedProblems {
         "a maximal-coordinate step with a constraint solve: no linear theory in the problem's "
         "coordinates");
   }
-
-  std::string problem_refusal(const Problem& problem) const override {
-    std::string why;
-    if (planar_chain_of(problem, why)) return "";
-    return fmt::format(
-        "method 'ode' builds ODE bodies and hinges of planar chains only: {}; "
-        "problems that apply: {}",
-        why, fmt::join(chain_problem_specs(), ", "));
-  }
-
-  void reset(const Problem& problem, const State& state, double h) override {
-    Integrator::reset(problem, state, h);
-    std::string why;
-    const auto chain = planar_chain_of(problem, why);
-    if (!chain) throw std::logic_error(problem_refusal(problem));
-    engine_ = std::make_unique<OdeChain>(*chain, options_);
-    written_q_.resize(0);
-    written_p_.resize(0);
-  }
-
-  StepStatus step(const Problem& problem, State& state, double h) override {
-    if (!engine_) reset(problem, state, h);
-    const bool engine_holds_state = written_q_.size() == state.q.size() &&
-                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
-                                    state.p == written_p_;
-    if (!engine_holds_state) {
-      engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
-    }
-    const StepStatus status = engine_->step(h);
-    ++counters_.steps;
-    if (!status.ok) return status;
-    engine_->get_state(state.q, velocity_);
-    state.p = chain_momentum(problem, state.q, velocity_);
-    state.t += h;
-    written_q_ = state.q;
-    written_p_ = state.p;
-    return status;
-  }
-
- private:
-  OdeOptions options_;
-  std::unique_ptr<OdeChain> engine_;
-  Vec written_q_, written_p_, velocity_;
 };
 
 }  // namespace
