@@ -28,7 +28,7 @@ constexpr const char* kGeneralSpec = "kepler:coordinates=polar,e=0.5";
 
 struct Marked {
   bool ok = false;
-  std::source_location where;
+  StepLocation where;
 };
 
 // One step of `method_spec` on `problem_spec` from its initial state, and the step it marked.
@@ -38,7 +38,7 @@ Marked step_once(const std::string& method_spec, const std::string& problem_spec
   State state = problem->initial_state();
   const double h = problem->default_dt();
   method->reset(*problem, state, h);
-  last_step_implementation = std::source_location{};
+  last_step_implementation = StepLocation{};
   Marked marked;
   marked.ok = method->step(*problem, state, h).ok;
   marked.where = last_step_implementation;
@@ -62,15 +62,14 @@ TEST(OneStepPerMethod, SeparableAndGeneralKindsRunTheSameStep) {
     const Marked on_separable = step_once(spec, kSeparableSpec);
     const Marked on_general = step_once(spec, kGeneralSpec);
     ASSERT_TRUE(on_separable.ok && on_general.ok);
-    const bool marks = on_separable.where.line() != 0 || on_general.where.line() != 0;
+    const bool marks = on_separable.where.line != 0 || on_general.where.line != 0;
     if (!marks) continue;
     marked_methods.push_back(method->info().name);
     EXPECT_EQ(
-        std::string(on_separable.where.file_name()) + ":" +
-            std::to_string(on_separable.where.line()),
-        std::string(on_general.where.file_name()) + ":" + std::to_string(on_general.where.line()))
+        std::string(on_separable.where.file_name) + ":" + std::to_string(on_separable.where.line),
+        std::string(on_general.where.file_name) + ":" + std::to_string(on_general.where.line))
         << "the separable and the general kind ran different step implementations";
-    EXPECT_STREQ(on_separable.where.function_name(), on_general.where.function_name());
+    EXPECT_STREQ(on_separable.where.function_name, on_general.where.function_name);
   }
   EXPECT_GE(both_kinds, 6);  // the kGeneralLagrangian family
   for (std::string_view name : kOneStepMethods) {
