@@ -5,9 +5,12 @@
 #include <fmt/format.h>
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cstring>
 #include <mutex>
+
+#include "engines/engine_method.hpp"
 
 namespace geomint::engines {
 namespace {
@@ -33,24 +36,32 @@ double point_mass_inertia(double mass, double length) {
   return std::max(10 * mjMINVAL, 1e-14 * mass * length * length);
 }
 
-std::string chain_xml(const PlanarChain& chain, const MujocoOptions& options) {
+// The <mujoco>, <compiler> and <option> lines of a model: the integrator, gravity along −z and the
+// flags. Clean: no contact or constraint machinery, no passive forces (the joints carry neither
+// damping, stiffness nor armature, written out per joint), energies computed for the tests.
+std::string model_header(const std::string& name, double gravity, const MujocoOptions& options) {
   const std::string integrator = options.integrator == "rk4"        ? "RK4"
                                  : options.integrator == "implicit" ? "implicit"
                                                                     : "Euler";
-  // Clean: no contact or constraint machinery, no passive forces (the joints carry neither
-  // damping, stiffness nor armature, written out below), energies computed for the tests.
   const std::string flags = options.shipped_defaults
                                 ? R"(<flag energy="enable"/>)"
                                 : R"(<flag contact="disable" constraint="disable" )"
                                   R"(passive="disable" energy="enable"/>)";
-  const std::string joint_extras =
-      options.shipped_defaults ? "" : R"( damping="0" stiffness="0" armature="0" frictionloss="0")";
-  std::string xml = fmt::format(
-      "<mujoco model=\"geomint_chain\">\n"
+  return fmt::format(
+      "<mujoco model=\"{}\">\n"
       "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
       "  <option timestep=\"0.01\" integrator=\"{}\" gravity=\"0 0 {:.17g}\">{}</option>\n"
       "  <worldbody>\n",
-      integrator, -chain.gravity, flags);
+      name, integrator, -gravity, flags);
+}
+
+std::string joint_extras(const MujocoOptions& options) {
+  return options.shipped_defaults ? ""
+                                  : R"( damping="0" stiffness="0" armature="0" frictionloss="0")";
+}
+
+std::string chain_xml(const PlanarChain& chain, const MujocoOptions& options) {
+  std::string xml = model_header("geomint_chain", chain.gravity, options);
   // Rod i hangs along −z from its joint; the axis −y makes a positive angle swing the rod
   // towards +x, the problems' convention x = Σ lᵢ sin θᵢ.
   std::string closing;
@@ -62,11 +73,64 @@ std::string chain_xml(const PlanarChain& chain, const MujocoOptions& options) {
         "<body pos=\"0 0 {:.17g}\"><joint type=\"hinge\" axis=\"0 -1 0\"{}/>"
         "<inertial pos=\"0 0 {:.17g}\" mass=\"{:.17g}\" diaginertia=\"{:.17g} {:.17g} "
         "{:.17g}\"/>\n",
-        -offset, joint_extras, -l, chain.mass[i], inertia, inertia, inertia);
+        -offset, joint_extras(options), -l, chain.mass[i], inertia, inertia, inertia);
     closing += "</body>";
   }
   xml += closing + "\n  </worldbody>\n</mujoco>\n";
   return xml;
+}
+
+// One body at the origin on a ball joint (a free joint for the free body), its centre of mass at
+// the principal centre, the principal moments on the body's own axes.
+std::string rotor_xml(const Rotor& rotor, const MujocoOptions& options) {
+  const Eigen::Vector3d& c = rotor.principal_centre;
+  const Eigen::Vector3d& I = rotor.principal_moments;
+  return model_header("geomint_rotor", rotor.gravity, options) +
+         fmt::format(
+             "<body pos=\"0 0 0\"><joint type=\"{}\"{}/>"
+             "<inertial pos=\"{:.17g} {:.17g} {:.17g}\" mass=\"{:.17g}\" "
+             "diaginertia=\"{:.17g} {:.17g} {:.17g}\"/></body>\n"
+             "  </worldbody>\n</mujoco>\n",
+             rotor.free() ? "free" : "ball", joint_extras(options), c[0], c[1], c[2], rotor.mass,
+             I[0], I[1], I[2]);
+}
+
+// Compiles `xml` from memory (a virtual file system holding the one MJCF file); the warning hook
+// is installed once (it is one global of the library, and sweeps build models on several threads).
+mjModel* load_model(const std::string& xml, const std::string& what) {
+  static std::once_flag hook_installed;
+  std::call_once(hook_installed, [] { mju_user_warning = &record_mujoco_warning; });
+  auto vfs = std::make_unique<mjVFS>();  // mjVFS is large: on the heap
+  mj_defaultVFS(vfs.get());
+  const char* file_name = "geomint_model.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), file_name, static_cast<int>(xml.size())) != 0) {
+    throw InputError("mujoco: cannot create the model file in MuJoCo's virtual file system");
+  }
+  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), file_name)], xml.data(), xml.size());
+  std::array<char, 1000> error{};
+  mjModel* model = mj_loadXML(file_name, vfs.get(), error.data(), static_cast<int>(error.size()));
+  mj_deleteVFS(vfs.get());
+  if (model == nullptr) {
+    throw InputError(fmt::format("mujoco: MuJoCo refused the model of {}: {}", what, error.data()));
+  }
+  return model;
+}
+
+// One mj_step of length h; a warning MuJoCo raises in it (bad qacc, qpos, qvel: its instability
+// detector, which would also reset the state) is a failed status naming it.
+StepStatus step_model(mjModel* model, mjData* data, double h) {
+  model->opt.timestep = h;
+  std::array<int, mjNWARNING> before{};
+  for (int i = 0; i < mjNWARNING; ++i) before[i] = data->warning[i].number;
+  mj_step(model, data);
+  for (int i = 0; i < mjNWARNING; ++i) {
+    if (data->warning[i].number != before[i]) {
+      return StepStatus::failure(
+          fmt::format("mujoco_{}", warning_name(i)),
+          fmt::format("MuJoCo warning {} in mj_step: {}", warning_name(i), last_mujoco_warning));
+    }
+  }
+  return StepStatus::success();
 }
 
 }  // namespace
@@ -78,26 +142,7 @@ const std::vector<std::string>& mujoco_integrators() {
 
 MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
     : xml_(chain_xml(chain, options)) {
-  // Installed once: the hook is one global of the library, and sweeps build models on several
-  // threads.
-  static std::once_flag hook_installed;
-  std::call_once(hook_installed, [] { mju_user_warning = &record_mujoco_warning; });
-  // The model is compiled from memory: a virtual file system holding the one MJCF file (mjVFS
-  // is large, so it lives on the heap).
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const char* file_name = "geomint_chain.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), file_name, static_cast<int>(xml_.size())) != 0) {
-    throw InputError("mujoco: cannot create the model file in MuJoCo's virtual file system");
-  }
-  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), file_name)], xml_.data(), xml_.size());
-  std::array<char, 1000> error{};
-  model_ = mj_loadXML(file_name, vfs.get(), error.data(), static_cast<int>(error.size()));
-  mj_deleteVFS(vfs.get());
-  if (model_ == nullptr) {
-    throw InputError(fmt::format("mujoco: MuJoCo refused the model of {} links: {}", chain.links(),
-                                 error.data()));
-  }
+  model_ = load_model(xml_, fmt::format("{} links", chain.links()));
   data_ = mj_makeData(model_);
 }
 
@@ -137,30 +182,58 @@ DenseMatrix MujocoChain::mass_matrix_absolute() const {
 double MujocoChain::potential() const { return data_->energy[0]; }
 double MujocoChain::kinetic() const { return data_->energy[1]; }
 
-StepStatus MujocoChain::step(double h) {
-  model_->opt.timestep = h;
-  std::array<int, mjNWARNING> before{};
-  for (int i = 0; i < mjNWARNING; ++i) before[i] = data_->warning[i].number;
-  mj_step(model_, data_);
-  for (int i = 0; i < mjNWARNING; ++i) {
-    if (data_->warning[i].number != before[i]) {
-      return StepStatus::failure(
-          fmt::format("mujoco_{}", warning_name(i)),
-          fmt::format("MuJoCo warning {} in mj_step: {}", warning_name(i), last_mujoco_warning));
-    }
-  }
-  return StepStatus::success();
+StepStatus MujocoChain::step(double h) { return step_model(model_, data_, h); }
+
+MujocoRotor::MujocoRotor(const Rotor& rotor, const MujocoOptions& options)
+    : xml_(rotor_xml(rotor, options)) {
+  model_ = load_model(xml_, "a rigid body");
+  data_ = mj_makeData(model_);
+  // A free joint's qpos starts with the position (3), its qvel with the linear velocity (3).
+  rotation_offset_ = rotor.free() ? 3 : 0;
+  spin_offset_ = rotor.free() ? 3 : 0;
 }
+
+MujocoRotor::~MujocoRotor() {
+  if (data_ != nullptr) mj_deleteData(data_);
+  if (model_ != nullptr) mj_deleteModel(model_);
+}
+
+void MujocoRotor::set_state(const RotorState& principal) {
+  mj_resetData(model_, data_);
+  const Eigen::Quaterniond q(principal.attitude);
+  double* quaternion = data_->qpos + rotation_offset_;  // MuJoCo's order: w, x, y, z
+  quaternion[0] = q.w(), quaternion[1] = q.x(), quaternion[2] = q.y(), quaternion[3] = q.z();
+  for (int k = 0; k < 3; ++k) data_->qvel[spin_offset_ + k] = principal.omega[k];
+  mj_forward(model_, data_);
+}
+
+RotorState MujocoRotor::get_state() const {
+  const double* quaternion = data_->qpos + rotation_offset_;
+  RotorState state;
+  state.attitude = Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2], quaternion[3])
+                       .toRotationMatrix();
+  for (int k = 0; k < 3; ++k) state.omega[k] = data_->qvel[spin_offset_ + k];
+  return state;
+}
+
+Eigen::Matrix3d MujocoRotor::rotational_mass_matrix() const {
+  const int n = model_->nv;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(n, n);
+  mj_fullM(model_, full.data(), data_->qM);
+  return full.block<3, 3>(spin_offset_, spin_offset_);
+}
+
+double MujocoRotor::potential() const { return data_->energy[0]; }
+double MujocoRotor::kinetic() const { return data_->energy[1]; }
+StepStatus MujocoRotor::step(double h) { return step_model(model_, data_, h); }
 
 namespace {
 
-// MuJoCo's own step on a planar chain (ChainEngineMethod writes the state into qpos/qvel only
-// when the harness changed it).
-class MujocoMethod final : public ChainEngineMethod<MujocoChain, MujocoOptions> {
+// MuJoCo's own step on a planar chain or a rigid body (EngineMethod writes the state into
+// qpos/qvel only when the harness changed it).
+class MujocoMethod final : public EngineMethod<MujocoChain, MujocoRotor, MujocoOptions> {
  public:
-  explicit MujocoMethod(MujocoOptions options)
-      : ChainEngineMethod(std::move(options), "builds a MuJoCo model of planar hinge chains only") {
-  }
+  explicit MujocoMethod(MujocoOptions options) : EngineMethod(std::move(options), "MuJoCo") {}
 
   MethodInfo info() const override {
     if (options_.integrator == "rk4") {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "engines/planar_chain.hpp"
+#include "engines/rotor.hpp"
 #include "integrators/integrator.hpp"
 #include "problems/lagrangian.hpp"
 
@@ -48,6 +49,34 @@ class MujocoChain {
   mjData_* data_ = nullptr;
   std::string xml_;
   Vec relative_, relative_rate_;
+};
+
+// One rigid body about a fixed point (engines/rotor.hpp) as a MuJoCo body on a ball joint at the
+// origin, or on a free joint for the free body (gravity off): qpos holds the attitude as a
+// quaternion, qvel the angular velocity in the body's own (principal) frame.
+class MujocoRotor {
+ public:
+  MujocoRotor(const Rotor& rotor, const MujocoOptions& options);
+  ~MujocoRotor();
+  MujocoRotor(const MujocoRotor&) = delete;
+  MujocoRotor& operator=(const MujocoRotor&) = delete;
+
+  void set_state(const RotorState& principal);
+  RotorState get_state() const;
+  // At the state last set: the rotational block of MuJoCo's mass matrix (mj_fullM), the inertia
+  // about the origin in the principal frame; its potential and kinetic energy.
+  Eigen::Matrix3d rotational_mass_matrix() const;
+  double potential() const;
+  double kinetic() const;
+  StepStatus step(double h);
+  const std::string& xml() const { return xml_; }
+
+ private:
+  mjModel_* model_ = nullptr;
+  mjData_* data_ = nullptr;
+  std::string xml_;
+  int rotation_offset_ = 0;  // where the quaternion starts in qpos (after a free joint's position)
+  int spin_offset_ = 0;      // where the angular velocity starts in qvel
 };
 
 }  // namespace geomint::engines

@@ -6,10 +6,13 @@
 #include <fmt/format.h>
 #include <ode/ode.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdarg>
 #include <mutex>
 #include <numbers>
+
+#include "engines/engine_method.hpp"
 
 namespace geomint::engines {
 namespace {
@@ -44,6 +47,50 @@ void init_ode_for_this_thread() {
 std::mutex quick_step_mutex;
 constexpr unsigned long kQuickStepSeed = 0;
 
+// A world with gravity g along −z; clean: hard joints (CFM = 0) without the Baumgarte correction
+// (ERP = 0), which feeds position errors back as velocity; no damping, sleeping or speed clamp
+// (their defaults, written out).
+dxWorld* make_world(double gravity, const OdeOptions& options) {
+  init_ode_for_this_thread();
+  dxWorld* world = dWorldCreate();
+  dWorldSetGravity(world, 0, 0, -gravity);
+  if (!options.shipped_defaults) {
+    dWorldSetCFM(world, 0);
+    dWorldSetERP(world, 0);
+    dWorldSetAutoDisableFlag(world, 0);
+    dWorldSetLinearDamping(world, 0);
+    dWorldSetAngularDamping(world, 0);
+    dWorldSetMaxAngularSpeed(world, dInfinity);
+  }
+  return world;
+}
+
+StepStatus step_world(dxWorld* world, const OdeOptions& options, double h) {
+  last_ode_message.clear();
+  int ok = 0;
+  if (options.step == "quick") {
+    const std::lock_guard<std::mutex> lock(quick_step_mutex);
+    dRandSetSeed(kQuickStepSeed);
+    ok = dWorldQuickStep(world, h);
+  } else {
+    ok = dWorldStep(world, h);
+  }
+  if (!ok || !last_ode_message.empty()) {
+    return StepStatus::failure("ode_step", last_ode_message.empty()
+                                               ? std::string("ODE's step returned failure")
+                                               : last_ode_message);
+  }
+  return StepStatus::success();
+}
+
+// ODE's dMatrix3 is row-major with a stride of 4.
+Eigen::Matrix3d from_ode(const dReal* R) {
+  Eigen::Matrix3d out;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out(i, j) = R[4 * i + j];
+  return out;
+}
+
 }  // namespace
 
 const std::vector<std::string>& ode_steps() {
@@ -59,19 +106,7 @@ const std::vector<std::string>& ode_steps() {
 // approximation (tested).
 OdeChain::OdeChain(const PlanarChain& chain, const OdeOptions& options)
     : options_(options), links_(chain.links()) {
-  init_ode_for_this_thread();
-  world_ = dWorldCreate();
-  dWorldSetGravity(world_, 0, 0, -chain.gravity);
-  if (!options.shipped_defaults) {
-    // Hard joints (CFM = 0) without the Baumgarte correction (ERP = 0), which feeds position
-    // errors back as velocity; no damping, sleeping or speed clamp (their defaults, written out).
-    dWorldSetCFM(world_, 0);
-    dWorldSetERP(world_, 0);
-    dWorldSetAutoDisableFlag(world_, 0);
-    dWorldSetLinearDamping(world_, 0);
-    dWorldSetAngularDamping(world_, 0);
-    dWorldSetMaxAngularSpeed(world_, dInfinity);
-  }
+  world_ = make_world(chain.gravity, options);
   for (int i = 0; i < links_; ++i) {
     Link link;
     link.length = chain.length[i];
@@ -169,31 +204,92 @@ double OdeChain::potential() const {
   return energy;
 }
 
-StepStatus OdeChain::step(double h) {
-  last_ode_message.clear();
-  int ok = 0;
-  if (options_.step == "quick") {
-    const std::lock_guard<std::mutex> lock(quick_step_mutex);
-    dRandSetSeed(kQuickStepSeed);
-    ok = dWorldQuickStep(world_, h);
-  } else {
-    ok = dWorldStep(world_, h);
+StepStatus OdeChain::step(double h) { return step_world(world_, options_, h); }
+
+OdeRotor::OdeRotor(const Rotor& rotor, const OdeOptions& options)
+    : options_(options), centre_(rotor.principal_centre) {
+  world_ = make_world(rotor.gravity, options);
+  Eigen::Vector3d I = rotor.principal_moments;
+  double total = rotor.mass;
+  const bool point_mass =
+      rotor.kind == Rotor::Kind::kSpherical || rotor.kind == Rotor::Kind::kSphericalAngles;
+  if (point_mass) {
+    // As for the chains: the bob's rod carries a second mass m at the pivot, which never moves, so
+    // the body (2m at the rod's middle, inertia (m/2)L² about it) has exactly the bob's energies
+    // and a rotational inertia of the bob's order: a near-zero one (the other engines' 1e-14·mL²)
+    // leaves dWorldQuickStep's iteration without convergence. The same inertia about the rod's own
+    // axis is never excited: no force or torque turns a symmetric body about it.
+    centre_ = rotor.principal_centre / 2;
+    total = 2 * rotor.mass;
+    I.setConstant(rotor.mass / 2 * rotor.principal_centre.squaredNorm());
   }
-  if (!ok || !last_ode_message.empty()) {
-    return StepStatus::failure("ode_step", last_ode_message.empty()
-                                               ? std::string("ODE's step returned failure")
-                                               : last_ode_message);
+  dMass mass;
+  dMassSetParameters(&mass, total, 0, 0, 0, I[0], I[1], I[2], 0, 0, 0);
+  body_ = dBodyCreate(world_);
+  dBodySetMass(body_, &mass);
+  if (!rotor.free()) {
+    joint_ = dJointCreateBall(world_, nullptr);
+    dJointAttach(joint_, body_, nullptr);
   }
-  return StepStatus::success();
+  set_state(RotorState{});
 }
+
+OdeRotor::~OdeRotor() {
+  if (world_ != nullptr) dWorldDestroy(world_);
+}
+
+void OdeRotor::set_state(const RotorState& principal) {
+  const Eigen::Matrix3d& Q = principal.attitude;
+  const Eigen::Vector3d omega = Q * principal.omega;  // ODE's angular velocity is spatial
+  const Eigen::Vector3d position = Q * centre_;
+  const Eigen::Vector3d velocity = omega.cross(position);
+  dMatrix3 rotation;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) rotation[4 * i + j] = Q(i, j);
+    rotation[4 * i + 3] = 0;
+  }
+  dBodySetRotation(body_, rotation);
+  dBodySetPosition(body_, position[0], position[1], position[2]);
+  dBodySetLinearVel(body_, velocity[0], velocity[1], velocity[2]);
+  dBodySetAngularVel(body_, omega[0], omega[1], omega[2]);
+  if (joint_ != nullptr) dJointSetBallAnchor(joint_, 0, 0, 0);
+}
+
+RotorState OdeRotor::get_state() const {
+  RotorState state;
+  state.attitude = from_ode(dBodyGetRotation(body_));
+  const dReal* w = dBodyGetAngularVel(body_);
+  state.omega = state.attitude.transpose() * Eigen::Vector3d(w[0], w[1], w[2]);
+  return state;
+}
+
+double OdeRotor::kinetic() const {
+  dMass mass;
+  dBodyGetMass(body_, &mass);
+  const Eigen::Matrix3d R = from_ode(dBodyGetRotation(body_));
+  const Eigen::Matrix3d I_body = from_ode(mass.I);
+  const dReal* v = dBodyGetLinearVel(body_);
+  const dReal* w = dBodyGetAngularVel(body_);
+  const Eigen::Vector3d omega(w[0], w[1], w[2]);
+  return 0.5 * mass.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
+         0.5 * omega.dot(R * I_body * R.transpose() * omega);
+}
+
+double OdeRotor::potential() const {
+  dVector3 gravity;
+  dWorldGetGravity(world_, gravity);
+  dMass mass;
+  dBodyGetMass(body_, &mass);
+  return -mass.mass * gravity[2] * dBodyGetPosition(body_)[2];
+}
+
+StepStatus OdeRotor::step(double h) { return step_world(world_, options_, h); }
 
 namespace {
 
-class OdeMethod final : public ChainEngineMethod<OdeChain, OdeOptions> {
+class OdeMethod final : public EngineMethod<OdeChain, OdeRotor, OdeOptions> {
  public:
-  explicit OdeMethod(OdeOptions options)
-      : ChainEngineMethod(std::move(options),
-                          "builds ODE bodies and hinges of planar chains only") {}
+  explicit OdeMethod(OdeOptions options) : EngineMethod(std::move(options), "ODE") {}
 
   MethodInfo info() const override {
     return {"ode", 1, kImplicit | kGeneralLagrangian,

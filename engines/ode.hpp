@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engines/planar_chain.hpp"
+#include "engines/rotor.hpp"
 #include "integrators/integrator.hpp"
 
 struct dxWorld;
@@ -50,6 +51,31 @@ class OdeChain {
   dxWorld* world_ = nullptr;
   std::vector<Link> links_data_;
   Vec angles_;
+};
+
+// One rigid body about a fixed point (engines/rotor.hpp) as an ODE body (its origin at the centre
+// of mass, as ODE requires) on a ball joint at the origin; the free body has no joint. The state is
+// the body's rotation and angular velocity (the pivot's drift, a joint error, is not read back).
+class OdeRotor {
+ public:
+  OdeRotor(const Rotor& rotor, const OdeOptions& options);
+  ~OdeRotor();
+  OdeRotor(const OdeRotor&) = delete;
+  OdeRotor& operator=(const OdeRotor&) = delete;
+
+  void set_state(const RotorState& principal);
+  RotorState get_state() const;
+  // ½m|v|² + ½ωᵀRIRᵀω and m g z of the body, from ODE's own mass, pose and velocities.
+  double kinetic() const;
+  double potential() const;
+  StepStatus step(double h);
+
+ private:
+  OdeOptions options_;
+  Eigen::Vector3d centre_;  // principal frame
+  dxWorld* world_ = nullptr;
+  dxBody* body_ = nullptr;
+  dxJoint* joint_ = nullptr;
 };
 
 }  // namespace geomint::engines

@@ -314,10 +314,14 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         "that apply: {}",
                         method.spec(), problem.name(), fmt::join(first_order_methods(), ", "))};
   }
-  // A method that models only some problems (a physics engine's chain) says which.
+  // A method that models only some problems (a physics engine) says which, and runs each of
+  // those as a whole: it reads the problem's parameters, not its functions, so the checks below
+  // (kinds, constraints) do not concern it (an engine's ball joint runs the constrained
+  // spherical pendulum and rigid body).
   if (const auto* listed = dynamic_cast<const RunsListedProblems*>(&method)) {
     std::string refusal = listed->problem_refusal(problem);
     if (!refusal.empty()) return {false, std::move(refusal)};
+    return {};
   }
   if (needs.structure != nullptr) {
     return {false, structure_refusal(method, problem, *needs.structure)};

@@ -1,0 +1,99 @@
+// The Integrator side every engine method shares: which problems it models (planar chains,
+// engines/planar_chain.hpp, and one rigid body about a fixed point, engines/rotor.hpp), the
+// engine model it builds for each, and the state's trip into the engine and back.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "engines/planar_chain.hpp"
+#include "engines/rotor.hpp"
+#include "integrators/integrator.hpp"
+
+namespace geomint::engines {
+
+// The problem's state goes into the engine only when it is not the state the previous step wrote
+// (a fresh run, a reversibility check), so a run follows the engine's own trajectory without a
+// round trip through the problem's momenta per step.
+// ChainEngine: constructed from (const PlanarChain&, const Options&), with set_state(θ, θ̇),
+// StepStatus step(h) and get_state(θ, θ̇) in the problem's absolute angles.
+// RotorEngine: constructed from (const Rotor&, const Options&), with set_state(RotorState),
+// StepStatus step(h) and RotorState get_state(), the attitude and body angular velocity of the
+// rotor's principal frame (RotorStateMap::to_principal).
+template <class ChainEngine, class RotorEngine, class Options>
+class EngineMethod : public Integrator, public RunsListedProblems {
+ public:
+  EngineMethod(Options options, std::string engine)
+      : options_(std::move(options)), engine_name_(std::move(engine)) {}
+
+  std::string problem_refusal(const Problem& problem) const override {
+    std::string why = engine_refusal(problem, info().name, engine_name_);
+    return why.empty() ? option_refusal(problem) : why;
+  }
+
+  void reset(const Problem& problem, const State& state, double h) override {
+    Integrator::reset(problem, state, h);
+    if (std::string why = problem_refusal(problem); !why.empty()) throw std::logic_error(why);
+    chain_engine_.reset();
+    rotor_engine_.reset();
+    rotor_map_.reset();
+    std::string ignored;
+    if (const auto chain = planar_chain_of(problem, ignored)) {
+      chain_engine_ = std::make_unique<ChainEngine>(*chain, options_);
+    } else {
+      const auto rotor = rotor_of(problem, ignored);
+      rotor_engine_ = std::make_unique<RotorEngine>(*rotor, options_);
+      rotor_map_ = std::make_unique<RotorStateMap>(*rotor);
+    }
+    written_q_.resize(0);
+    written_p_.resize(0);
+  }
+
+  StepStatus step(const Problem& problem, State& state, double h) override {
+    if (!chain_engine_ && !rotor_engine_) reset(problem, state, h);
+    // (Eigen compares vectors of equal size only; after reset() nothing has been written.)
+    const bool engine_holds_state = written_q_.size() == state.q.size() &&
+                                    written_p_.size() == state.p.size() && state.q == written_q_ &&
+                                    state.p == written_p_;
+    StepStatus status;
+    if (chain_engine_) {
+      if (!engine_holds_state) {
+        chain_engine_->set_state(state.q, chain_velocity(problem, state.q, state.p));
+      }
+      status = chain_engine_->step(h);
+      ++counters_.steps;
+      if (!status.ok) return status;
+      chain_engine_->get_state(state.q, velocity_);
+      state.p = chain_momentum(problem, state.q, velocity_);
+    } else {
+      if (!engine_holds_state) {
+        rotor_engine_->set_state(rotor_map_->to_principal(rotor_map_->to_rotor(problem, state)));
+      }
+      status = rotor_engine_->step(h);
+      ++counters_.steps;
+      if (!status.ok) return status;
+      rotor_map_->to_problem(problem, rotor_map_->from_principal(rotor_engine_->get_state()),
+                             state);
+    }
+    state.t += h;
+    written_q_ = state.q;
+    written_p_ = state.p;
+    return status;
+  }
+
+ protected:
+  // An option the engine has only for some of its problems (Bullet's gyro= for its btRigidBody)
+  // refuses the others: "" when it applies.
+  virtual std::string option_refusal(const Problem&) const { return ""; }
+  Options options_;
+
+ private:
+  std::string engine_name_;
+  std::unique_ptr<ChainEngine> chain_engine_;
+  std::unique_ptr<RotorEngine> rotor_engine_;
+  std::unique_ptr<RotorStateMap> rotor_map_;
+  Vec written_q_, written_p_, velocity_;
+};
+
+}  // namespace geomint::engines
