@@ -595,5 +595,17 @@ TEST(RotorRuns, EveryEngineFollowsTheEnergyOfEveryRotorProblem) {
   }
 }
 
+// A ball joint far beyond its stable step ends the run with MuJoCo's own warning, as a chain does.
+TEST(RotorFailures, AnUnstableTopEndsTheRunWithMujocosWarning) {
+  const auto problem = make_problem("heavy_top");
+  const auto method = make_integrator("mujoco");
+  State state = problem->initial_state();
+  method->reset(*problem, state, 2.0);
+  StepStatus status;
+  for (int k = 0; k < 1000 && status.ok; ++k) status = method->step(*problem, state, 2.0);
+  ASSERT_FALSE(status.ok);
+  EXPECT_NE(status.reason.find("mujoco_mjWARN_BAD"), std::string::npos) << status.reason;
+}
+
 }  // namespace
 }  // namespace geomint::engines
