@@ -2,7 +2,6 @@
 #include "engines/planar_chain.hpp"
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include <cmath>
 
@@ -91,14 +90,6 @@ Vec chain_momentum(const Problem& problem, const Vec& q, const Vec& v) {
     return lagrangian->momentum(q, v);
   }
   return problem.mass().cwiseProduct(v);
-}
-
-std::string chain_refusal(const Problem& problem, const std::string& method,
-                          const std::string& builds) {
-  std::string why;
-  if (planar_chain_of(problem, why)) return "";
-  return fmt::format("method '{}' {}: {}; problems that apply: {}", method, builds, why,
-                     fmt::join(chain_problem_specs(), ", "));
 }
 
 }  // namespace geomint::engines

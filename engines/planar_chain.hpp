@@ -36,9 +36,4 @@ void relative_to_absolute(const Vec& relative, Vec& absolute);
 Vec chain_velocity(const Problem& problem, const Vec& q, const Vec& p);
 Vec chain_momentum(const Problem& problem, const Vec& q, const Vec& v);
 
-// "" when `problem` is a planar chain, else why `method` (which `builds`, e.g. "builds a MuJoCo
-// model of planar hinge chains only") refuses it, with the problems that apply.
-std::string chain_refusal(const Problem& problem, const std::string& method,
-                          const std::string& builds);
-
 }  // namespace geomint::engines
