@@ -121,10 +121,17 @@ void parse_legacy_file(const std::string& file, Gate& gate, const std::string& w
 ResultFile read_result_file(const fs::path& path) {
   // A damaged table is refused whole (read_csv_file): a row cut inside a number would read as
   // another number and could pass a band the intact table fails.
-  const CsvTable table = read_csv_file(path.string());
+  CsvTable csv = read_csv_file(path.string());
+  ResultTable table{path.stem().string(), std::move(csv.provenance), {}, std::move(csv.rows)};
+  return result_file(table, path.string());
+}
+
+}  // namespace
+
+ResultFile result_file(const ResultTable& table, const std::string& path) {
   ResultFile file;
-  file.path = path.string();
-  file.table = path.stem().string();
+  file.path = path;
+  file.table = table.name;
   file.rows = table.rows;
   const std::map<std::string, std::string> lines(table.provenance.begin(), table.provenance.end());
   const auto scene = lines.find("scene");
@@ -140,14 +147,28 @@ ResultFile read_result_file(const fs::path& path) {
   }
   if (file.variant != "full" && file.variant != "quick") {
     throw InputError(fmt::format("gate: result file '{}': unknown variant '{}' (full or quick)",
-                                 path.string(), file.variant));
+                                 path, file.variant));
   }
   if (file.scene.empty()) {
-    throw InputError(fmt::format(
-        "gate: result file '{}': cannot tell its scene (no '# scene:' line)", path.string()));
+    throw InputError(
+        fmt::format("gate: result file '{}': cannot tell its scene (no '# scene:' line)", path));
   }
   return file;
 }
+
+std::vector<ResultFile> result_files(const std::vector<ResultTable>& tables,
+                                     const std::string& folder) {
+  std::vector<ResultFile> files;
+  for (const auto& table : tables) {
+    files.push_back(result_file(table, (fs::path(folder) / (table.name + ".csv")).string()));
+  }
+  // In the order load_result_files reads a folder's tables: by file name.
+  std::sort(files.begin(), files.end(),
+            [](const ResultFile& a, const ResultFile& b) { return a.path < b.path; });
+  return files;
+}
+
+namespace {
 
 // The same file reached by two spellings must be recognised (a cycle through "./x.toml").
 fs::path canonical_or_absolute(const fs::path& path) {

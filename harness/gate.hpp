@@ -60,6 +60,17 @@ struct ResultFile {
   std::vector<Row> rows;
 };
 
+// The gates' view of a result table in memory (a sweep's, harness/sweep.hpp): the scene and
+// variant from its provenance lines (else from `path`, as for a file), `path` naming it in the
+// verdicts. Every file the gates read goes through here. InputError as for a file.
+ResultFile result_file(const ResultTable& table, const std::string& path);
+
+// The tables of a sweep in memory as if read from `folder` (load_result_files of the folder its
+// CSVs are written to gives the same files, in the same order): check_gates on them gives the
+// verdicts `geomint gate` gives on the written folder, line for line.
+std::vector<ResultFile> result_files(const std::vector<ResultTable>& tables,
+                                     const std::string& folder);
+
 // Reads result CSVs; a directory stands for the tables in it (summary.csv, order.csv,
 // stability.csv, ...; not series/). InputError for a missing, unreadable or unparsable path, a
 // directory without tables, or a file whose scene cannot be told.

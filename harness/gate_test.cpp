@@ -10,6 +10,8 @@
 #include <map>
 
 #include "harness/metrics.hpp"
+#include "harness/scene.hpp"
+#include "harness/sweep.hpp"
 #include "problems/spec.hpp"
 
 namespace geomint {
@@ -350,6 +352,71 @@ TEST(Gate, RepositoryGatesLiveInTheirScenesFolders) {
               static_cast<std::size_t>(per_file[scene]))
         << scene;
   }
+}
+
+// The gates on a sweep's tables in memory give the verdicts they give on the files the sweep
+// wrote, line for line: one passing, one failing, one on the order table, one not applicable.
+TEST(Gate, VerdictsOnInMemoryTablesAreThoseOnTheWrittenFiles) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("geomint_gate_in_memory_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "scene.toml")
+      << "title = \"t\"\n[[runs]]\nlabel = \"short\"\nproblems = [\"pendulum:theta0=0.5\"]\n"
+         "methods = [\"stormer_verlet\", \"explicit_euler\"]\ndt = 0.05\nt_end = 2.0\n"
+         "timing_repeats = 0\n[[orders]]\nlabel = \"ladder\"\nproblems = [\"pendulum\"]\n"
+         "methods = [\"stormer_verlet\"]\ndt0 = 0.1\nlevels = 4\nt_end = 1.0\n";
+  const Scene scene = load_scene((dir / "scene.toml").string(), true);
+  SweepOptions options;
+  options.out_dir = (dir / "quick").string();
+  options.progress = false;
+  options.command_line = "geomint sweep scene.toml --quick";
+  options.scene_name = "mem";
+  options.variant = "quick";
+  const SweepResult result = sweep(scene, options);
+  static std::vector<Gate> gates;  // outcomes point into it
+  gates = load_gates(write_temp("in_memory_gates.toml", R"(
+[[gate]]
+name = "verlet keeps energy"
+scene = "mem"
+table = "summary"
+where = { method = "stormer_verlet" }
+column = "energy_err_max"
+max = 1e-2
+[[gate]]
+name = "euler fails a tight band"
+scene = "mem"
+where = { method = "explicit_euler" }
+column = "energy_err_max"
+max = 1e-12
+[[gate]]
+name = "second order"
+scene = "mem"
+table = "order"
+column = "order"
+min = 1.9
+max = 2.1
+[[gate]]
+name = "another scene"
+scene = "other"
+column = "status"
+equals = "ok"
+)"));
+  const auto from_files = check_gates(gates, load_result_files({options.out_dir}));
+  const auto in_memory = check_gates(gates, result_files(result.tables, options.out_dir));
+  ASSERT_EQ(in_memory.size(), 4u);
+  ASSERT_EQ(from_files.size(), 4u);
+  for (size_t i = 0; i < in_memory.size(); ++i) {
+    EXPECT_EQ(in_memory[i].applicable, from_files[i].applicable) << gates[i].name;
+    EXPECT_EQ(in_memory[i].passed, from_files[i].passed) << gates[i].name;
+    EXPECT_EQ(in_memory[i].rows_checked, from_files[i].rows_checked) << gates[i].name;
+    EXPECT_EQ(in_memory[i].lines, from_files[i].lines) << gates[i].name;
+  }
+  EXPECT_TRUE(in_memory[0].passed);
+  EXPECT_FALSE(in_memory[1].passed);
+  EXPECT_TRUE(in_memory[2].passed) << in_memory[2].lines.front();
+  EXPECT_FALSE(in_memory[3].applicable);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Gate, RepositoryGatesPassOnTheCommittedResults) {

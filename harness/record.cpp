@@ -31,60 +31,62 @@ const std::vector<std::pair<const char*, long Counters::*>>& counter_columns() {
   return columns;
 }
 
-template <typename T>
-std::function<std::optional<std::string>(const RunRecord&)> text(
-    std::optional<T> RunRecord::*field) {
-  return [field](const RunRecord& record) { return record.*field; };
+RecordColumn text(const std::string& name, std::optional<std::string> RunRecord::*field) {
+  return {name, ColumnType::kText, [field](const RunRecord& record) { return record.*field; }};
 }
 
-std::function<std::optional<std::string>(const RunRecord&)> real(
-    std::optional<double> RunRecord::*field) {
-  return [field](const RunRecord& record) -> std::optional<std::string> {
-    if (!(record.*field)) return std::nullopt;
-    return format_number(*(record.*field));
-  };
+RecordColumn real(const std::string& name, std::optional<double> RunRecord::*field) {
+  return {name, ColumnType::kReal, [field](const RunRecord& record) -> std::optional<std::string> {
+            if (!(record.*field)) return std::nullopt;
+            return real_cell(*(record.*field));
+          }};
 }
 
-std::function<std::optional<std::string>(const RunRecord&)> integer(
-    std::optional<long> RunRecord::*field) {
-  return [field](const RunRecord& record) -> std::optional<std::string> {
-    if (!(record.*field)) return std::nullopt;
-    return std::to_string(*(record.*field));
-  };
+RecordColumn integer(const std::string& name, std::optional<long> RunRecord::*field) {
+  return {name, ColumnType::kInteger,
+          [field](const RunRecord& record) -> std::optional<std::string> {
+            if (!(record.*field)) return std::nullopt;
+            return integer_cell(*(record.*field));
+          }};
+}
+
+RecordColumn required_text(const std::string& name, std::string RunRecord::*field) {
+  return {name, ColumnType::kText,
+          [field](const RunRecord& record) { return std::optional(record.*field); }};
 }
 
 std::vector<RecordColumn> build_schema() {
   std::vector<RecordColumn> schema = {
-      {"label", text(&RunRecord::label)},
-      {"problem", [](const RunRecord& r) { return std::optional(r.problem); }},
-      {"method", [](const RunRecord& r) { return std::optional(r.method); }},
-      {"family", text(&RunRecord::family)},
-      {"dt", real(&RunRecord::dt)},
-      {"t_end", real(&RunRecord::t_end)},
-      {"status", [](const RunRecord& r) { return std::optional(r.status); }},
-      {"message", text(&RunRecord::message)},
-      {"t_reached", real(&RunRecord::t_reached)},
-      {"steps", integer(&RunRecord::steps)},
+      text("label", &RunRecord::label),
+      required_text("problem", &RunRecord::problem),
+      required_text("method", &RunRecord::method),
+      text("family", &RunRecord::family),
+      real("dt", &RunRecord::dt),
+      real("t_end", &RunRecord::t_end),
+      required_text("status", &RunRecord::status),
+      text("message", &RunRecord::message),
+      real("t_reached", &RunRecord::t_reached),
+      integer("steps", &RunRecord::steps),
   };
   for (const auto& name : metric_names()) {
-    schema.push_back({name, [name = name](const RunRecord& r) {
+    schema.push_back({name, ColumnType::kReal, [name = name](const RunRecord& r) {
                         const auto found = r.metrics.find(name);
                         if (found == r.metrics.end()) return std::optional<std::string>();
-                        return std::optional(format_number(found->second));
+                        return std::optional(real_cell(found->second));
                       }});
   }
   for (const auto& [name, member] : counter_columns()) {
-    schema.push_back({name, [member = member](const RunRecord& r) {
+    schema.push_back({name, ColumnType::kInteger, [member = member](const RunRecord& r) {
                         if (!r.counters) return std::optional<std::string>();
-                        return std::optional(std::to_string((*r.counters).*member));
+                        return std::optional(integer_cell((*r.counters).*member));
                       }});
   }
-  schema.push_back({"wall_s", real(&RunRecord::wall_s)});
-  schema.push_back({"wall_s_min", real(&RunRecord::wall_s_min)});
-  schema.push_back({"wall_s_iqr", real(&RunRecord::wall_s_iqr)});
-  schema.push_back({"wall_s_repeats", integer(&RunRecord::wall_s_repeats)});
-  schema.push_back({"order_level", integer(&RunRecord::order_level)});
-  schema.push_back({"reference", text(&RunRecord::reference)});
+  schema.push_back(real("wall_s", &RunRecord::wall_s));
+  schema.push_back(real("wall_s_min", &RunRecord::wall_s_min));
+  schema.push_back(real("wall_s_iqr", &RunRecord::wall_s_iqr));
+  schema.push_back(integer("wall_s_repeats", &RunRecord::wall_s_repeats));
+  schema.push_back(integer("order_level", &RunRecord::order_level));
+  schema.push_back(text("reference", &RunRecord::reference));
   return schema;
 }
 
@@ -114,42 +116,47 @@ namespace {
 std::optional<std::string> fitted_order_cell(const OrderRecord& r,
                                              const std::optional<double>& order) {
   if (!r.ran) return std::nullopt;
-  return order ? fmt::format("{:.3f}", *order) : "";
+  return order ? real_cell(*order, 3) : "";
 }
 }  // namespace
 
 const std::vector<Column<OrderRecord>>& order_schema() {
   using Cell = std::optional<std::string>;
   static const std::vector<Column<OrderRecord>> schema = {
-      {"label", [](const OrderRecord& r) { return r.label; }},
-      {"problem", [](const OrderRecord& r) { return Cell(r.problem); }},
-      {"method", [](const OrderRecord& r) { return Cell(r.method); }},
-      {"order", [](const OrderRecord& r) { return fitted_order_cell(r, r.order); }},
-      {"order_q", [](const OrderRecord& r) { return fitted_order_cell(r, r.order_q); }},
-      {"order_p", [](const OrderRecord& r) { return fitted_order_cell(r, r.order_p); }},
-      {"order_multiplier",
+      {"label", ColumnType::kText, [](const OrderRecord& r) { return r.label; }},
+      {"problem", ColumnType::kText, [](const OrderRecord& r) { return Cell(r.problem); }},
+      {"method", ColumnType::kText, [](const OrderRecord& r) { return Cell(r.method); }},
+      {"order", ColumnType::kReal,
+       [](const OrderRecord& r) { return fitted_order_cell(r, r.order); }},
+      {"order_q", ColumnType::kReal,
+       [](const OrderRecord& r) { return fitted_order_cell(r, r.order_q); }},
+      {"order_p", ColumnType::kReal,
+       [](const OrderRecord& r) { return fitted_order_cell(r, r.order_p); }},
+      // "n/a" where the problem has no exact multipliers: a word, not a number (number()).
+      {"order_multiplier", ColumnType::kReal,
        [](const OrderRecord& r) -> Cell {
          if (r.ran && !r.multiplier_applies) return "n/a";
          return fitted_order_cell(r, r.order_multiplier);
        }},
-      {"declared_order",
+      {"declared_order", ColumnType::kInteger,
        [](const OrderRecord& r) -> Cell {
          if (!r.ran) return std::nullopt;
-         return std::to_string(r.declared_order);
+         return integer_cell(r.declared_order);
        }},
-      {"points_used",
+      // The dt of the fitted points, space-separated: one text cell.
+      {"points_used", ColumnType::kText,
        [](const OrderRecord& r) -> Cell {
          if (!r.ran) return std::nullopt;
          std::vector<std::string> dts;
-         for (double dt : r.points_used) dts.push_back(format_number(dt));
+         for (double dt : r.points_used) dts.push_back(real_cell(dt));
          return fmt::format("{}", fmt::join(dts, " "));
        }},
-      {"status", [](const OrderRecord& r) { return Cell(r.status); }},
-      {"message", [](const OrderRecord& r) { return r.message; }},
-      {"t_end",
+      {"status", ColumnType::kText, [](const OrderRecord& r) { return Cell(r.status); }},
+      {"message", ColumnType::kText, [](const OrderRecord& r) { return r.message; }},
+      {"t_end", ColumnType::kReal,
        [](const OrderRecord& r) -> Cell {
          if (!r.t_end) return std::nullopt;
-         return format_number(*r.t_end);
+         return real_cell(*r.t_end);
        }},
   };
   return schema;
@@ -159,7 +166,24 @@ Row to_row(const OrderRecord& record) { return row_of(order_schema(), record); }
 
 std::string records_to_csv(const std::vector<RunRecord>& records,
                            const std::vector<std::pair<std::string, std::string>>& lines) {
-  return to_csv(to_rows(records), record_columns(records), lines);
+  return to_csv(record_table("", records, lines));
+}
+
+ColumnType record_column_type(const std::string& name) {
+  for (const auto& column : record_schema()) {
+    if (column.name == name) return column.type;
+  }
+  return ColumnType::kText;
+}
+
+ResultTable record_table(const std::string& name, const std::vector<RunRecord>& records,
+                         const std::vector<std::pair<std::string, std::string>>& lines) {
+  return {name, lines, typed_columns_of(record_schema(), records), to_rows(records)};
+}
+
+ResultTable order_table(const std::vector<OrderRecord>& records,
+                        const std::vector<std::pair<std::string, std::string>>& lines) {
+  return {"order", lines, typed_columns_of(order_schema(), records), to_rows(records)};
 }
 
 }  // namespace geomint

@@ -55,10 +55,12 @@ struct OrderRecord {
   std::optional<double> t_end;
 };
 
-// A column of a record's table: its one name and how its cell is formatted.
+// A column of a record's table: its one name, its type and its cell (formatted by real_cell or
+// integer_cell for the number types).
 template <typename Record>
 struct Column {
   std::string name;
+  ColumnType type;
   // The formatted cell, or nullopt when the record does not set this column.
   std::function<std::optional<std::string>(const Record&)> value;
 };
@@ -71,6 +73,22 @@ Row row_of(const std::vector<Column<Record>>& schema, const Record& record) {
     if (auto cell = column.value(record)) row[column.name] = std::move(*cell);
   }
   return row;
+}
+
+// The schema columns set in at least one record, in schema order, with their types.
+template <typename Record>
+std::vector<TableColumn> typed_columns_of(const std::vector<Column<Record>>& schema,
+                                          const std::vector<Record>& records) {
+  std::vector<TableColumn> columns;
+  for (const auto& column : schema) {
+    for (const auto& record : records) {
+      if (column.value(record)) {
+        columns.push_back({column.name, column.type});
+        break;
+      }
+    }
+  }
+  return columns;
 }
 
 // The schema columns set in at least one record, in schema order.
@@ -116,5 +134,16 @@ std::vector<Row> to_rows(const std::vector<Record>& records) {
   for (const auto& record : records) rows.push_back(to_row(record));
   return rows;
 }
+
+// The type of a run record's column `name` (record_schema()); text for a name it does not have.
+ColumnType record_column_type(const std::string& name);
+
+// The in-memory table of run records (summary.csv, `geomint run --out`) over record_columns().
+ResultTable record_table(const std::string& name, const std::vector<RunRecord>& records,
+                         const std::vector<std::pair<std::string, std::string>>& lines);
+
+// order.csv's table of order studies over the order_schema() columns they set.
+ResultTable order_table(const std::vector<OrderRecord>& records,
+                        const std::vector<std::pair<std::string, std::string>>& lines);
 
 }  // namespace geomint

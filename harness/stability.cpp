@@ -254,4 +254,13 @@ const std::vector<std::string>& stability_columns() {
   return columns;
 }
 
+ColumnType stability_column_type(const std::string& name) {
+  if (name == "runs") return ColumnType::kInteger;
+  for (const char* real : {"alpha", "omega", "homega_lo", "homega_hi", "homega_max_measured",
+                           "predicted", "rel_diff", "horizon", "growth"}) {
+    if (name == real) return ColumnType::kReal;
+  }
+  return ColumnType::kText;
+}
+
 }  // namespace geomint

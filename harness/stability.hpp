@@ -74,4 +74,8 @@ void check_stability_budget(const Problem& problem, const std::string& problem_s
 // Columns of stability.csv, in order.
 const std::vector<std::string>& stability_columns();
 
+// The type of a stability.csv column (the runs count an integer, the h*omega values and the
+// method's alpha reals, the rest text).
+ColumnType stability_column_type(const std::string& name);
+
 }  // namespace geomint

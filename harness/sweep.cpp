@@ -303,7 +303,10 @@ Plan expand_scene(const Scene& scene, const SweepOptions& options) {
                   "methods or problems distinct specs)",
                   block.label, normal.string()));
             }
-            job.config.series_path = (fs::path(options.out_dir) / normal).string();
+            // A sweep in memory (no output folder) writes no series files.
+            if (!options.out_dir.empty()) {
+              job.config.series_path = (fs::path(options.out_dir) / normal).string();
+            }
           }
           jobs.push_back(std::move(job));
         }
@@ -491,24 +494,54 @@ void remove_stale_temporaries(const Scene& scene, const std::string& out_dir) {
   remove_stale_outputs(expand_scene(scene, options), out_dir);
 }
 
+const ResultTable* SweepResult::table(const std::string& name) const {
+  for (const auto& table : tables) {
+    if (table.name == name) return &table;
+  }
+  return nullptr;
+}
+
+SceneTables SweepResult::scene_tables() const {
+  SceneTables rows;
+  if (const ResultTable* summary = table("summary")) rows.summary = summary->rows;
+  if (const ResultTable* order = table("order")) rows.order = order->rows;
+  if (const ResultTable* stability = table("stability")) rows.stability = stability->rows;
+  return rows;
+}
+
 int run_sweep(const Scene& scene, const SweepOptions& options) {
+  // An empty folder is the working directory, as it always was for the program.
+  SweepOptions writing = options;
+  if (writing.out_dir.empty()) writing.out_dir = ".";
+  return sweep(scene, writing).failed;
+}
+
+SweepResult sweep(const Scene& scene, const SweepOptions& options) {
   namespace fs = std::filesystem;
-  check_output_dir(options.out_dir, "output folder");
+  const bool sharded = options.shard_count > 0;
+  const bool writes = !options.out_dir.empty();
+  if (sharded && !writes) {
+    throw InputError("a sharded sweep writes shard files: give it an output folder");
+  }
+  if (writes) check_output_dir(options.out_dir, "output folder");
   Plan plan = expand_scene(scene, options);
-  check_sweep_outputs(plan, options);
+  if (writes) check_sweep_outputs(plan, options);
   auto& jobs = plan.jobs;
   auto& order_jobs = plan.order_jobs;
   auto& stability_jobs = plan.stability_jobs;
   SpecBook& specs = *scene.specs;
-  const bool sharded = options.shard_count > 0;
   const ShardId shard{options.shard_index, options.shard_count};
   // The shards of one sweep write disjoint files and share the folder; anything else owns it.
-  const OutputFolderLock lock(
-      options.out_dir,
-      sharded ? OutputFolderLock::Mode::kShared : OutputFolderLock::Mode::kExclusive,
-      sharded ? fmt::format("geomint sweep --shard {}", shard_text(shard)) : "geomint sweep");
-  check_folder_scene(options.out_dir, options.scene_name);
-  remove_stale_outputs(plan, options.out_dir);
+  // A sweep in memory writes nothing and takes no folder.
+  std::optional<OutputFolderLock> lock;
+  if (writes) {
+    lock.emplace(
+        options.out_dir,
+        sharded ? OutputFolderLock::Mode::kShared : OutputFolderLock::Mode::kExclusive,
+        sharded ? fmt::format("geomint sweep --shard {}", shard_text(shard)) : "geomint sweep");
+    check_folder_scene(options.out_dir, options.scene_name);
+    remove_stale_outputs(plan, options.out_dir);
+  }
   // The units of this sweep by canonical index k (runs, order studies, stability searches):
   // all of them, or a shard's k mod N == i (round-robin, so long runs spread over the shards).
   const auto mine = [&](size_t k) {
@@ -608,10 +641,12 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
   auto lines = provenance(options.command_line);
   if (!options.scene_name.empty()) lines.emplace_back("scene", options.scene_name);
   lines.emplace_back("variant", options.variant);
+  SweepResult result;
   if (sharded) {
-    return write_shard(plan, accuracy_units, stability_units, lines, options);
+    result.failed = write_shard(plan, accuracy_units, stability_units, lines, options);
+    return result;
   }
-  int failed = 0;
+  int& failed = result.failed;
   std::vector<RunRecord> summary_records, order_point_records;
   std::vector<OrderRecord> order_records;
   for (const auto& job : jobs) {
@@ -627,30 +662,38 @@ int run_sweep(const Scene& scene, const SweepOptions& options) {
       order_point_records.back().label = job.label;
     }
   }
-  const fs::path out(options.out_dir);
-  SceneTables tables;
-  tables.summary = to_rows(summary_records);
-  tables.order = to_rows(order_records);
+  // The tables the scene has, in memory; the files below are written from them alone.
   if (!summary_records.empty()) {
-    write_file_atomic((out / "summary.csv").string(), records_to_csv(summary_records, lines));
+    result.tables.push_back(record_table("summary", summary_records, lines));
   }
   if (!order_records.empty()) {
-    write_file_atomic((out / "order.csv").string(),
-                      to_csv(tables.order, columns_of(order_schema(), order_records), lines));
-    write_file_atomic((out / "order_points.csv").string(),
-                      to_csv(to_rows(order_point_records),
-                             order_points_columns(record_columns(order_point_records)), lines));
+    result.tables.push_back(order_table(order_records, lines));
+    ResultTable points = record_table("order_points", order_point_records, lines);
+    points.columns.clear();
+    for (const auto& name : order_points_columns(record_columns(order_point_records))) {
+      points.columns.push_back({name, record_column_type(name)});
+    }
+    result.tables.push_back(std::move(points));
   }
   if (!stability_jobs.empty()) {
-    for (const auto& job : stability_jobs) tables.stability.push_back(job.row);
-    write_file_atomic(
-        (out / "stability.csv").string(),
-        to_csv(tables.stability, column_union(tables.stability, stability_columns()), lines));
+    std::vector<Row> rows;
+    for (const auto& job : stability_jobs) rows.push_back(job.row);
+    std::vector<TableColumn> columns;
+    for (const auto& name : column_union(rows, stability_columns())) {
+      columns.push_back({name, stability_column_type(name)});
+    }
+    result.tables.push_back({"stability", lines, std::move(columns), std::move(rows)});
   }
-  write_file_atomic((out / "table.md").string(),
-                    scene_markdown(scene, tables, options.command_line,
-                                   table_citation(lines, options.scene_hash)));
-  return failed;
+  if (writes) {
+    const fs::path out(options.out_dir);
+    for (const auto& table : result.tables) {
+      write_file_atomic((out / (table.name + ".csv")).string(), to_csv(table));
+    }
+    write_file_atomic((out / "table.md").string(),
+                      scene_markdown(scene, result.scene_tables(), options.command_line,
+                                     table_citation(lines, options.scene_hash)));
+  }
+  return result;
 }
 
 std::vector<std::string> order_points_columns(std::vector<std::string> columns) {

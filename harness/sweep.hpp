@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "harness/scene.hpp"
+#include "harness/table.hpp"
 
 namespace geomint {
 
@@ -30,10 +31,31 @@ struct SweepOptions {
   std::string scene_hash;  // scene_content_hash() of the scene file, for the shard provenance
 };
 
-// Runs the scene; returns the number of failed runs (failure rows are results, not errors).
-// Throws InputError before any computing when the output folder cannot be written or two runs
-// would write the same series file. No exception escapes a worker thread: a run that throws
-// becomes a row with status `error` and the exception's text as message.
+struct SceneTables;
+
+// A sweep's results in memory (docs/DESIGN.md §5 "Tables in memory"): the scene's tables
+// (summary, order, order_points, stability: those the scene has, in that order), each with the
+// provenance lines its CSV starts with, and the number of failed runs. to_csv(table) is the text
+// of <out_dir>/<table.name>.csv, byte for byte.
+struct SweepResult {
+  int failed = 0;
+  std::vector<ResultTable> tables;
+  // The table of that name, or nullptr when the scene has none.
+  const ResultTable* table(const std::string& name) const;
+  // The rows table.md shows.
+  SceneTables scene_tables() const;
+};
+
+// Runs the scene and returns its tables. With an output folder (options.out_dir) it also writes
+// what `geomint sweep` writes there: the CSVs from the returned tables, table.md and the series;
+// without one it writes nothing (no series files either). A sharded sweep (shard_count > 0)
+// writes its shard files and returns no tables. Failure rows are results, not errors. Throws
+// InputError before any computing when the output folder cannot be written, two runs would write
+// the same series file, or a sharded sweep has no folder. No exception escapes a worker thread: a
+// run that throws becomes a row with status `error` and the exception's text as message.
+SweepResult sweep(const Scene& scene, const SweepOptions& options);
+
+// sweep() into options.out_dir (empty: the working directory); returns the number of failed runs.
 int run_sweep(const Scene& scene, const SweepOptions& options);
 
 // How many units of each kind the scene expands to (the canonical order of a sharded sweep).

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -115,6 +116,89 @@ TEST_F(SweepTables, MarkdownOnlyRebuildsTheSameTableFromTheCsvs) {
   EXPECT_EQ(read_text(dir_ / "table.md"), written);
   fs::remove(dir_ / "summary.csv");
   EXPECT_THROW(rewrite_scene_markdown(scene_, options), InputError);
+}
+
+// A scene with every kind of table: runs (one diverging, one skipped), order studies (ladder
+// points, fits, "n/a" multiplier orders) and a stability search.
+constexpr const char* kAllTablesScene =
+    "title = \"all tables\"\n"
+    "[[runs]]\nlabel = \"runs\"\nproblems = [\"pendulum:theta0=1.5\", \"van_der_pol\"]\n"
+    "methods = [\"stormer_verlet\", \"explicit_euler\", \"hp:alpha=0\"]\ndt = [0.1, 0.7]\n"
+    "t_end = 20.0\ntiming_repeats = 0\n"
+    "[[orders]]\nlabel = \"ladder\"\nproblems = [\"pendulum:theta0=1.5\"]\n"
+    "methods = [\"stormer_verlet\", \"rk4\"]\ndt0 = 0.1\nlevels = 4\nt_end = 1.0\n"
+    "[[stability]]\nlabel = \"limit\"\nproblems = [\"harmonic\"]\nmethods = [\"stormer_verlet\"]\n"
+    "homega_min = 0.5\nhomega_max = 10.0\nmin_steps = 200\nperiods = 5.0\nrel_tol = 1e-2\n";
+
+Scene write_all_tables_scene(const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.toml") << kAllTablesScene;
+  return load_scene((dir / "scene.toml").string(), false);
+}
+
+// sweep() returns the scene's tables in memory and writes every CSV from them: each file is
+// to_csv() of its table byte for byte, the columns carry their types, and a real cell reads back
+// as a number. Without an output folder the same rows come back and nothing is written.
+TEST(SweepResult, InMemoryTablesAreTheWrittenFilesByteForByte) {
+  const fs::path dir = fs::path(testing::TempDir()) / "geomint_sweep_in_memory";
+  const Scene scene = write_all_tables_scene(dir);
+  SweepOptions options;
+  options.out_dir = (dir / "out").string();
+  options.progress = false;
+  options.command_line = "geomint sweep scene.toml";
+  options.scene_name = "all_tables";
+  options.jobs = 2;
+  const SweepResult result = sweep(scene, options);
+  EXPECT_GE(result.failed, 1);  // the diverging and skipped runs
+  std::vector<std::string> names, files;
+  for (const auto& table : result.tables) {
+    names.push_back(table.name);
+    EXPECT_EQ(to_csv(table), read_text(fs::path(options.out_dir) / (table.name + ".csv")))
+        << table.name;
+    EXPECT_EQ(table.value("scene"), "all_tables");
+  }
+  for (const auto& entry : fs::directory_iterator(options.out_dir)) {
+    if (entry.path().extension() == ".csv") files.push_back(entry.path().stem().string());
+  }
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"summary", "order", "order_points", "stability"}));
+  EXPECT_EQ(files, (std::vector<std::string>{"order", "order_points", "stability", "summary"}));
+
+  const ResultTable& summary = *result.table("summary");
+  EXPECT_EQ(summary.column("dt")->type, ColumnType::kReal);
+  EXPECT_EQ(summary.column("steps")->type, ColumnType::kInteger);
+  EXPECT_EQ(summary.column("status")->type, ColumnType::kText);
+  EXPECT_EQ(summary.number(0, "dt"), 0.1);
+  const ResultTable& order = *result.table("order");
+  EXPECT_EQ(order.column("declared_order")->type, ColumnType::kInteger);
+  EXPECT_EQ(order.column("order")->type, ColumnType::kReal);
+  EXPECT_EQ(order.rows[0].at("order_multiplier"), "n/a");
+  EXPECT_EQ(order.number(0, "order_multiplier"), std::nullopt);
+  EXPECT_EQ(result.table("stability")->column("runs")->type, ColumnType::kInteger);
+  bool diverged = false;
+  for (size_t row = 0; row < summary.rows.size(); ++row) {
+    for (const auto& column : summary.columns) {
+      const auto cell = summary.rows[row].find(column.name);
+      if (column.type == ColumnType::kText || cell == summary.rows[row].end()) continue;
+      // A number cell reads back as the double it was formatted from.
+      ASSERT_TRUE(summary.number(row, column.name)) << column.name << " = " << cell->second;
+      EXPECT_EQ(real_cell(*summary.number(row, column.name)), cell->second);
+    }
+    diverged = diverged || summary.rows[row].at("status") != "ok";
+  }
+  EXPECT_TRUE(diverged);
+
+  SweepOptions in_memory = options;
+  in_memory.out_dir.clear();
+  const SweepResult again = sweep(scene, in_memory);
+  ASSERT_EQ(again.tables.size(), result.tables.size());
+  for (size_t i = 0; i < again.tables.size(); ++i) {
+    EXPECT_EQ(again.tables[i].column_names(), result.tables[i].column_names());
+    EXPECT_EQ(again.tables[i].rows, result.tables[i].rows) << again.tables[i].name;
+  }
+  EXPECT_EQ(again.failed, result.failed);
+  fs::remove_all(dir);
 }
 
 // A skipped row says why with the short label table.md shows, not the canonical spec with

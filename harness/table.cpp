@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +94,59 @@ std::vector<std::pair<std::string, std::string>> provenance(const std::string& c
   };
   add_blas_provenance(lines);
   return lines;
+}
+
+const char* column_type_name(ColumnType type) {
+  switch (type) {
+    case ColumnType::kInteger:
+      return "integer";
+    case ColumnType::kReal:
+      return "real";
+    case ColumnType::kText:
+      break;
+  }
+  return "text";
+}
+
+std::string real_cell(double value, int decimals) {
+  return decimals < 0 ? format_number(value) : fmt::format("{:.{}f}", value, decimals);
+}
+
+std::string integer_cell(long value) { return std::to_string(value); }
+
+std::vector<std::string> ResultTable::column_names() const {
+  std::vector<std::string> names;
+  names.reserve(columns.size());
+  for (const auto& column : columns) names.push_back(column.name);
+  return names;
+}
+
+const TableColumn* ResultTable::column(const std::string& name) const {
+  for (const auto& column : columns) {
+    if (column.name == name) return &column;
+  }
+  return nullptr;
+}
+
+std::string ResultTable::value(const std::string& key, const std::string& absent) const {
+  for (const auto& [name, text] : provenance) {
+    if (name == key) return text;
+  }
+  return absent;
+}
+
+std::optional<double> ResultTable::number(size_t row, const std::string& column) const {
+  const auto cell = rows.at(row).find(column);
+  if (cell == rows.at(row).end() || cell->second.empty()) return std::nullopt;
+  // strtod reads the shortest round-trip text back as the same double, and nan/inf as such.
+  char* end = nullptr;
+  const double value = std::strtod(cell->second.c_str(), &end);
+  if (end != cell->second.c_str() + cell->second.size()) return std::nullopt;
+  return value;
+}
+
+std::string to_csv(const ResultTable& table) {
+  return to_csv(table.rows, table.column_names(), table.provenance);
 }
 
 const std::vector<std::string>& standard_columns() {

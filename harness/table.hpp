@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,45 @@ using Row = std::map<std::string, std::string>;
 
 // Provenance lines: version, git SHA, compiler and flags, library versions, CPU, date, command.
 std::vector<std::pair<std::string, std::string>> provenance(const std::string& command_line);
+
+// What a result table's column holds (docs/DESIGN.md §5 "Tables in memory"): text, an integer
+// (counts) or a real number. Its cells are formatted by integer_cell and real_cell only.
+enum class ColumnType { kText, kInteger, kReal };
+
+// "text", "integer" or "real".
+const char* column_type_name(ColumnType type);
+
+// The cell text of a number, the one place of the tables' number formats: a real is the
+// shortest text that reads back as the same double (format_number: the committed results rely
+// on it to reproduce bit for bit), or `decimals` digits after the point when given (a fitted
+// order, "2.000"); an integer its decimal digits.
+std::string real_cell(double value, int decimals = -1);
+std::string integer_cell(long value);
+
+struct TableColumn {
+  std::string name;
+  ColumnType type = ColumnType::kText;
+};
+
+// A result table in memory, as `sweep` and `order` return it and every writer consumes it: its
+// provenance lines, its typed columns in CSV order and its rows. A row holds each cell as the CSV
+// writes it (absent: an empty cell), so the CSV, table.md and the gates see one text, and a real
+// cell reads back (number()) as the double it was formatted from, bit for bit. A real column may
+// hold a word where there is no number (order_multiplier "n/a"): number() is then nullopt.
+struct ResultTable {
+  std::string name;  // summary, order, order_points, stability (the CSV's file stem)
+  std::vector<std::pair<std::string, std::string>> provenance;
+  std::vector<TableColumn> columns;
+  std::vector<Row> rows;
+
+  std::vector<std::string> column_names() const;
+  // The column of that name, or nullptr.
+  const TableColumn* column(const std::string& name) const;
+  // The value of a provenance line, or `absent`.
+  std::string value(const std::string& key, const std::string& absent = "") const;
+  // The cell as a number (nullopt: empty, or no number); nan and inf cells are numbers.
+  std::optional<double> number(size_t row, const std::string& column) const;
+};
 
 // Columns present in any row, ordered by `preferred` first, then alphabetically.
 std::vector<std::string> column_union(const std::vector<Row>& rows,
@@ -30,6 +70,9 @@ std::string provenance_line(const std::string& key, const std::string& value);
 // CSV text (header + rows); values containing ',' or '"' are quoted.
 std::string to_csv(const std::vector<Row>& rows, const std::vector<std::string>& columns,
                    const std::vector<std::pair<std::string, std::string>>& provenance_lines);
+
+// The CSV of the table (its provenance lines, header and rows): the text every table file holds.
+std::string to_csv(const ResultTable& table);
 
 // Parses CSV text as written by to_csv: `#` provenance lines are skipped, the first other line
 // is the header, quoted fields may contain ',' and '""'. Empty fields are left out of the row.
