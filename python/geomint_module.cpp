@@ -3,6 +3,7 @@
 // that python/geomint/__init__.py parses exactly the text `geomint run` would have written.
 #include <fmt/format.h>
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -167,11 +168,55 @@ py::dict score(const PyProblem& problem, const std::string& path, double start_t
   return out;
 }
 
+// A table's columns as numpy arrays by name, typed by the column (docs/PYTHON.md "sweep and
+// gate"): real → float64 (NaN where a cell is empty or holds no number, order_multiplier's
+// "n/a"), integer → int64 (float64 with NaN when a cell is empty, as pandas holds it), text → a
+// list of str (None where empty).
+py::dict table_arrays(const ResultTable& table) {
+  py::dict arrays;
+  const size_t rows = table.rows.size();
+  for (const TableColumn& column : table.columns) {
+    if (column.type == ColumnType::kText) {
+      py::list cells;
+      for (const Row& row : table.rows) {
+        const auto cell = row.find(column.name);
+        cells.append(cell == row.end() || cell->second.empty() ? py::object(py::none())
+                                                               : py::object(py::str(cell->second)));
+      }
+      arrays[py::str(column.name)] = cells;
+      continue;
+    }
+    std::vector<double> values(rows);
+    bool complete = true;
+    for (size_t r = 0; r < rows; ++r) {
+      const auto value = table.number(r, column.name);
+      complete = complete && value.has_value();
+      values[r] = value.value_or(std::nan(""));
+    }
+    if (column.type == ColumnType::kInteger && complete) {
+      py::array_t<long> integers(static_cast<py::ssize_t>(rows));
+      for (size_t r = 0; r < rows; ++r) integers.mutable_at(r) = static_cast<long>(values[r]);
+      arrays[py::str(column.name)] = integers;
+    } else {
+      arrays[py::str(column.name)] = py::array_t<double>(values.size(), values.data());
+    }
+  }
+  return arrays;
+}
+
+// The in-memory tables of a sweep (harness/sweep.hpp SweepResult) and its failed runs.
+py::dict sweep_result(SweepResult result) {
+  py::dict out;
+  out["failed"] = result.failed;
+  out["tables"] = std::move(result.tables);
+  return out;
+}
+
 // `geomint sweep SCENE [--quick] --out OUT [--no-timing]`, as harness/cli/sweep.cpp sets it up
-// (the scene's name is the folder holding scene.toml, whatever the output folder): the number of
-// failed runs; the tables are the CSV files in `out_dir`.
-int sweep(const std::string& scene_path, bool quick, const std::string& out_dir, int jobs,
-          bool timing, bool progress, const std::string& command_line) {
+// (the scene's name is the folder holding scene.toml, whatever the output folder): the failed
+// runs and the tables in memory, also written into `out_dir` when it is not empty.
+py::dict sweep_scene(const std::string& scene_path, bool quick, const std::string& out_dir,
+                     int jobs, bool timing, bool progress, const std::string& command_line) {
   const Scene scene = load_scene(scene_path, quick);
   SweepOptions options;
   options.jobs = jobs;
@@ -182,21 +227,18 @@ int sweep(const std::string& scene_path, bool quick, const std::string& out_dir,
   options.variant = quick ? "quick" : "full";
   options.scene_hash = scene_content_hash(scene_path, quick);
   options.timing = timing;
-  check_output_dir(options.out_dir, "out");
-  int failed = 0;
+  if (!out_dir.empty()) check_output_dir(options.out_dir, "out");
+  SweepResult result;
   InterruptScope interrupt;
   {
     py::gil_scoped_release release;
-    failed = run_sweep(scene, options);
+    result = sweep(scene, options);
   }
   interrupt.raise_if_interrupted();
-  return failed;
+  return sweep_result(std::move(result));
 }
 
-// `geomint gate GATES RESULTS...`'s verdicts, one dict per gate (applicable or not).
-py::list gate(const std::string& gates_path, const std::vector<std::string>& results) {
-  const std::vector<Gate> gates = load_gates(gates_path);
-  const std::vector<ResultFile> files = load_result_files(results);
+py::list verdicts_of(const std::vector<Gate>& gates, const std::vector<ResultFile>& files) {
   py::list verdicts;
   for (const GateOutcome& outcome : check_gates(gates, files)) {
     py::dict verdict;
@@ -212,6 +254,19 @@ py::list gate(const std::string& gates_path, const std::vector<std::string>& res
     verdicts.append(verdict);
   }
   return verdicts;
+}
+
+// `geomint gate GATES RESULTS...`'s verdicts, one dict per gate (applicable or not).
+py::list gate(const std::string& gates_path, const std::vector<std::string>& results) {
+  const std::vector<Gate> gates = load_gates(gates_path);
+  return verdicts_of(gates, load_result_files(results));
+}
+
+// The same verdicts on a sweep's tables in memory, named as if read from `folder`.
+py::list gate_tables(const std::string& gates_path, const std::vector<ResultTable>& tables,
+                     const std::string& folder) {
+  const std::vector<Gate> gates = load_gates(gates_path);
+  return verdicts_of(gates, result_files(tables, folder));
 }
 
 }  // namespace
@@ -248,6 +303,24 @@ PYBIND11_MODULE(_geomint, module) {
       .def("invariants", &PyProblem::invariants, py::arg("q"), py::arg("p"))
       .def("period", &PyProblem::period);
 
+  // A result table in memory (harness/table.hpp ResultTable): typed columns, cells as the CSV
+  // writes them; geomint.sweep turns it into a DataFrame.
+  py::class_<ResultTable>(module, "ResultTable")
+      .def_readonly("name", &ResultTable::name)
+      .def_readonly("provenance", &ResultTable::provenance)
+      .def_property_readonly("columns", &ResultTable::column_names)
+      .def_property_readonly("types",
+                             [](const ResultTable& table) {
+                               std::vector<std::string> types;
+                               for (const auto& column : table.columns) {
+                                 types.emplace_back(column_type_name(column.type));
+                               }
+                               return types;
+                             })
+      .def_property_readonly("rows", [](const ResultTable& table) { return table.rows.size(); })
+      .def("arrays", &table_arrays)
+      .def("to_csv", [](const ResultTable& table) { return to_csv(table); });
+
   py::class_<RunConfig>(module, "RunConfig")
       .def(py::init<>())
       .def_readwrite("dt", &RunConfig::dt)
@@ -270,9 +343,10 @@ PYBIND11_MODULE(_geomint, module) {
              py::arg("levels"), py::arg("t_end"), py::arg("diverge_factor"));
   module.attr("default_diverge_factor") = kDefaultDivergeFactor;
   module.attr("default_max_steps") = kDefaultMaxSteps;
-  module.def("sweep", &sweep, py::arg("scene"), py::arg("quick"), py::arg("out_dir"),
+  module.def("sweep", &sweep_scene, py::arg("scene"), py::arg("quick"), py::arg("out_dir"),
              py::arg("jobs"), py::arg("timing"), py::arg("progress"), py::arg("command_line"));
   module.def("gate", &gate, py::arg("gates"), py::arg("results"));
+  module.def("gate_tables", &gate_tables, py::arg("gates"), py::arg("tables"), py::arg("folder"));
   module.def("score", &score, py::arg("problem"), py::arg("path"), py::arg("start_tol"),
              py::arg("velocities"), py::arg("metrics"), py::arg("label"), py::arg("reference_dir"));
   bind_python_methods(module);

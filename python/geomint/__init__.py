@@ -12,7 +12,7 @@ from ._geomint import InputError  # a subclass of ValueError
 
 __all__ = [
     "problems", "methods", "Problem", "Run", "Series", "run", "order", "InputError",
-    "register_method", "check_names", "check", "verify", "sweep", "gate", "read_table", "Tables", "score",
+    "register_method", "check_names", "check", "verify", "sweep", "gate", "read_table", "Tables", "frame", "score",
 ]
 
 
@@ -118,8 +118,10 @@ def _problem(problem):
 
 
 def read_table(path):
-    """A table CSV the harness wrote, as pandas reads it with comment="#" (docs/PYTHON.md), but
-    only whole lines starting with # are provenance: they go to df.attrs["provenance"]."""
+    """A table CSV the harness wrote, as pandas reads it with comment="#" and
+    float_precision="round_trip" (the exact doubles: pandas' default parser can round the last
+    of 17 digits; docs/PYTHON.md), but only whole lines starting with # are provenance: they go
+    to df.attrs["provenance"]."""
     import io
 
     import pandas as pd
@@ -131,20 +133,55 @@ def read_table(path):
         if line.startswith("# ") and ":" in line:
             key, value = line[2:].split(":", 1)
             provenance[key.strip()] = value.strip()
-    frame = pd.read_csv(io.StringIO("".join(line for line in lines if not line.startswith("#"))))
-    frame.attrs["provenance"] = provenance
-    return frame
+    table = pd.read_csv(io.StringIO("".join(line for line in lines if not line.startswith("#"))),
+                        float_precision="round_trip")
+    table.attrs["provenance"] = provenance
+    return table
+
+
+def frame(table):
+    """A result table in memory (a sweep's) as a pandas DataFrame, its columns typed by the
+    harness's column types: real -> float64 (NaN where empty or no number, as "n/a"), integer ->
+    int64 (float64 with NaN when a cell is empty), text -> object (NaN where empty); the provenance
+    lines in df.attrs["provenance"]."""
+    import pandas as pd
+
+    arrays = table.arrays()
+    columns = {}
+    for name, kind in zip(table.columns, table.types):
+        values = arrays[name]
+        if kind == "text":
+            # Empty cells are NaN, as pandas reads an empty CSV cell.
+            values = np.array([math.nan if cell is None else cell for cell in values],
+                              dtype=object)
+        columns[name] = values
+    result = pd.DataFrame(columns, columns=table.columns, index=pd.RangeIndex(table.rows))
+    provenance = {}
+    for key, value in table.provenance:
+        provenance[key.strip()] = value.strip()  # as read_table reads a file's lines
+    result.attrs["provenance"] = provenance
+    return result
 
 
 class Tables(dict):
     """A sweep's tables by name (summary, order, order_points, stability: those the scene has),
-    each a pandas DataFrame; `failed` is the number of failed runs (rows, not errors) and
-    `folder` where the CSVs are (None when they were written to a temporary folder)."""
+    each a pandas DataFrame built from the tables the harness returns in memory; `failed` is the
+    number of failed runs (rows, not errors), `folder` where the CSVs were written (None when
+    out was not given: nothing was written). csv(name) is the text of that table's CSV, and
+    geomint.gate(gates, tables) gates the tables without reading a file."""
 
-    def __init__(self, tables, failed, folder):
+    def __init__(self, tables, failed, folder, raw=()):
         super().__init__(tables)
         self.failed = failed
         self.folder = folder
+        self._raw = list(raw)
+
+    def csv(self, name):
+        """The CSV text of table `name`, byte for byte the file `geomint sweep` writes."""
+        for table in self._raw:
+            if table.name == name:
+                return table.to_csv()
+        raise KeyError(name)
 
     def __getattr__(self, name):
         try:
@@ -159,34 +196,23 @@ SWEEP_TABLES = ("summary", "order", "order_points", "stability")
 def sweep(scene, quick=False, out=None, jobs=1, timing=True, progress=False):
     """Runs a scene (its scene.toml, or the folder holding it) as `geomint sweep SCENE` does,
     with --quick, --jobs and --no-timing (timing=False), and returns its tables as a Tables dict
-    of DataFrames equal to the CSVs the program writes. `out` is the output folder (as --out);
-    by default a temporary folder, removed afterwards (never the scene's results folder)."""
+    of DataFrames, built from the tables in memory (no CSV is read back). `out` is the output
+    folder (as --out): the CSVs, table.md and series are written there from the same tables.
+    Without it nothing is written (no series files either)."""
     scene = os.fspath(scene)
     if os.path.isdir(scene):
         scene = os.path.join(scene, "scene.toml")
     command = f"python: geomint.sweep({scene!r}, quick={bool(quick)!r}, timing={bool(timing)!r})"
-
-    def run_into(folder):
-        failed = _geomint.sweep(scene, bool(quick), folder, int(jobs), bool(timing),
-                                bool(progress), command)
-        tables = {
-            name: read_table(os.path.join(folder, name + ".csv"))
-            for name in SWEEP_TABLES
-            if os.path.exists(os.path.join(folder, name + ".csv"))
-        }
-        return tables, failed
-
-    if out is not None:
-        out = os.fspath(out)
-        tables, failed = run_into(out)
-        return Tables(tables, failed, out)
-    with tempfile.TemporaryDirectory(prefix="geomint-sweep-") as folder:
-        tables, failed = run_into(folder)
-    return Tables(tables, failed, None)
+    folder = "" if out is None else os.fspath(out)
+    result = _geomint.sweep(scene, bool(quick), folder, int(jobs), bool(timing), bool(progress),
+                            command)
+    tables = {table.name: frame(table) for table in result["tables"]}
+    return Tables(tables, result["failed"], folder or None, result["tables"])
 
 
 def gate(gates, results=None):
-    """The verdicts of `geomint gate GATES RESULTS...`: a DataFrame with one row per gate that
+    """The verdicts of `geomint gate GATES RESULTS...` (or of the gates on the Tables a sweep
+    returned, in memory): a DataFrame with one row per gate that
     applies to the results (gate, scene, table, column, file, passed, rows_checked, lines: the
     checked rows' verdicts), and df.attrs["passed"] (every gate passed: the program's exit 0)
     and df.attrs["not_applicable"] (the other gates' names). `gates` is a gates file or a scene
@@ -200,9 +226,13 @@ def gate(gates, results=None):
         gates = os.path.join(gates, "gates.toml")
     if results is None:
         raise ValueError(f"gate: give the results to check after the gates file '{gates}'")
-    if isinstance(results, (str, os.PathLike)):
-        results = [results]
-    verdicts = _geomint.gate(gates, [os.fspath(path) for path in results])
+    if isinstance(results, Tables):
+        # A sweep's tables in memory, named as the files of its folder would be.
+        verdicts = _geomint.gate_tables(gates, results._raw, results.folder or "(in memory)")
+    else:
+        if isinstance(results, (str, os.PathLike)):
+            results = [results]
+        verdicts = _geomint.gate(gates, [os.fspath(path) for path in results])
     applied = [verdict for verdict in verdicts if verdict["applicable"]]
     if not applied:
         raise InputError(f"gate: none of the {len(verdicts)} gate(s) in '{gates}' applies to the "

@@ -34,16 +34,61 @@ def cli_folder():
         yield folder
 
 
+# The dtype of each column type of the harness (geomint.frame): integer columns with an empty
+# cell are float64, as pandas holds them.
+DTYPES = {"real": ("float64",), "integer": ("int64", "float64"), "text": ("object",)}
+
+
 def test_quick_sweep_frames_equal_the_cli_csvs(cli_folder):
     tables = geomint.sweep(SCENE, quick=True, timing=False)
     written = sorted(name[:-4] for name in os.listdir(cli_folder) if name.endswith(".csv"))
     assert sorted(tables) == written == ["order", "order_points", "summary"]
     assert tables.failed == 0 and tables.folder is None
     for name, frame in tables.items():
-        expected = pd.read_csv(os.path.join(cli_folder, name + ".csv"), comment="#")
-        pd.testing.assert_frame_equal(frame, expected, check_exact=True, obj=name)
+        # round_trip: pandas' default float parser can round the last of 17 digits, where the
+        # frame holds the harness's doubles.
+        expected = pd.read_csv(os.path.join(cli_folder, name + ".csv"), comment="#",
+                               float_precision="round_trip")
+        # The values are the CSV's exactly; the dtypes are the column types', where pandas guesses
+        # from the text (a real column whose cells all look like integers reads as int64).
+        pd.testing.assert_frame_equal(frame, expected, check_exact=True, check_dtype=False,
+                                      obj=name)
+        raw = next(table for table in tables._raw if table.name == name)
+        for column, kind in zip(raw.columns, raw.types):
+            assert str(frame[column].dtype) in DTYPES[kind], (name, column, kind)
     provenance = tables.summary.attrs["provenance"]
     assert provenance["scene"] == "order_basic" and provenance["variant"] == "quick"
+    # Typed columns: the counters are integers, the errors reals, the status text.
+    assert str(tables.summary["steps"].dtype) == "int64"
+    assert str(tables.summary["energy_err_max"].dtype) == "float64"
+    assert str(tables.summary["t_end"].dtype) == "float64"
+    assert tables.summary["status"].tolist() == ["ok"] * len(tables.summary)
+
+
+def test_sweep_without_out_writes_nothing_and_with_out_writes_its_tables(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    geomint.sweep(SCENE, quick=True, timing=False)
+    assert os.listdir(tmp_path) == []
+    out = tmp_path / "out"
+    tables = geomint.sweep(SCENE, quick=True, timing=False, out=out)
+    assert tables.folder == str(out)
+    for name, frame in tables.items():
+        with open(out / (name + ".csv"), encoding="utf-8") as handle:
+            assert tables.csv(name) == handle.read(), name
+        # The frames built in memory equal the written files read back with pandas.
+        pd.testing.assert_frame_equal(frame, geomint.read_table(out / (name + ".csv")),
+                                      check_exact=True, check_dtype=False, obj=name)
+
+
+def test_gate_on_the_tables_in_memory_equals_the_gate_on_their_files(tmp_path):
+    tables = geomint.sweep(SCENE, quick=True, timing=False, out=tmp_path / "quick")
+    in_memory = geomint.gate(SCENE, tables)
+    from_files = geomint.gate(SCENE, tmp_path / "quick")
+    pd.testing.assert_frame_equal(in_memory, from_files)
+    assert in_memory.attrs == from_files.attrs
+    unwritten = geomint.gate(SCENE, geomint.sweep(SCENE, quick=True, timing=False))
+    assert list(unwritten["passed"]) == list(from_files["passed"])
+    assert unwritten.attrs["passed"]
 
 
 def test_gate_verdicts_are_the_programs(cli_folder):
