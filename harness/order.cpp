@@ -250,4 +250,11 @@ OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const Meth
   return study;
 }
 
+ResultTable ladder_table(const OrderStudy& study,
+                         const std::vector<std::pair<std::string, std::string>>& lines) {
+  std::vector<RunRecord> records;
+  for (const auto& level : study.runs) records.push_back(level.record);
+  return record_table("ladder", records, lines);
+}
+
 }  // namespace geomint

@@ -64,4 +64,9 @@ OrderStudy order_study(const std::shared_ptr<const Problem>& problem, const Meth
                        double dt0, int levels, double t_end,
                        double diverge_factor = kDefaultDivergeFactor);
 
+// The study's ladder in memory, one row per level over the record columns its runs set: the
+// table `geomint order --out` writes (to_csv) and geomint.order returns.
+ResultTable ladder_table(const OrderStudy& study,
+                         const std::vector<std::pair<std::string, std::string>>& lines);
+
 }  // namespace geomint

@@ -121,15 +121,9 @@ py::dict order(const PyProblem& problem, const std::string& method_spec, double 
     study = order_study(problem.shared(), method, dt0, levels, t_end, diverge_factor);
   }
   interrupt.raise_if_interrupted();
-  std::vector<RunRecord> records;
-  py::list rows;
-  for (const RunResult& level : study.runs) {
-    records.push_back(level.record);
-    rows.append(cells(level.record));
-  }
   py::dict out;
-  out["rows"] = rows;
-  out["columns"] = record_columns(records);
+  // The ladder as `geomint order --out` writes it, in memory (geomint.frame types its columns).
+  out["table"] = ladder_table(study, {});
   py::dict summary;
   for (const auto& [column, cell] : to_row(study.record)) summary[py::str(column)] = cell;
   out["summary"] = summary;

@@ -63,9 +63,7 @@ int run_order(OrderOptions options, const Context& context) {
                row.count(metric::error_final.key()) ? row.at(metric::error_final.key()) : "-"));
   }
   if (!options.out_path.empty()) {
-    std::vector<RunRecord> records;
-    for (const auto& run_result : study.runs) records.push_back(run_result.record);
-    std::string table = records_to_csv(records, provenance(context.command_line));
+    std::string table = to_csv(ladder_table(study, provenance(context.command_line)));
     // The JSON is the CSV read back, so both hold the same cells to the digit.
     if (format == TableFormat::kJson) table = to_json(parse_csv_table(table, "the ladder runs"));
     write_file_atomic(options.out_path, table);

@@ -332,21 +332,16 @@ def score(problem, t=None, q=None, p=None, *, v=None, path=None, metrics=(),
 
 def order(problem, method, dt, t_end, levels=6, diverge_factor=None):
     """The convergence order over the ladder dt·2^-k as `geomint order` fits it: a pandas
-    DataFrame equal to the CSV `geomint order --out` writes (one row per level), with the fit
+    DataFrame equal to the CSV `geomint order --out` writes (one row per level; its columns typed
+    as geomint.frame types them), with the fit
     (the order.csv row: order, order_q, order_p, points_used, status, ...) in df.attrs["fit"]."""
-    import pandas as pd
-
     problem = _problem(problem)
     factor = _geomint.default_diverge_factor if diverge_factor is None else float(diverge_factor)
     result = _geomint.order(problem, method, float(dt), int(levels), float(t_end), factor)
-    frame = pd.DataFrame(
-        [[parse_row(row).get(column, math.nan) for column in result["columns"]]
-         for row in result["rows"]],
-        columns=result["columns"],
-    )
-    frame.attrs["fit"] = parse_row(result["summary"])
-    frame.attrs["note"] = result["note"]
-    return frame
+    ladder = frame(result["table"])  # typed columns, from the table in memory
+    ladder.attrs["fit"] = parse_row(result["summary"])
+    ladder.attrs["note"] = result["note"]
+    return ladder
 
 
 def register_method(method, step=None, *, name=None, order=None, implicit=False,
