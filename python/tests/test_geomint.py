@@ -191,3 +191,6 @@ def test_order_equals_the_cli_ladder():
                if not (isinstance(value, float) and math.isnan(value) and key not in want)}
         assert same_cells(got, want)
     assert f"{frame.attrs['fit']['order']:.3f}" == done.stdout.strip()
+    # Typed by the harness's column types, not guessed from the text.
+    assert str(frame["steps"].dtype) == "int64" and str(frame["dt"].dtype) == "float64"
+    assert frame["status"].dtype == object
