@@ -14,6 +14,7 @@
 #include "integrators/high_order_coefficients.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/mass_operator.hpp"
+#include "problems/structures/time_dependent.hpp"
 
 namespace geomint {
 namespace {
@@ -34,7 +35,10 @@ class Field {
   explicit Field(const Problem& problem)
       : problem_(problem),
         dof_(problem.dof()),
-        non_separable_(problem.kind() == ProblemKind::kLagrangian) {
+        // A time-dependent H(q, p, t) has q' = ∂T/∂p(p, t), not M⁻¹p: its own, like the general
+        // kind's.
+        non_separable_(problem.kind() == ProblemKind::kLagrangian ||
+                       problem.as<TimeDependentHamiltonian>() != nullptr) {
     // Only the separable kind has a constant diagonal mass (the operator throws on the others).
     if (!non_separable_)
       inverse_mass_ = MassOperator(problem).constant_inverse_diagonal().cast<Real>();

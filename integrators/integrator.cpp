@@ -9,9 +9,11 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/time_treatment.hpp"
 #include "problems/mass_operator.hpp"
 #include "problems/structures/charged_particle.hpp"
 #include "problems/structures/free_rigid_body.hpp"
+#include "problems/structures/time_dependent.hpp"
 
 namespace geomint {
 
@@ -326,6 +328,15 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
   if (needs.structure != nullptr) {
     return {false, structure_refusal(method, problem, *needs.structure)};
   }
+  // H(q, p, t): a method that reads only M⁻¹p and ∇V(q) would integrate H frozen at t = t₀.
+  if (problem.as<TimeDependentHamiltonian>() != nullptr &&
+      time_treatment(method) == TimeTreatment::kNone) {
+    return {false,
+            fmt::format("method '{}' does not treat time (its step reads M⁻¹p and ∇V(q), "
+                        "never t); problem '{}' has a time-dependent Hamiltonian H(q, p, "
+                        "t); methods that treat time: {}",
+                        method.spec(), problem.name(), fmt::join(time_dependent_methods(), ", "))};
+  }
   if (!needs.runs(kind)) return {false, lagrangian_kind_refusal(method, problem)};
   // On a non-separable problem the second derivatives come from its LagrangianSystem.
   if (needs.needs_hessian && !problem.has(kHessian) && kind != ProblemKind::kLagrangian) {
@@ -378,6 +389,39 @@ std::vector<std::string> first_order_methods() {
   for (const auto& spec : integrator_test_specs()) {
     const unsigned flags = make_integrator(spec)->info().flags;
     if ((flags & kFirstOrderCapable) && !(flags & kConstraintsOnly)) specs.push_back(spec);
+  }
+  return specs;
+}
+
+const char* time_treatment_name(TimeTreatment treatment) {
+  switch (treatment) {
+    case TimeTreatment::kNone:
+      return "none";
+    case TimeTreatment::kStageTimes:
+      return "stage_times";
+    case TimeTreatment::kExtendedPhaseSpace:
+      return "extended_phase_space";
+    case TimeTreatment::kFrozenPerStep:
+      return "frozen_per_step";
+  }
+  return "none";
+}
+
+TimeTreatment time_treatment(const Integrator& method) {
+  if (const auto* own = dynamic_cast<const TreatsTime*>(&method)) return own->time_treatment();
+  // These see the problem only through first_order_rhs(t, y), which a time-dependent H answers
+  // at the t each stage passes (Problem::first_order_rhs).
+  const unsigned flags = method.info().flags;
+  if ((flags & kFirstOrderCapable) && (flags & kGeneralLagrangian)) {
+    return TimeTreatment::kStageTimes;
+  }
+  return TimeTreatment::kNone;
+}
+
+std::vector<std::string> time_dependent_methods() {
+  std::vector<std::string> specs;
+  for (const auto& spec : integrator_test_specs()) {
+    if (time_treatment(*make_integrator(spec)) != TimeTreatment::kNone) specs.push_back(spec);
   }
   return specs;
 }

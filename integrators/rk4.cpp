@@ -7,6 +7,7 @@
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
+#include "problems/structures/time_dependent.hpp"
 
 namespace geomint {
 namespace {
@@ -56,7 +57,9 @@ class Rk4 final : public ExplicitStepper<Rk4> {
       advance_first_order(problem, state, h);
       return;
     }
-    if (problem.kind() == ProblemKind::kLagrangian) {
+    // A time-dependent H(q, p, t) has its own q̇ = ∂T/∂p(p, t): first_order_rhs gives it.
+    if (problem.kind() == ProblemKind::kLagrangian ||
+        problem.as<TimeDependentHamiltonian>() != nullptr) {
       advance_general(problem, state, h);
       return;
     }

@@ -12,6 +12,7 @@
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 #include "problems/structures/charged_particle.hpp"
+#include "problems/structures/time_dependent.hpp"
 
 namespace geomint {
 namespace {
@@ -85,9 +86,13 @@ class GivenInitialState : public Problem, public HolonomicConstraints {
     base_constraints_->constraint_time_terms(t, q, v, g_t, a_t);
   }
   // A charged particle's mass, charge, fields and vector potential do not depend on its start:
-  // the Boris pusher and the magnetic-moment metric keep them.
+  // the Boris pusher and the magnetic-moment metric keep them. Nor does a time-dependent H(q, p,
+  // t), without which the wrapper would pass for the time-free H(q, p, 0).
   const void* structure(const StructureKey& key) const override {
-    if (&key == &ChargedParticleStructure::kStructureKey) return base_->structure(key);
+    if (&key == &ChargedParticleStructure::kStructureKey ||
+        &key == &TimeDependentHamiltonian::kStructureKey) {
+      return base_->structure(key);
+    }
     return nullptr;
   }
   std::vector<std::string> series_names() const override { return base_->series_names(); }

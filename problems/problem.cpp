@@ -9,6 +9,7 @@
 #include "problems/first_order.hpp"
 #include "problems/force.hpp"
 #include "problems/lagrangian.hpp"
+#include "problems/structures/time_dependent.hpp"
 
 namespace geomint {
 
@@ -388,6 +389,15 @@ void Problem::first_order_rhs(double t, const Vec& y, Vec& ydot) const {
     system.lagrangian_q(q, v, L_q);
     ydot.head(n) = v;
     ydot.tail(n) = L_q;
+    return;
+  }
+  // H(q, p, t): its own halves at t, not M⁻¹p and −∇V(q), which are H at the initial time only.
+  if (const auto* hamiltonian = as<TimeDependentHamiltonian>()) {
+    Vec qdot, pdot;
+    hamiltonian->velocity(y.tail(n), t, qdot);
+    hamiltonian->momentum_rate(y.head(n), y.tail(n), t, pdot);
+    ydot.head(n) = qdot;
+    ydot.tail(n) = pdot;
     return;
   }
   const Vec v = inverse_mass().cwiseProduct(y.tail(n));

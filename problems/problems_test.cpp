@@ -31,6 +31,7 @@
 #include "problems/problem.hpp"
 #include "problems/rigid_body.hpp"
 #include "problems/structures/kepler_orbit.hpp"
+#include "problems/structures/time_dependent.hpp"
 #include "problems/structures/toda.hpp"
 #include "tests/test_util.hpp"
 
@@ -245,6 +246,42 @@ TEST_P(ProblemTest, SizesMassAndEnergyAreConsistent) {
   }
   if (!problem.has(kExact)) {
     EXPECT_THROW(problem.exact(1.0), std::logic_error);
+  }
+}
+
+// A time-dependent H(q, p, t) (problems/structures/time_dependent.hpp): its velocity and momentum
+// rate are ∂H/∂p and −∂H/∂q by central differences at several (q, p, t) when it says it is
+// Hamiltonian, and at its initial time H is the energy() the time-free pieces give (potential()
+// and gradient() are V(q, t₀), which the gradient test above checks).
+TEST_P(ProblemTest, TimeDependentHamiltonianMatchesItsEquations) {
+  const Problem& problem = *problem_;
+  const auto* hamiltonian = problem.as<TimeDependentHamiltonian>();
+  if (hamiltonian == nullptr) GTEST_SKIP() << "no time-dependent Hamiltonian";
+  const State start = problem.initial_state();
+  EXPECT_NEAR(hamiltonian->hamiltonian(start.q, start.p, start.t), problem.energy(start.q, start.p),
+              1e-14 * std::max(1.0, std::abs(problem.energy(start.q, start.p))));
+  if (!hamiltonian->is_hamiltonian()) GTEST_SKIP() << "a non-Hamiltonian form";
+  const int n = problem.dof();
+  for (const double t : {0.0, 1.3, 7.9, 22.0}) {
+    const Vec q = start.q + 0.7 * Vec::Ones(n), p = start.p - 0.4 * Vec::Ones(n);
+    Vec qdot, pdot;
+    hamiltonian->velocity(p, t, qdot);
+    hamiltonian->momentum_rate(q, p, t, pdot);
+    ASSERT_EQ(qdot.size(), n);
+    ASSERT_EQ(pdot.size(), n);
+    const double h = 1e-5;
+    for (int j = 0; j < n; ++j) {
+      Vec plus = q, minus = q;
+      plus[j] += h, minus[j] -= h;
+      const double dH_dq =
+          (hamiltonian->hamiltonian(plus, p, t) - hamiltonian->hamiltonian(minus, p, t)) / (2 * h);
+      EXPECT_NEAR(pdot[j], -dH_dq, 1e-8 * std::max(1.0, std::abs(dH_dq))) << "t = " << t;
+      plus = p, minus = p;
+      plus[j] += h, minus[j] -= h;
+      const double dH_dp =
+          (hamiltonian->hamiltonian(q, plus, t) - hamiltonian->hamiltonian(q, minus, t)) / (2 * h);
+      EXPECT_NEAR(qdot[j], dH_dp, 1e-8 * std::max(1.0, std::abs(dH_dp))) << "t = " << t;
+    }
   }
 }
 
@@ -559,6 +596,8 @@ TEST_P(ProblemTest, KindQueriesAgreeWithTheInterfacesTheClassDerivesFrom) {
   EXPECT_EQ(problem.as<ChargedParticleStructure>(),
             dynamic_cast<const ChargedParticleStructure*>(&problem));
   EXPECT_EQ(problem.as<TodaStructure>(), dynamic_cast<const TodaStructure*>(&problem));
+  EXPECT_EQ(problem.as<TimeDependentHamiltonian>(),
+            dynamic_cast<const TimeDependentHamiltonian*>(&problem));
   // Instance-level: nbody offers the Kepler orbit only with two bodies.
   if (const auto* orbit = problem.as<KeplerOrbitStructure>()) {
     EXPECT_EQ(orbit, dynamic_cast<const KeplerOrbitStructure*>(&problem));
@@ -838,8 +877,8 @@ TEST_P(ExactBranch, MatchesTwoLibraryIntegrators) {
   // Absolute tolerance at 1e-13 of the state's size, so that neither integrator crawls on a
   // component that passes through zero; the size of the exact state at the end counts too, for a
   // motion that starts from rest at q = 0 (elastic_rod under its end load).
-  const double size = std::max(
-      {inf_norm(stacked(start)), inf_norm(stacked(problem->exact(times.back()))), 1e-300});
+  const double size =
+      std::max({inf_norm(stacked(start)), inf_norm(stacked(problem->exact(times.back()))), 1e-300});
   constexpr double kRtol = 1e-13;
   const std::vector<Trajectory> runs = {
       integrate_gsl_rk8pd(rhs, stacked(start), times, kRtol, kRtol * size),

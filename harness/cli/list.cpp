@@ -8,6 +8,7 @@
 
 #include "harness/cli/verbs.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/time_treatment.hpp"
 #include "problems/problem.hpp"
 
 namespace geomint::cli {
@@ -86,9 +87,10 @@ void print_aligned(const std::vector<std::vector<std::string>>& rows,
 void print_methods(bool markdown) {
   std::vector<std::vector<std::string>> rows;
   if (markdown) {
-    fmt::print("| method | provider | order | flags | what it is |\n|---|---|---|---|---|\n");
+    fmt::print(
+        "| method | provider | order | flags | time | what it is |\n|---|---|---|---|---|---|\n");
   } else {
-    rows.push_back({"method", "provider", "order", "flags", "parameters (default)"});
+    rows.push_back({"method", "provider", "order", "flags", "time", "parameters (default)"});
   }
   for (const auto& entry : integrator_registry()) {
     if (markdown && !entry.builtin) continue;
@@ -96,17 +98,17 @@ void print_methods(bool markdown) {
     const auto integrator = entry.factory(params);
     const MethodInfo info = integrator->info();
     if (markdown) {
-      fmt::print("| `{}` | {} | {} | {} | {} |\n", entry.name, entry.provider.label(),
+      fmt::print("| `{}` | {} | {} | {} | {} | {} |\n", entry.name, entry.provider.label(),
                  order_column(entry, info.order),
                  fmt::format("{}", fmt::join(flag_names(info.flags), ", ")),
-                 markdown_cell(entry.summary));
+                 time_treatment_name(time_treatment(*integrator)), markdown_cell(entry.summary));
     } else {
       rows.push_back({entry.name, entry.provider.label(), std::to_string(info.order),
                       fmt::format("{}", fmt::join(flag_names(info.flags), ",")),
-                      parameter_list(params)});
+                      time_treatment_name(time_treatment(*integrator)), parameter_list(params)});
     }
   }
-  if (!markdown) print_aligned(rows, {false, false, true, false, false});
+  if (!markdown) print_aligned(rows, {false, false, true, false, false, false});
 }
 
 // The integer parameters with their ranges ("`n` 1..64"): the size limits a reader of the table
@@ -138,8 +140,11 @@ void print_problems(bool markdown) {
                  fmt::format("{}", fmt::join(capabilities, ", ")), integer_limits(params),
                  markdown_cell(entry.summary));
     } else {
+      // "none" keeps the column aligned (damped_harmonic_td declares no capability).
       rows.push_back({entry.name, std::to_string(problem->dof()),
-                      fmt::format("{}", fmt::join(capabilities, ",")), parameter_list(params)});
+                      capabilities.empty() ? std::string("none")
+                                           : fmt::format("{}", fmt::join(capabilities, ",")),
+                      parameter_list(params)});
     }
   }
   if (!markdown) print_aligned(rows, {false, true, false, false});
@@ -175,10 +180,12 @@ void print_entry(const std::string& name) {
   for (const auto& entry : integrator_registry()) {
     if (entry.name != name) continue;
     Params params(Spec{entry.name, {}}, entry.name);
-    const MethodInfo info = entry.factory(params)->info();
-    fmt::print("{} (method): {}\nprovider {}; order {}; flags: {}\n\n", entry.name, entry.summary,
-               entry.provider.label(), order_column(entry, info.order),
-               fmt::join(flag_names(info.flags), ", "));
+    const auto integrator = entry.factory(params);
+    const MethodInfo info = integrator->info();
+    fmt::print("{} (method): {}\nprovider {}; order {}; flags: {}; time: {}\n\n", entry.name,
+               entry.summary, entry.provider.label(), order_column(entry, info.order),
+               fmt::join(flag_names(info.flags), ", "),
+               time_treatment_name(time_treatment(*integrator)));
     print_parameters(params);
     found = true;
   }
