@@ -12,6 +12,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/high_order_coefficients.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/articulated.hpp"
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
@@ -323,6 +324,25 @@ TEST(GeneralStep, ApplicabilityFollowsTheDeclaredFlag) {
   }
   EXPECT_GE(admitted, 5);
   EXPECT_GE(refused, 20);
+}
+
+// RK4 on an articulated problem runs on the O(n) recursions alone: per step, 4 evaluations of
+// Hamilton's equations, each one mass solve (2 recursive passes) and one ∂T/∂θ (2 passes), and
+// nothing else that walks the tree (the work counter of problems/articulated.hpp), at any n.
+TEST(ArticulatedRk4, SixteenRecursivePassesPerStep) {
+  for (const std::string spec : {"rope:n=256", "branching", "rod_chain:coordinates=joint,n=100"}) {
+    const auto problem = make_problem(spec);
+    const auto* tree =
+        dynamic_cast<const articulated::PlanarTreeLagrangian*>(problem->as_lagrangian());
+    ASSERT_NE(tree, nullptr) << spec;
+    const auto method = make_integrator("rk4");
+    State state = problem->initial_state();
+    method->reset(*problem, state, problem->default_dt());
+    const long before = tree->dynamics().passes();
+    for (int k = 0; k < 10; ++k)
+      ASSERT_TRUE(method->step(*problem, state, problem->default_dt()).ok);
+    EXPECT_EQ(tree->dynamics().passes() - before, 160) << spec;
+  }
 }
 
 }  // namespace

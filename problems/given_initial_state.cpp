@@ -136,6 +136,16 @@ class GivenInitialLagrangian final : public GivenInitialState, public Lagrangian
   void gyroscopic_hessian(const Vec& q, const Vec& v, DenseMatrix& a_qq) const override {
     system_.gyroscopic_hessian(q, v, a_qq);
   }
+  // The base's own (possibly O(n)) mass operator and gyroscopic force, not the dense defaults.
+  void add_gyroscopic_force(const Vec& q, const Vec& v, Vec& L_q) const override {
+    system_.add_gyroscopic_force(q, v, L_q);
+  }
+  void apply_mass(const Vec& q, const Vec& v, Vec& Mv) const override {
+    system_.apply_mass(q, v, Mv);
+  }
+  void solve_mass(const Vec& q, const Vec& p, Vec& v) const override {
+    system_.solve_mass(q, p, v);
+  }
   // One override each for Problem's and LagrangianSystem's V and ∇V (the same functions).
   double potential(const Vec& q) const override { return system_.potential(q); }
   void gradient(const Vec& q, Vec& g) const override { system_.gradient(q, g); }

@@ -43,6 +43,10 @@ void LagrangianSystem::lagrangian_q(const Vec& q, const Vec& v, Vec& L_q) const 
   Vec g;
   gradient(q, g);
   L_q -= g;
+  add_gyroscopic_force(q, v, L_q);
+}
+
+void LagrangianSystem::add_gyroscopic_force(const Vec& q, const Vec& v, Vec& L_q) const {
   DenseMatrix A;
   gyroscopic_jacobian(q, A);
   L_q.noalias() += A.transpose() * v;  // ∂(a(q)ᵀv)/∂q_j = Σ_i v_i ∂a_i/∂q_j

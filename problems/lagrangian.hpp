@@ -36,6 +36,10 @@ class LagrangianSystem {
   virtual void gyroscopic(const Vec& q, Vec& a) const;
   virtual void gyroscopic_jacobian(const Vec& q, DenseMatrix& A) const;
   virtual void gyroscopic_hessian(const Vec& q, const Vec& v, DenseMatrix& a_qq) const;
+  // L_q += ∂(a(q)ᵀv)/∂q = Aᵀv (lagrangian_q's gyroscopic part). Default: through the dense
+  // gyroscopic_jacobian; a problem with a = 0 and many dof overrides it with nothing, so that the
+  // explicit methods' route (first_order_rhs) builds no n × n matrix.
+  virtual void add_gyroscopic_force(const Vec& q, const Vec& v, Vec& L_q) const;
   // V(q), ∇V(q) and ∇²V(q). The first two have Problem's signatures, so a problem deriving from
   // both Problem and LagrangianSystem writes them once.
   virtual double potential(const Vec& q) const = 0;

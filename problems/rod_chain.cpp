@@ -9,12 +9,17 @@
 #include <cmath>
 #include <string>
 
+#include "problems/articulated.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/problem.hpp"
 #include "problems/rods.hpp"
 
 namespace geomint {
 namespace {
+
+// The Cartesian form's constrained steps solve dense systems in the 2n node coordinates and n
+// multipliers: it keeps the cap it always had.
+constexpr int kMaxCartesianRods = 64;
 
 class RodChain final : public rods::RodProblem {
  public:
@@ -61,27 +66,20 @@ class RodChain final : public rods::RodProblem {
   State initial_;
 };
 
-// The chain in joint (absolute) angles, θ_i from the downward vertical. Node i sits at
-// Σ_{k ≤ i} l_k (sin θ_k, −cos θ_k), so T = ½ Σ_ij C_ij cos(θ_i − θ_j) θ̇_iθ̇_j with
-// C_ij = μ_ij l_i l_j, and V = −g Σ_i μ_ii l_i cos θ_i (μ_ii: the mass at and below node i).
-class RodChainJoint final : public Problem, public LagrangianSystem {
+// The chain in joint (absolute) angles, θ_i from the downward vertical: a planar articulated
+// chain (problems/articulated.hpp) whose links carry their mass at the tip (centre of mass at the
+// rod's end, no inertia of their own). So T = ½ Σ_ij C_ij cos(θ_i − θ_j) θ̇_iθ̇_j with
+// C_ij = μ_ij l_i l_j and V = −g Σ_i μ_ii l_i cos θ_i (μ_ii: the mass at and below node i), and
+// the mass operator, ∂T/∂θ and the energy are the O(n) recursions; the dense members remain for
+// the dense methods.
+class RodChainJoint final : public Problem, public articulated::PlanarTreeLagrangian {
  public:
   const LagrangianSystem* as_lagrangian() const override { return this; }
   RodChainJoint(const Vec& node_mass, const Vec& length, double gravity, Vec theta, Vec omega)
-      : theta_(std::move(theta)), omega_(std::move(omega)) {
-    const int n = static_cast<int>(node_mass.size());
-    Vec tail_mass(n);  // μ_ii = Σ_{k ≥ i} m_k
-    double sum = 0;
-    for (int i = n - 1; i >= 0; --i) tail_mass[i] = sum += node_mass[i];
-    coupling_.resize(n, n);
-    // Filled as a symmetric matrix (l_i l_j and l_j l_i round differently).
-    for (int i = 0; i < n; ++i) {
-      for (int j = i; j < n; ++j) {
-        coupling_(i, j) = coupling_(j, i) = tail_mass[j] * length[i] * length[j];
-      }
-    }
-    weight_ = gravity * tail_mass.cwiseProduct(length);
-    set_dof(n);  // no constant mass: the mass is M(θ)
+      : PlanarTreeLagrangian(point_mass_chain(node_mass, length, gravity)),
+        theta_(std::move(theta)),
+        omega_(std::move(omega)) {
+    set_dof(static_cast<int>(node_mass.size()));  // no constant mass: the mass is M(θ)
     set_capabilities(kOmegaMax);
     const double time_unit = std::sqrt(length.sum() / gravity);
     set_defaults(0.01 * time_unit, 100.0 * time_unit);
@@ -92,7 +90,7 @@ class RodChainJoint final : public Problem, public LagrangianSystem {
   }
 
   // The fastest small-oscillation mode about the hanging chain, K v = ω²M(0)v (as
-  // double_pendulum).
+  // double_pendulum; dense, O(n³): only the stability search asks for it).
   double omega_max(const Vec&) const override {
     DenseMatrix M, K;
     const Vec hanging = Vec::Zero(dof());
@@ -101,70 +99,29 @@ class RodChainJoint final : public Problem, public LagrangianSystem {
     const Eigen::GeneralizedSelfAdjointEigenSolver<DenseMatrix> modes(K, M, Eigen::EigenvaluesOnly);
     return std::sqrt(modes.eigenvalues().maxCoeff());
   }
-
-  void mass_matrix(const Vec& q, DenseMatrix& M) const override {
-    const int n = dof();
-    M.resize(n, n);
-    for (int i = 0; i < n; ++i) {
-      for (int j = i; j < n; ++j) M(i, j) = M(j, i) = coupling_(i, j) * std::cos(q[i] - q[j]);
-    }
-  }
-  // ∂T/∂θ_a = −θ̇_a Σ_j C_aj sin(θ_a − θ_j) θ̇_j.
-  void kinetic_gradient(const Vec& q, const Vec& v, Vec& T_q) const override {
-    const int n = dof();
-    T_q.resize(n);
-    for (int a = 0; a < n; ++a) {
-      double sum = 0;
-      for (int j = 0; j < n; ++j) sum += coupling_(a, j) * std::sin(q[a] - q[j]) * v[j];
-      T_q[a] = -v[a] * sum;
-    }
-  }
-  // (Mv)_i = Σ_j C_ij cos(θ_i − θ_j) v_j: ∂/∂θ_b = C_ib sin(θ_i − θ_b) v_b for b ≠ i, and
-  // −Σ_j C_ij sin(θ_i − θ_j) v_j for b = i.
-  void mass_velocity_jacobian(const Vec& q, const Vec& v, DenseMatrix& D) const override {
-    const int n = dof();
-    D = DenseMatrix::Zero(n, n);
-    for (int i = 0; i < n; ++i) {
-      for (int b = 0; b < n; ++b) {
-        if (b == i) continue;
-        const double term = coupling_(i, b) * std::sin(q[i] - q[b]) * v[b];
-        D(i, b) = term;
-        D(i, i) -= term;
-      }
-    }
-  }
-  // ∂²T/∂θ_a∂θ_b = C_ab cos(θ_a − θ_b) θ̇_aθ̇_b for b ≠ a; the diagonal is minus the row's rest.
-  void kinetic_hessian(const Vec& q, const Vec& v, DenseMatrix& T_qq) const override {
-    const int n = dof();
-    T_qq = DenseMatrix::Zero(n, n);
-    for (int a = 0; a < n; ++a) {
-      for (int b = 0; b < n; ++b) {
-        if (b == a) continue;
-        const double term = coupling_(a, b) * std::cos(q[a] - q[b]) * v[a] * v[b];
-        T_qq(a, b) = term;
-        T_qq(a, a) -= term;
-      }
-    }
-  }
-  double potential(const Vec& q) const override { return -weight_.dot(q.array().cos().matrix()); }
-  void gradient(const Vec& q, Vec& g) const override {
-    g = weight_.cwiseProduct(q.array().sin().matrix());
-  }
-  void potential_hessian(const Vec& q, DenseMatrix& K) const override {
-    K = weight_.cwiseProduct(q.array().cos().matrix()).asDiagonal();
-  }
+  double potential(const Vec& q) const override { return dynamics().potential(q); }
+  void gradient(const Vec& q, Vec& g) const override { dynamics().potential_gradient(q, g); }
 
  private:
-  DenseMatrix coupling_;  // C_ij = μ_ij l_i l_j
-  Vec weight_;            // g μ_ii l_i
+  static articulated::PlanarTree point_mass_chain(const Vec& node_mass, const Vec& length,
+                                                  double gravity) {
+    const int n = static_cast<int>(node_mass.size());
+    std::vector<int> parent(n);
+    for (int i = 0; i < n; ++i) parent[i] = i - 1;
+    return {std::move(parent), node_mass, length, length, Vec::Zero(n), gravity};
+  }
   Vec theta_, omega_;
 };
 
 }  // namespace
 
 std::unique_ptr<Problem> make_rod_chain(Params& params) {
-  const int n =
-      static_cast<int>(params.integer("n", 2, "number of rods (and moving nodes)", 1, 64));
+  const int n = static_cast<int>(
+      params.integer("n", 2,
+                     fmt::format("number of rods (and moving nodes); at most {} with "
+                                 "coordinates=cartesian",
+                                 kMaxCartesianRods),
+                     1, articulated::kMaxLinks));
   const double mass = params.real("mass", 1.0, "mass of node 1", Range::above(0));
   const double mass_ratio =
       params.real("mass_ratio", 1.0, "mass of node i+1 / mass of node i", Range::above(0));
@@ -185,6 +142,12 @@ std::unique_ptr<Problem> make_rod_chain(Params& params) {
       "angles with the mass M(theta) (non_separable)");
   // Every Cartesian spec (and committed result) stays as it was.
   params.omit_default_from_canonical("coordinates");
+  if (coordinates == "cartesian" && n > kMaxCartesianRods) {
+    throw InputError(fmt::format(
+        "problem 'rod_chain': parameter n={} is too large for coordinates=cartesian; allowed: 1 "
+        "to {} (coordinates=joint: 1 to {})",
+        n, kMaxCartesianRods, articulated::kMaxLinks));
+  }
   Vec node_mass(n), rod_lengths(n), angles(n);
   std::vector<rods::Rod> chain;
   State initial{0.0, Vec(2 * n), Vec(2 * n)};

@@ -1654,7 +1654,19 @@ const std::vector<Case>& cases() {
       {"MisspeltListName", "list rod_chian", 2, "did you mean 'rod_chain'?"},
       {"ListUnknownName", "list frobnicate", 2, "neither a method nor a problem"},
       // --- the ranges `geomint list NAME` prints are the ones enforced ---
-      {"RodChainTooManyRods", "run --problem rod_chain:n=65 --method rattle", 2, "1..64"},
+      {"RodChainTooManyRods", "run --problem rod_chain:coordinates=joint,n=4097 --method rk4", 2,
+       "1..4096"},
+      // The Cartesian form keeps its own, smaller cap, stated in n's help and in the message.
+      {"RodChainCartesianTooManyRods", "run --problem rod_chain:n=65 --method rattle", 2,
+       "coordinates=cartesian; allowed: 1 to 64"},
+      {"ArticulatedChainTooManyLinks", "run --problem articulated_chain:n=4097 --method rk4", 2,
+       "1..4096"},
+      {"ArticulatedChainWrongLengthList",
+       "run --problem articulated_chain:n=3,masses=1/2 --method rk4", 2,
+       "parameter masses has 2 entries; allowed: exactly n = 3"},
+      {"ArticulatedChainNonPositiveInertia",
+       "run --problem articulated_chain:n=2,inertias=1/0 --method rk4", 2,
+       "inertias entry 2 is 0; allowed: > 0"},
       // The thread count of the element loops (problems/parallel.hpp): refused before any output.
       {"ThreadsZero",
        "run --problem pendulum --method rk4 --dt 0.1 --t-end 1 --out {dir}/a.csv",

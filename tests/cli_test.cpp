@@ -632,7 +632,7 @@ TEST(Cli, ListNameShowsEveryEntryAndEveryPrintedRangeIsEnforced) {
   EXPECT_GT(entries, 40);
   EXPECT_GT(refused, 100);
   const Outcome rod_chain = geomint("list rod_chain");
-  EXPECT_NE(rod_chain.output.find("1..64"), std::string::npos) << rod_chain.output;
+  EXPECT_NE(rod_chain.output.find("1..4096"), std::string::npos) << rod_chain.output;
 }
 
 // The lines strictly between <!-- MARKER:begin --> and <!-- MARKER:end --> of its catalogue.
