@@ -706,6 +706,8 @@ class Ida final : public SundialsIntegrator {
     const double upper = 0.001 * std::abs(t_stop - t_);
     const double q_rate_norm = std::sqrt(yp.head(dof_).cwiseProduct(weights).squaredNorm() / n_);
     const double ida_step = q_rate_norm * upper > 0.5 ? 0.5 / q_rate_norm : upper;
+    // On a mass M(q) q'' = M⁻¹(p' − Ṁv): M⁻¹p' is exact only from rest (andrews starts there);
+    // in motion it is an estimate, which is all a first step needs.
     const Vec q_second = MassOperator(*problem_).solve(y.head(dof_), yp.segment(dof_, dof_));
     const double q_second_norm = std::sqrt(q_second.cwiseProduct(weights).squaredNorm() / dof_);
     if (!(q_second_norm > 0) || !std::isfinite(q_second_norm)) return 0;
