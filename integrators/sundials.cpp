@@ -470,11 +470,15 @@ class Ida final : public SundialsIntegrator {
       return {"ida", max_order_, kImplicit | kAdaptive | kFirstOrderCapable | kGeneralLagrangian,
               "SUNDIALS IDA, variable-order BDF on the residual form (IDA user guide v6.4.1, §2)"};
     }
-    return {"ida", max_order_, kImplicit | kAdaptive | kConstrained | kConstraintsOnly | kRheonomic,
-            index_ == 3 ? "SUNDIALS IDA, BDF on the index-3 constrained equations of motion "
-                          "(Brenan, Campbell & Petzold 1996 §6.2)"
-                        : "SUNDIALS IDA, BDF on the stabilised index-2 (Gear-Gupta-Leimkuhler "
-                          "1985) constrained equations of motion"};
+    // The residual below takes p' = L_q + F − Gᵀλ from the problem's LagrangianSystem on the
+    // general kind (andrews: M(q) with constraints), so both forms run it.
+    return {
+        "ida", max_order_,
+        kImplicit | kAdaptive | kConstrained | kConstraintsOnly | kRheonomic | kGeneralLagrangian,
+        index_ == 3 ? "SUNDIALS IDA, BDF on the index-3 constrained equations of motion "
+                      "(Brenan, Campbell & Petzold 1996 §6.2)"
+                    : "SUNDIALS IDA, BDF on the stabilised index-2 (Gear-Gupta-Leimkuhler "
+                      "1985) constrained equations of motion"};
   }
 
   void reset(const Problem& problem, const State& state, double) override {
@@ -625,12 +629,24 @@ class Ida final : public SundialsIntegrator {
       h = std::abs(h);
       q_ = y.head(n);
       constraints_->constraint_jacobian_at(t, q_, G_);
-      const Vec& inverse_mass = MassOperator(*problem_).constant_inverse_diagonal();
       Vec on_p = Vec::Zero(m), on_q = Vec::Zero(m);
-      for (int col = 0; col < G_.outerSize(); ++col) {
-        for (SparseMatrix::InnerIterator it(G_, col); it; ++it) {
-          on_p[it.row()] += std::pow(it.value() * w[n + col], 2);
-          on_q[it.row()] += std::pow(it.value() * inverse_mass[col] * w[col], 2);
+      const MassOperator mass(*problem_);
+      if (mass.is_constant_diagonal()) {
+        const Vec& inverse_mass = mass.constant_inverse_diagonal();
+        for (int col = 0; col < G_.outerSize(); ++col) {
+          for (SparseMatrix::InnerIterator it(G_, col); it; ++it) {
+            on_p[it.row()] += std::pow(it.value() * w[n + col], 2);
+            on_q[it.row()] += std::pow(it.value() * inverse_mass[col] * w[col], 2);
+          }
+        }
+      } else {
+        // M(q): the rows of G M⁻¹ = (M⁻¹Gᵀ)ᵀ, dense (a few constraints).
+        Eigen::MatrixXd inverse_mass_Gt = Eigen::MatrixXd(G_).transpose();
+        mass.solve_columns(q_, inverse_mass_Gt);
+        const Eigen::MatrixXd G_dense(G_);
+        for (int i = 0; i < m; ++i) {
+          on_p[i] = G_dense.row(i).transpose().cwiseProduct(w.segment(n, n)).squaredNorm();
+          on_q[i] = inverse_mass_Gt.col(i).cwiseProduct(w.head(n)).squaredNorm();
         }
       }
       const double unit_roundoff = std::numeric_limits<double>::epsilon();
@@ -690,6 +706,8 @@ class Ida final : public SundialsIntegrator {
     const double upper = 0.001 * std::abs(t_stop - t_);
     const double q_rate_norm = std::sqrt(yp.head(dof_).cwiseProduct(weights).squaredNorm() / n_);
     const double ida_step = q_rate_norm * upper > 0.5 ? 0.5 / q_rate_norm : upper;
+    // On a mass M(q) q'' = M⁻¹(p' − Ṁv): M⁻¹p' is exact only from rest (andrews starts there);
+    // in motion it is an estimate, which is all a first step needs.
     const Vec q_second = MassOperator(*problem_).solve(y.head(dof_), yp.segment(dof_, dof_));
     const double q_second_norm = std::sqrt(q_second.cwiseProduct(weights).squaredNorm() / dof_);
     if (!(q_second_norm > 0) || !std::isfinite(q_second_norm)) return 0;
@@ -724,8 +742,12 @@ class Ida final : public SundialsIntegrator {
       q_ = y.head(n);
       p_ = y.segment(n, n);
       const Vec v = MassOperator(problem).solve(q_, p_);
-      problem.gradient(q_, force_);
-      force_ = -force_;
+      if (const LagrangianSystem* general = problem.as_lagrangian()) {
+        general->lagrangian_q(q_, v, force_);  // p' = L_q = T_q − ∇V on M(q)
+      } else {
+        problem.gradient(q_, force_);
+        force_ = -force_;
+      }
       if (problem.has(kForce)) {
         force_of(problem).force(q_, v, t, applied_);
         force_ += applied_;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "problems/mass_operator.hpp"
 #include "problems/problem.hpp"
 #include "tests/test_util.hpp"
 
@@ -43,8 +44,10 @@ class ConstrainedProblem : public testing::TestWithParam<std::string> {
     // The initial configuration and three configurations off the manifold by 5% of the size of
     // q (the derivatives must hold everywhere, not only where g = 0), with velocities of the
     // initial size in random directions.
-    const double speed = std::max(1.0, problem_->inverse_mass().cwiseProduct(start.p).norm());
-    points_.push_back({start.q, problem_->inverse_mass().cwiseProduct(start.p)});
+    // v = M(q)⁻¹p whatever the kind (a constant diagonal, or M(q): andrews).
+    const Vec start_velocity = MassOperator(*problem_).solve(start.q, start.p);
+    const double speed = std::max(1.0, start_velocity.norm());
+    points_.push_back({start.q, start_velocity});
     for (unsigned seed = 1; seed <= 3; ++seed) {
       const int n = problem_->dof();
       points_.push_back({start.q + 0.05 * length_scale_ * test::random_vector(n, seed),
@@ -152,8 +155,9 @@ TEST_P(ConstrainedProblem, InconsistentStateIsAnInputErrorNamingTheResidual) {
   State pushed = problem.initial_state();
   // Along a constraint normal: a velocity that changes a rod's length.
   const Eigen::MatrixXd G = jacobian_at(problem, pushed.q);
-  const double speed = std::max(1.0, problem.inverse_mass().cwiseProduct(pushed.p).norm());
-  pushed.p += 1e-6 * speed * problem.mass().cwiseProduct(G.row(0).transpose());
+  const MassOperator mass(problem);
+  const double speed = std::max(1.0, mass.solve(pushed.q, pushed.p).norm());
+  pushed.p += 1e-6 * speed * mass.apply(pushed.q, G.row(0).transpose());
   EXPECT_TRUE(test::input_error_names(
       [&](const std::string& what) { problem.check_consistent(pushed, what); }, "initial state",
       {problem.spec(), "velocity constraint residual max|G(q) v|"}));

@@ -229,7 +229,49 @@ const HolonomicConstraints& constraints_of(const Problem& problem) {
   return *constraints;
 }
 
+// With M(q) the motion is d/dt(M v) = L_q + F − Gᵀλ, so M q̈ = L_q − Ṁv + F − Gᵀλ with Ṁv = D v
+// (D = ∂(M v)/∂q, LagrangianSystem::mass_velocity_jacobian); d²g/dt² = 0 then gives
+// (G M⁻¹ Gᵀ) λ = G M⁻¹ (L_q − D v + F) + c(q, v) + a_t, M⁻¹ by dense Cholesky.
+namespace {
+Vec general_multipliers(const Problem& problem, double t, const Vec& q, const Vec& p) {
+  const LagrangianSystem& system = general_system(problem);
+  const Vec v = system.velocity(q, p);
+  Vec force_total;
+  system.lagrangian_q(q, v, force_total);
+  Eigen::MatrixXd D;
+  system.mass_velocity_jacobian(q, v, D);
+  force_total -= D * v;
+  if (const NonConservativeForce* forced = problem.as_forced()) {
+    Vec f;
+    forced->force(q, v, t, f);
+    force_total += f;
+  }
+  const HolonomicConstraints& constraints = constraints_of(problem);
+  SparseMatrix G;
+  constraints.constraint_jacobian_at(t, q, G);
+  Vec c, g_t, a_t;
+  constraints.constraint_curvature(q, v, c);
+  constraints.constraint_time_terms(t, q, v, g_t, a_t);
+  c += a_t;
+  Eigen::MatrixXd M;
+  system.mass_matrix(q, M);
+  const Eigen::LLT<Eigen::MatrixXd> mass(M);
+  const Eigen::MatrixXd Gdense(G);
+  const Eigen::MatrixXd MinvGt = mass.solve(Gdense.transpose());
+  const Eigen::MatrixXd S = Gdense * MinvGt;
+  const Vec rhs = MinvGt.transpose() * force_total + c;
+  return S.ldlt().solve(rhs);
+}
+
+// The velocity the constraint residuals use: M⁻¹p, or M(q)⁻¹(p − a(q)) on the kLagrangian kind.
+Vec constraint_velocity(const Problem& problem, const Vec& q, const Vec& p) {
+  if (problem.kind() == ProblemKind::kLagrangian) return general_system(problem).velocity(q, p);
+  return problem.inverse_mass().cwiseProduct(p);
+}
+}  // namespace
+
 Vec Problem::multipliers(double t, const Vec& q, const Vec& p) const {
+  if (kind() == ProblemKind::kLagrangian) return general_multipliers(*this, t, q, p);
   const Vec v = inverse_mass().cwiseProduct(p);
   Vec force_total;
   gradient(q, force_total);
@@ -283,7 +325,7 @@ double Problem::constraint_velocity_residual(double t, const Vec& q, const Vec& 
   const HolonomicConstraints& constraints = constraints_of(*this);
   SparseMatrix G;
   constraints.constraint_jacobian_at(t, q, G);
-  const Vec v = inverse_mass().cwiseProduct(p);
+  const Vec v = constraint_velocity(*this, q, p);
   Vec g_t, a_t;
   constraints.constraint_time_terms(t, q, v, g_t, a_t);
   const Vec rate = G * v + g_t;
@@ -299,7 +341,7 @@ void Problem::check_consistent(const State& state, const std::string& what, doub
     for (SparseMatrix::InnerIterator it(G, k); it; ++it) row_sums[it.row()] += std::abs(it.value());
   }
   const double G_norm = row_sums.size() > 0 ? row_sums.maxCoeff() : 0.0;
-  const Vec v = inverse_mass().cwiseProduct(state.p);
+  const Vec v = constraint_velocity(*this, state.q, state.p);
   const double q_norm = state.q.size() > 0 ? state.q.cwiseAbs().maxCoeff() : 0.0;
   const double v_norm = v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0;
   const double position = constraint_residual(state.t, state.q);

@@ -1,5 +1,6 @@
 # Mechanisms (results/mechanisms/README.md): the elastic rod's tip under a step end load against
-# d'Alembert's triangle wave, and the loop action next to the map defect. Run inside
+# d'Alembert's triangle wave, the loop action next to the map defect, and Andrews' squeezer's
+# error against wall time. Run inside
 # results/mechanisms (scripts/reproduce.sh does); reads series/rod_*/ and summary.csv.
 load scripts."/common.gp"
 table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
@@ -36,4 +37,14 @@ do for [format in "png pdf svg"] {
   set xrange [1e-16:1]; set yrange [1e-17:1]
   plot for [k=1:words(loop_keys)] table using (is_loop(0) && strstrt(strcol("method"), word(loop_keys, k)) == 1 ? clip(column("symplecticity_defect_map")) : NaN):(clip(column("loop_action_err"))) with points ls ms(word(loop_styles, k)) title mtitle(word(loop_styles, k))
   unset logscale; set format x "% h"; set format y "% h"; set xrange [*:*]; set yrange [*:*]
+
+  # Andrews' squeezer: error against the Test Set reference at t = 0.03 against wall time, IDA's
+  # two forms over rtol 1e-4 ... 1e-12 (one point per tolerance).
+  set output "andrews_wp.".format
+  set title "andrews (IVP Test Set) to t = 0.03: error against the Test Set reference vs wall time\nIDA index 3 over rtol 1e-4 ... 1e-10, index 2 over 1e-4 ... 1e-12 (multiplier_atol = 1)"
+  set xlabel "wall time [s]"; set ylabel "||(q,p) - reference|| at t = 0.03"
+  set logscale xy; set format x "1e%T"; set format y "1e%T"
+  plot table using (strcol("label") eq "andrews_ida" && strstrt(strcol("method"), "index=3") ? column("wall_s") : NaN):(column("error_final")) with points ls 41 ps 1.5 title "ida:index=3", \
+       table using (strcol("label") eq "andrews_ida" && strstrt(strcol("method"), "index=2") ? column("wall_s") : NaN):(column("error_final")) with points ls 43 ps 1.5 title "ida:index=2"
+  unset logscale; set format x "% h"; set format y "% h"
 }
