@@ -16,7 +16,16 @@ FIGURE_SCENES = $(filter-out $(LONG_SCENES),$(SCENES))
 
 all: build
 
+# `make test` prints a line at the start of each phase (install, configure, build, tests, gates,
+# report, external) and at its end: wall seconds since it started and the CPU seconds its finished
+# recipes used (scripts/make-phase.sh; scripts/fresh-machine-test.sh reads them). Set for `test`
+# and, as make does with target variables, for its prerequisites; not in the sub-makes.
+MAKE_START := $(shell date +%s.%N)
+phase = $(if $(MARK_PHASES),@sh scripts/make-phase.sh $(1) $(MAKE_START))
+test: MARK_PHASES = 1
+
 deps:
+	$(call phase,install)
 	@bash scripts/install-deps.sh --quiet
 
 # clang and its sanitizer runtimes, for the sanitizer and fuzzing builds only.
@@ -30,6 +39,7 @@ deps-sanitize:
 # when the recipe runs, after `deps` may have installed ccache (docs/TESTING.md "Fresh clone").
 CCACHE ?= 1
 configure: deps
+	$(call phase,configure)
 	@mkdir -p $(BUILD_DIR) && launcher=; \
 	if [ "$(CCACHE)" = 0 ]; then launcher=-DCMAKE_CXX_COMPILER_LAUNCHER=; \
 	elif [ -z "$$CMAKE_CXX_COMPILER_LAUNCHER" ] && command -v ccache > /dev/null; then \
@@ -38,6 +48,7 @@ configure: deps
 	  || (cat $(BUILD_DIR)/configure.log; exit 1)
 
 build: configure
+	$(call phase,build)
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 # The mutation list checked against the code (a `find` text the code no longer has fails here, in a
@@ -49,15 +60,20 @@ build: configure
 # TEST_PER_PROCESS=1 runs every test in a process of its own as ctest does.
 TEST_PER_PROCESS ?= 0
 test: build
+	$(call phase,tests)
 	@/usr/bin/python3 scripts/mutation.py --check
 ifeq ($(TEST_PER_PROCESS),1)
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -LE slow
 else
-	@cd $(BUILD_DIR) && /usr/bin/python3 $(CURDIR)/scripts/gtest-shards.py . $(JOBS) --labels fast,nosan --others
+	@cd $(BUILD_DIR) && /usr/bin/python3 '$(CURDIR)/scripts/gtest-shards.py' . $(JOBS) --labels fast,nosan --others
 endif
+	$(call phase,gates)
 	@$(MAKE) --no-print-directory gate-quick
+	$(call phase,report)
 	@$(MAKE) --no-print-directory report-quick SITE=$(BUILD_DIR)/site-quick
+	$(call phase,external)
 	@$(MAKE) --no-print-directory test-external
+	$(call phase,end)
 
 test-external: build
 	@JOBS=$(JOBS) bash scripts/test-external.sh $(BUILD_DIR)
@@ -113,7 +129,7 @@ ifeq ($(SAN_PER_TEST),1)
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan' \
 	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
 else
-	@cd $(SAN_DIR) && $(SAN_ENV) /usr/bin/python3 $(CURDIR)/scripts/gtest-shards.py . $(JOBS) \
+	@cd $(SAN_DIR) && $(SAN_ENV) /usr/bin/python3 '$(CURDIR)/scripts/gtest-shards.py' . $(JOBS) \
 	  $(if $(SAN_EXCLUDE),--exclude '$(SAN_EXCLUDE)')
 	@cd $(SAN_DIR) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) -LE 'slow|nosan|fast' \
 	  $(if $(SAN_EXCLUDE),-E '$(SAN_EXCLUDE)')
