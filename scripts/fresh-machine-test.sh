@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Times `make test` as a new user runs it on a fresh Debian 12 machine (docs/TESTING.md "Fresh
 # machine"): a minimal Debian 12 root (debootstrap minbase plus git and make) in a chroot, this
-# repository's HEAD cloned into a folder whose name has a space and a `$(x)`, then `make test` as
-# root, which installs the packages itself. Prints each phase's wall and CPU seconds and the load.
+# repository's HEAD cloned into a folder whose name has a space and parentheses, then `make test`
+# as root, which installs the packages itself. Prints each phase's wall and CPU seconds and the
+# load. First checks that a clone under a folder with `$(x)` in its name, which CMake cannot build
+# in, is refused with a message.
 #
 # usage (root): scripts/fresh-machine-test.sh [ROOT]       ROOT defaults to /work/fresh-root
 #   FRESH_MIRROR   Debian mirror (default: the first URI of /etc/apt/sources.list.d/debian.sources,
@@ -27,7 +29,8 @@ declare -A budget=(
   [report]=${BUDGET_REPORT:-300} [external]=${BUDGET_EXTERNAL:-600}
 )
 # The clone's folder name tests the quoting of every script `make test` runs.
-clone_dir='/root/fresh clone $(x)/geomint'
+clone_dir='/root/fresh clone (x)/geomint'
+dollar_dir='/root/dollar $(x)/geomint'
 marker=.geomint-fresh-machine-test  # marks a root this script made, so that it may replace it
 
 if [ "$(id -u)" -ne 0 ]; then
@@ -101,6 +104,19 @@ git clone -q --no-local "$repo" "$root$clone_dir"
 git -C "$root$clone_dir" checkout -q "$(git -C "$repo" rev-parse "$rev")"
 commit=$(git -C "$root$clone_dir" rev-parse --short=12 HEAD)
 
+# A `$` in the path: refused before anything runs (exit 2, the message names the folder).
+mkdir -p "$root$(dirname "$dollar_dir")"
+git clone -q --no-local "$root$clone_dir" "$root$dollar_dir"
+dollar_status=0
+dollar_out=$(chroot "$root" /bin/bash -c 'cd "$1" && make test' make-test "$dollar_dir" 2>&1) ||
+  dollar_status=$?
+if [ $dollar_status -ne 2 ] || ! grep -qF "contains '\$'" <<< "$dollar_out"; then
+  echo "fresh-machine-test: make test under '$dollar_dir' exited $dollar_status: $dollar_out" >&2
+  exit 1
+fi
+echo "fresh-machine-test: refused as it should: $dollar_out"
+rm -rf "$root$(dirname "$dollar_dir")"
+
 log="$root/root/make-test.log"
 packages_before=$(chroot "$root" dpkg-query -W -f='${Status}\n' | grep -c 'install ok installed')
 echo "fresh-machine-test: $(date -u '+%F %T') UTC, commit $commit, load: $(uptime)"
@@ -149,7 +165,7 @@ echo "fresh-machine-test: packages installed by make test: $((packages_after - p
 # make had finished, load-independent).
 echo "| phase | wall s | CPU s |"
 echo "|---|---|---|"
-awk '/^make-phase: / { name[n] = $2; wall[n] = $8; cpu[n] = $11; n++ }
+awk 'BEGIN { n = 0 } /^make-phase: / { name[n] = $2; wall[n] = $8; cpu[n] = $11; n++ }
      END { for (i = 0; i + 1 < n; i++)
              printf "| %s | %.1f | %.1f |\n", name[i], wall[i+1] - wall[i], cpu[i+1] - cpu[i];
            if (n > 0) printf "| total (make test) | %.1f | %.1f |\n", wall[n-1], cpu[n-1] }' "$log"

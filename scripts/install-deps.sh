@@ -5,7 +5,9 @@
 # and libFuzzer runtimes, which only `make sanitize-build`, `test-sanitize` and `fuzz` use (not
 # `make test`: 14 packages, 48 MB to download, docs/TESTING.md "Fresh clone");
 # `install-deps.sh cluster` installs the local single-node Slurm that `make test-cluster` runs
-# (docs/CLUSTER.md "Running on a cluster") instead.
+# (docs/CLUSTER.md "Running on a cluster") instead. dpkg unpacks with --force-unsafe-io (no fsync
+# per file: most of the install's time on a fresh machine, docs/TESTING.md "Fresh machine");
+# INSTALL_SAFE_IO=1 keeps dpkg's default.
 set -euo pipefail
 
 PACKAGES=(
@@ -67,4 +69,11 @@ export DEBIAN_FRONTEND=noninteractive
 wait_for_dpkg_lock
 apt-get update -q
 wait_for_dpkg_lock
-apt-get install -y -q --no-install-recommends -o DPkg::Lock::Timeout=600 "${missing[@]}"
+# dpkg's fsync of every unpacked file (and its rename dance) waits on the disk's cache flush: on a
+# fresh machine that is most of the install time, while the CPU idles. A power loss during the
+# install may then leave some of these packages' files empty; `apt-get install --reinstall` of
+# them repairs it. Nothing else on the system is affected.
+unsafe_io=(-o DPkg::Options::=--force-unsafe-io)
+[ "${INSTALL_SAFE_IO:-0}" = 1 ] && unsafe_io=()
+apt-get install -y -q --no-install-recommends -o DPkg::Lock::Timeout=600 "${unsafe_io[@]}" \
+  "${missing[@]}"
