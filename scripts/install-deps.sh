@@ -19,7 +19,7 @@ PACKAGES=(
   python3 ccache
   libxml2-utils tidy chromium python3-yaml python3-jsonschema
   libcmark-gfm-dev libcmark-gfm-extensions-dev
-  pybind11-dev python3-numpy python3-pandas python3-pytest
+  pybind11-dev python3-dev python3-numpy python3-pandas python3-pytest
   libmujoco-dev libode-dev libbullet-dev
 )
 if [ "${1:-}" = cluster ]; then
