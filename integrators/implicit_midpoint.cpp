@@ -5,11 +5,13 @@
 
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "integrators/forcing.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
 
@@ -26,6 +28,13 @@ namespace {
 // then q₁ = q₀ + h v̄ and p₁ = 2M v̄ − p₀. Declared variational: for constant M this is exactly
 // the DEL map of the midpoint discrete Lagrangian (del:rule=midpoint, hp:alpha=0.5), and with a
 // force it is that map with F_d⁻ = F_d⁺ = (h/2)F(q̄, v̄) (force_slot=split, force_at=midpoint).
+// On the general kind L = ½vᵀM(q)v + a(q)ᵀv − V(q) the same unknown and the same Newton solve:
+// p̄ = L_v(q̄, v̄) is the midpoint momentum whose velocity is v̄, so the rule on z = (q, p) of the
+// Hamiltonian view (docs/MECHANICS_GENERAL.md §3) reads
+//   R(v̄) = L_v(q̄, v̄) − p₀ − (h/2)[L_q(q̄, v̄) + F] = 0,
+//   ∂R/∂v̄ = M(q̄) + (h/2)(L_vq − L_qv) − (h²/4)L_qq   (not symmetric with a gyroscopic a(q)),
+// then q₁ = q₀ + h v̄ and p₁ = 2p̄ − p₀ with p̄ = p₀ + (h/2)[L_q + F] = L_v(q̄, v̄) — the α = ½
+// DEL map of the general L.
 class ImplicitMidpoint final : public Integrator {
  public:
   explicit ImplicitMidpoint(const NewtonOptions& newton) : newton_(newton) {
@@ -49,22 +58,33 @@ class ImplicitMidpoint final : public Integrator {
     damping_symmetric_.reset();
   }
 
+  // The one step of both kinds (integrators/step_implementation.hpp): they differ only in the
+  // view asked at (q̄, v̄) — L_v = M v̄ through the mass operator and L_q = −∇V on the separable
+  // kind, the problem's LagrangianSystem on the general one (momentum, lagrangian_q and, for the
+  // Newton matrix, M(q̄), L_vq and L_qq).
   StepStatus step(const Problem& problem, State& state, double h) override {
-    if (problem.kind() == ProblemKind::kLagrangian) {
-      // On z = (q, p) of the Hamiltonian view (docs/MECHANICS_GENERAL.md §3).
-      return general_implicit_midpoint_step(
-          *problem.as_lagrangian(), state, h,
-          {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
-    }
-    const Vec& mass = MassOperator(problem).constant_diagonal();
-    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
+    mark_step_implementation();
+    const MassOperator mass(problem);
+    const LagrangianSystem* general = problem.as_lagrangian();
+    if (general == nullptr) update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double t_mid = state.t + h / 2;
-    Vec v = MassOperator(problem).solve(state.q, state.p);
+    // Start v̄ = v(q₀, p₀) = M⁻¹(p₀ − a(q₀)) (linear momentum exact through every iterate, as for
+    // del and hp).
+    Vec v = general != nullptr ? general->velocity(state.q, state.p) : mass.solve(state.q, state.p);
     if (forced) decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
 
-    // −(h/2)[−∇V(q̄) + F(q̄, v̄, t + h/2)], the implicit part of R, memoised on v̄ (the solver's
-    // first evaluation repeats the one for the residual scale).
+    // L_v(q̄, v̄) at q̄ = q₀ + (h/2)v̄: M(q̄)v̄ + a(q̄) on the general kind, M v̄ on the separable
+    // one (the constant diagonal's product, which reads no q̄).
+    const auto momentum = [&](const Vec& x, Vec& out) {
+      if (general != nullptr) {
+        out = general->momentum(state.q + (h / 2) * x, x);
+      } else {
+        mass.apply(state.q, x, out);
+      }
+    };
+    // −(h/2)[L_q(q̄, v̄) + F(q̄, v̄, t + h/2)] (L_q = −∇V on the separable kind), the implicit part
+    // of R, memoised on v̄ (the solver's first evaluation repeats the one for the residual scale).
     bool memo_valid = false;
     Vec memo_v;
     const auto impulse = [&](const Vec& x, Vec& out) {
@@ -72,7 +92,13 @@ class ImplicitMidpoint final : public Integrator {
       memo_valid = true;
       memo_v = x;
       const Vec q_mid = state.q + (h / 2) * x;
-      eval_gradient(problem, q_mid, out);
+      if (general != nullptr) {
+        ++counters_.force_evals;
+        general->lagrangian_q(q_mid, x, out);
+        out = -out;
+      } else {
+        eval_gradient(problem, q_mid, out);
+      }
       if (forced) {
         ++counters_.force_evals;
         eval_force(problem, q_mid, x, t_mid, force_);
@@ -85,13 +111,20 @@ class ImplicitMidpoint final : public Integrator {
     system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& x, Vec& residual) {
       impulse(x, impulse_);
-      residual = mass.cwiseProduct(x) - state.p + impulse_;
+      momentum(x, momentum_);
+      residual = momentum_ - state.p + impulse_;
     };
     system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
       const Vec q_mid = state.q + (h / 2) * x;
-      eval_hessian(problem, q_mid, hessian_);
-      inner_scale = std::abs(h / 2) * gradient_term_scale(hessian_, q_mid);
-      jacobian = mass_matrix_ + (h * h / 4) * hessian_;
+      if (general != nullptr) {
+        general_jacobian(*general, q_mid, x, h, jacobian);
+        inner_scale =
+            std::abs(h / 2) * robust_norm((lagrangian_qq_.cwiseAbs() * q_mid.cwiseAbs()).eval());
+      } else {
+        eval_hessian(problem, q_mid, hessian_);
+        inner_scale = std::abs(h / 2) * gradient_term_scale(hessian_, q_mid);
+        jacobian = mass_matrix_ + (h * h / 4) * hessian_;
+      }
       if (!forced) return;
       if (problem.has(kForceJacobian)) {
         force_of(problem).force_jacobian_v(q_mid, x, t_mid, damping_);
@@ -105,9 +138,10 @@ class ImplicitMidpoint final : public Integrator {
         counters_.force_evals += 2 * x.size();
       }
     };
-    system.symmetric = !forced || (problem.has(kForceJacobian) && *damping_symmetric_);
+    // The general kind's matrix has the non-symmetric part (h/2)(L_vq − L_qv).
+    system.symmetric =
+        general == nullptr && (!forced || (problem.has(kForceJacobian) && *damping_symmetric_));
 
-    // Start v̄ = M⁻¹p₀ (linear momentum exact through every iterate, as for del and hp).
     impulse(v, impulse_);
     const double residual_scale = robust_norm(state.p) + robust_norm(impulse_);
     const NewtonResult result = newton_.solve(system, v, residual_scale);
@@ -116,8 +150,17 @@ class ImplicitMidpoint final : public Integrator {
     counters_.factorizations += result.factorizations;
     if (!result.converged) return StepStatus::failure(result.reason, describe(result));
 
+    // p₁ = 2p̄ − p₀. On the general kind p̄ = p₀ + (h/2)[L_q + F] at the accepted v̄ (equal to
+    // L_v(q̄, v̄) up to the residual), which keeps the momentum of a cyclic coordinate (L_q ≡ 0:
+    // polar Kepler's p_φ) exact whatever residual the solve left, as the rule on z = (q, p) does.
+    if (general != nullptr) {
+      impulse(v, impulse_);
+      state.p -= 2 * impulse_;
+    } else {
+      momentum(v, momentum_);
+      state.p = 2 * momentum_ - state.p;
+    }
     state.q += h * v;
-    state.p = 2 * mass.cwiseProduct(v) - state.p;
     state.t += h;
     ++counters_.steps;
     return StepStatus::success();
@@ -137,11 +180,33 @@ class ImplicitMidpoint final : public Integrator {
   }
 
  private:
+  // ∂R/∂v̄ on the general kind, R = L_v(q̄, v̄) − p₀ − (h/2)L_q(q̄, v̄) with q̄ = q₀ + (h/2)v̄:
+  // M(q̄) + (h/2)(L_vq − L_qv) − (h²/4)L_qq (on the separable kind M + (h²/4)∇²V). Every entry is
+  // stored, zeros included, so the solver keeps one sparsity pattern per run.
+  void general_jacobian(const LagrangianSystem& general, const Vec& q_mid, const Vec& v, double h,
+                        SparseMatrix& jacobian) {
+    general.mass_matrix(q_mid, dense_jacobian_);
+    general.lagrangian_vq(q_mid, v, lagrangian_vq_);
+    general.lagrangian_qq(q_mid, v, lagrangian_qq_);
+    dense_jacobian_ +=
+        (h / 2) * (lagrangian_vq_ - lagrangian_vq_.transpose()) - (h * h / 4) * lagrangian_qq_;
+    const Eigen::Index n = dense_jacobian_.rows();
+    triplets_.clear();
+    triplets_.reserve(static_cast<size_t>(n * n));
+    for (Eigen::Index j = 0; j < n; ++j) {
+      for (Eigen::Index i = 0; i < n; ++i) triplets_.emplace_back(i, j, dense_jacobian_(i, j));
+    }
+    jacobian.resize(n, n);
+    jacobian.setFromTriplets(triplets_.begin(), triplets_.end());
+  }
+
   NewtonSolver newton_;
   Vec mass_diagonal_;
   SparseMatrix mass_matrix_, hessian_, damping_;
   std::optional<bool> damping_symmetric_;
-  Vec impulse_, force_;
+  Vec impulse_, force_, momentum_;
+  DenseMatrix dense_jacobian_, lagrangian_vq_, lagrangian_qq_;
+  std::vector<Eigen::Triplet<double>> triplets_;
 };
 
 }  // namespace

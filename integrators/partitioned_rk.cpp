@@ -8,6 +8,7 @@
 
 #include "integrators/general_step.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
 
@@ -29,6 +30,14 @@ constexpr double kSameStep = 1e-6;
 // p₁ = p₀ + hΣ_j b_j F_j and pairwise forces sum to zero at any stage positions, so linear
 // momentum is exact whatever the convergence; angular momentum (a quadratic invariant, GNI
 // §IV.2) needs the converged solve, hence the polishing correction.
+//
+// On the general kind L = ½vᵀM(q)v + a(q)ᵀv − V(q) the same unknowns and the same solve: the
+// PRK on Hamilton's equations (GNI §II.2.2, Q_i = q₀ + hΣ_j a_ij v(Q_j, P_j),
+// P_i = p₀ + hΣ_j â_ij L_q(Q_j, v_j)) with V_j = v(Q_j, P_j), so P_i = L_v(Q_i, V_i) and
+//   R_i(V) = L_v(Q_i, V_i) − p₀ − hΣ_j â_ij [L_q(Q_j, V_j) + F_j] = 0,
+//   ∂R_i/∂V_k = M(Q_i)δ_ik + h a_ik L_vq(Q_i) − h â_ik L_qv(Q_k) − h²Σ_j â_ij a_jk L_qq(Q_j)
+// (on the separable kind L_v = MV, L_q = −∇V, L_vq = 0: the equations above), and the same
+// update p₁ = p₀ + hΣ_j b_j [L_q + F]_j, which keeps a cyclic momentum (L_q ≡ 0) exact.
 class ImplicitPartitionedRk final : public Integrator {
  public:
   ImplicitPartitionedRk(const coefficients::PartitionedTableau& tableau, MethodInfo info,
@@ -73,16 +82,15 @@ class ImplicitPartitionedRk final : public Integrator {
     previous_v_.resize(0);
   }
 
+  // The one step of both kinds (integrators/step_implementation.hpp): they differ only in the
+  // view asked at the stages — L_v = M V_i, L_q = −∇V and ∇²V on the separable kind (the
+  // constant diagonal read once), the problem's LagrangianSystem on the general one.
   StepStatus step(const Problem& problem, State& state, double h) override {
-    if (problem.kind() == ProblemKind::kLagrangian) {
-      // On (q, p) of the Hamiltonian view (../shared/MECHANICS.md §4).
-      return general_partitioned_rk_step(
-          *problem.as_lagrangian(), state, h, a_, a_hat_, b_,
-          {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
-    }
+    mark_step_implementation();
     const int n = problem.dof();
-    const Vec& mass = MassOperator(problem).constant_diagonal();
-    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
+    const LagrangianSystem* general = problem.as_lagrangian();
+    const MassOperator mass_operator(problem);
+    const Vec* mass = general != nullptr ? nullptr : &mass_operator.constant_diagonal();
     const bool forced = problem.has(kForce);
     const Vec q0 = state.q;
     const Vec p0 = state.p;
@@ -91,6 +99,11 @@ class ImplicitPartitionedRk final : public Integrator {
     stage_f_.resize(stages_);
     hessians_.resize(stages_);
     dampings_.resize(stages_);
+    if (general != nullptr) {
+      stage_mass_.resize(stages_);
+      stage_l_vq_.resize(stages_);
+      stage_l_qq_.resize(stages_);
+    }
 
     // Stage positions and forces at V, memoised (the solver evaluates the residual at the
     // accepted iterate last, and the update below needs the forces there).
@@ -105,7 +118,8 @@ class ImplicitPartitionedRk final : public Integrator {
         for (int k = 0; k < stages_; ++k) {
           if (a_(j, k) != 0.0) stage_q_[j] += (h * a_(j, k)) * v.segment(k * n, n);
         }
-        eval_total_force(problem, stage_q_[j], v.segment(j * n, n), t0 + c_[j] * h, stage_f_[j]);
+        stage_force(problem, general, stage_q_[j], v.segment(j * n, n), t0 + c_[j] * h,
+                    stage_f_[j]);
       }
     };
 
@@ -117,13 +131,22 @@ class ImplicitPartitionedRk final : public Integrator {
       residual.resize(stages_ * n);
       for (int i = 0; i < stages_; ++i) {
         auto block = residual.segment(i * n, n);
-        block = mass.cwiseProduct(v.segment(i * n, n)) - p0;
+        if (general != nullptr) {
+          block = general->momentum(stage_q_[i], v.segment(i * n, n)) - p0;
+        } else {
+          block = mass->cwiseProduct(v.segment(i * n, n)) - p0;
+        }
         for (int j = 0; j < stages_; ++j) {
           if (a_hat_(i, j) != 0.0) block -= (h * a_hat_(i, j)) * stage_f_[j];
         }
       }
     };
     system.jacobian = [&](const Vec& v, SparseMatrix& jacobian) {
+      if (general != nullptr) {
+        general_jacobian(*general, q0, v, h, jacobian, inner_scale);
+        if (forced) add_general_damping(problem, q0, v, t0, h, jacobian);
+        return;
+      }
       std::vector<Eigen::Triplet<double>> triplets;
       inner_scale = 0.0;
       for (int j = 0; j < stages_; ++j) {
@@ -136,7 +159,7 @@ class ImplicitPartitionedRk final : public Integrator {
         if (forced) damping_at(problem, qj, v.segment(j * n, n), t0 + c_[j] * h, dampings_[j]);
       }
       for (int i = 0; i < stages_; ++i) {
-        for (int d = 0; d < n; ++d) triplets.emplace_back(i * n + d, i * n + d, mass[d]);
+        for (int d = 0; d < n; ++d) triplets.emplace_back(i * n + d, i * n + d, (*mass)[d]);
         for (int k = 0; k < stages_; ++k) {
           // Structural zeros of the tableau stay zeros: the pattern is the same every step.
           for (int j = 0; j < stages_; ++j) {
@@ -156,9 +179,10 @@ class ImplicitPartitionedRk final : public Integrator {
 
     // Start from the previous step's stage velocities extrapolated to this step's nodes (GNI
     // §VIII.6.1) when this step continues it, otherwise from the explicit-Euler stage
-    // velocities V_i = M⁻¹(p₀ + c_i h f(q₀, v₀, t₀)).
+    // velocities V_i = M⁻¹(p₀ + c_i h f(q₀, v₀, t₀)) (v(q₀, p₀ + c_i h f) on the general kind).
     Vec force0;
-    eval_total_force(problem, q0, inverse_mass.cwiseProduct(p0), t0, force0);
+    const Vec v0 = general != nullptr ? general->velocity(q0, p0) : mass_operator.solve(q0, p0);
+    stage_force(problem, general, q0, v0, t0, force0);
     Vec v(stages_ * n);
     // The harness steps h = t_{k+1} − t_k with t_k = t_0 + k·dt, which differs from dt by
     // rounding (a relative 1e-10 at t/dt = 1e6), so h is compared with a relative tolerance; an
@@ -173,8 +197,10 @@ class ImplicitPartitionedRk final : public Integrator {
         for (int j = 0; j < stages_; ++j) {
           v.segment(i * n, n) += extrapolation_(i, j) * previous_v_.segment(j * n, n);
         }
+      } else if (general != nullptr) {
+        v.segment(i * n, n) = general->velocity(q0, p0 + (c_[i] * h) * force0);
       } else {
-        v.segment(i * n, n) = inverse_mass.cwiseProduct(p0 + (c_[i] * h) * force0);
+        v.segment(i * n, n) = mass_operator.solve(q0, p0 + (c_[i] * h) * force0);
       }
     }
     const double residual_scale = std::sqrt(static_cast<double>(stages_)) *
@@ -243,6 +269,82 @@ class ImplicitPartitionedRk final : public Integrator {
   }
 
  private:
+  // The stage's generalized force: −∇V(Q) + F(Q, V, t) on the separable kind,
+  // L_q(Q, V) + F(Q, V, t) on the general one.
+  void stage_force(const Problem& problem, const LagrangianSystem* general, const Vec& q,
+                   const Vec& v, double t, Vec& force) {
+    if (general == nullptr) {
+      eval_total_force(problem, q, v, t, force);
+      return;
+    }
+    ++counters_.force_evals;
+    general->lagrangian_q(q, v, force);
+    if (problem.has(kForce)) {
+      eval_force(problem, q, v, t, force_);
+      force += force_;
+    }
+  }
+
+  // ∂R/∂V on the general kind (the comment above the class), every entry of every block stored
+  // (zeros included: one sparsity pattern per run); `inner_scale` gets hΣ_j |L_qq(Q_j)||Q_j|.
+  void general_jacobian(const LagrangianSystem& general, const Vec& q0, const Vec& v, double h,
+                        SparseMatrix& jacobian, double& inner_scale) {
+    const int n = static_cast<int>(q0.size());
+    inner_scale = 0.0;
+    for (int j = 0; j < stages_; ++j) {
+      Vec qj = q0;
+      for (int k = 0; k < stages_; ++k) {
+        if (a_(j, k) != 0.0) qj += (h * a_(j, k)) * v.segment(k * n, n);
+      }
+      const Vec vj = v.segment(j * n, n);
+      general.mass_matrix(qj, stage_mass_[j]);
+      general.lagrangian_vq(qj, vj, stage_l_vq_[j]);
+      general.lagrangian_qq(qj, vj, stage_l_qq_[j]);
+      inner_scale += std::abs(h) * robust_norm((stage_l_qq_[j].cwiseAbs() * qj.cwiseAbs()).eval());
+    }
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<size_t>(stages_ * stages_ * n * n));
+    Eigen::MatrixXd block(n, n);
+    for (int i = 0; i < stages_; ++i) {
+      for (int k = 0; k < stages_; ++k) {
+        block.setZero();
+        if (i == k) block += stage_mass_[i];
+        block += (h * a_(i, k)) * stage_l_vq_[i];
+        block -= (h * a_hat_(i, k)) * stage_l_vq_[k].transpose();
+        for (int j = 0; j < stages_; ++j) {
+          block -= (h * h * a_hat_(i, j) * a_(j, k)) * stage_l_qq_[j];
+        }
+        for (int col = 0; col < n; ++col) {
+          for (int row = 0; row < n; ++row) {
+            triplets.emplace_back(i * n + row, k * n + col, block(row, col));
+          }
+        }
+      }
+    }
+    jacobian.resize(stages_ * n, stages_ * n);
+    jacobian.setFromTriplets(triplets.begin(), triplets.end());
+  }
+
+  // h â_ik C(Q_k, V_k) on the general kind (C = −∂F/∂v), added to the matrix above.
+  void add_general_damping(const Problem& problem, const Vec& q0, const Vec& v, double t0, double h,
+                           SparseMatrix& jacobian) {
+    const int n = static_cast<int>(q0.size());
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int k = 0; k < stages_; ++k) {
+      Vec qk = q0;
+      for (int m = 0; m < stages_; ++m) {
+        if (a_(k, m) != 0.0) qk += (h * a_(k, m)) * v.segment(m * n, n);
+      }
+      damping_at(problem, qk, v.segment(k * n, n), t0 + c_[k] * h, dampings_[k]);
+      for (int i = 0; i < stages_; ++i) {
+        if (a_hat_(i, k) != 0.0) add_block(triplets, i, k, n, h * a_hat_(i, k), dampings_[k]);
+      }
+    }
+    SparseMatrix damping(stages_ * n, stages_ * n);
+    damping.setFromTriplets(triplets.begin(), triplets.end());
+    jacobian += damping;
+  }
+
   // C = −∂F/∂v at a stage: the problem's force_jacobian_v, or central differences.
   void damping_at(const Problem& problem, const Vec& q, const Vec& v, double t, SparseMatrix& C) {
     if (problem.has(kForceJacobian)) {
@@ -271,6 +373,8 @@ class ImplicitPartitionedRk final : public Integrator {
   NewtonSolver newton_;
   std::vector<Vec> stage_q_, stage_f_;
   std::vector<SparseMatrix> hessians_, dampings_;
+  std::vector<Eigen::MatrixXd> stage_mass_, stage_l_vq_, stage_l_qq_;  // the general kind's
+  Vec force_;
   // Last step's stage velocities, step and end state, for the starting guess of the next one.
   Vec previous_v_, previous_q_, previous_p_;
   double previous_h_ = 0.0;

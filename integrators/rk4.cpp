@@ -1,10 +1,12 @@
-// Classical fourth-order Runge–Kutta on the first-order system (q, p)' = (M⁻¹p, −∇V(q) +
-// F(q, M⁻¹p, t)) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
+// Classical fourth-order Runge–Kutta on Hamilton's equations of the Lagrangian view,
+// (q, p)' = (v(q, p), L_q(q, v) + F(q, v, t)) — on the separable kind v = M⁻¹p and
+// L_q = −∇V(q) (Kutta 1901; Hairer, Nørsett & Wanner, "Solving ODEs I", §II.1, Table 1.2).
 // Not symplectic: the negative control of docs/METHOD.md §7. On a first-order-only problem it is
 // the same tableau on y' = f(t, y).
 #include "integrators/fixed_step_loop.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
 #include "problems/structures/time_dependent.hpp"
@@ -51,22 +53,18 @@ class Rk4 final : public ExplicitStepper<Rk4> {
     return step(problem, state, h);
   }
 
-  // One step (ExplicitStepper runs it for step() and advance()).
+  // One step (ExplicitStepper runs it for step() and advance()): the one implementation for the
+  // separable and the general Lagrangian kinds, which differ only in rhs().
   void advance_by(const Problem& problem, State& state, double h) {
     if (problem.has(kFirstOrderOnly)) {
       advance_first_order(problem, state, h);
       return;
     }
-    // A time-dependent H(q, p, t) has its own q̇ = ∂T/∂p(p, t): first_order_rhs gives it.
-    if (problem.kind() == ProblemKind::kLagrangian ||
-        problem.as<TimeDependentHamiltonian>() != nullptr) {
-      advance_general(problem, state, h);
-      return;
-    }
+    mark_step_implementation();
     const double t = state.t;
     const Vec& q = state.q;
     const Vec& p = state.p;
-    // Stage derivatives: dq_i = M⁻¹p_i, dp_i = total force at stage i. The stage points go
+    // Stage derivatives: dq_i = v(q_i, p_i), dp_i = total force at stage i. The stage points go
     // into stage_q_/stage_p_ so that no step allocates.
     rhs(problem, t, q, p, dq_[0], dp_[0]);
     stage_q_ = q + (h / 2) * dq_[0], stage_p_ = p + (h / 2) * dp_[0];
@@ -98,39 +96,37 @@ class Rk4 final : public ExplicitStepper<Rk4> {
     ++counters_.steps;
   }
 
-  // The same tableau on y = (q, p) with Hamilton's equations of the general L,
-  // (q̇, ṗ) = (v(q, p), L_q(q, v)) (Problem::first_order_rhs, docs/MECHANICS_GENERAL.md §1).
-  void advance_general(const Problem& problem, State& state, double h) {
-    const double t = state.t;
-    const long n = state.q.size();
-    general_y_.resize(2 * n);
-    general_y_ << state.q, state.p;
-    const Vec& y = general_y_;
-    first_order(problem, t, y, dq_[0]);
-    stage_q_ = y + (h / 2) * dq_[0];
-    first_order(problem, t + h / 2, stage_q_, dq_[1]);
-    stage_q_ = y + (h / 2) * dq_[1];
-    first_order(problem, t + h / 2, stage_q_, dq_[2]);
-    stage_q_ = y + h * dq_[2];
-    first_order(problem, t + h, stage_q_, dq_[3]);
-    general_y_ += (h / 6) * (dq_[0] + 2 * (dq_[1] + dq_[2]) + dq_[3]);
-    state.q = general_y_.head(n);
-    state.p = general_y_.tail(n);
-    state.t = t + h;
-    ++counters_.steps;
-  }
-
   void first_order(const Problem& problem, double t, const Vec& y, Vec& ydot) {
     ++counters_.force_evals;
     problem.first_order_rhs(t, y, ydot);
   }
 
+  // Hamilton's equations of the Lagrangian view (docs/MECHANICS_GENERAL.md §1): dq = ∂H/∂p, the
+  // velocity v(q, p) = M(q)⁻¹(p − a(q)) (M⁻¹p through the mass operator on the separable kind),
+  // and dp = −∂H/∂q + F = L_q(q, v) + F(q, v, t) (−∇V(q) + F on the separable kind).
   void rhs(const Problem& problem, double t, const Vec& q, const Vec& p, Vec& dq, Vec& dp) {
+    // A time-dependent H(q, p, t) has its own halves at t (q̇ = ∂T/∂p(p, t)), not M⁻¹p and −∇V.
+    if (const auto* hamiltonian = problem.as<TimeDependentHamiltonian>()) {
+      ++counters_.force_evals;
+      hamiltonian->velocity(p, t, dq);
+      hamiltonian->momentum_rate(q, p, t, dp);
+      return;
+    }
+    if (const LagrangianSystem* general = problem.as_lagrangian()) {
+      dq = general->velocity(q, p);
+      ++counters_.force_evals;
+      general->lagrangian_q(q, dq, dp);
+      if (const NonConservativeForce* forced = problem.as_forced()) {
+        forced->force(q, dq, t, force_);
+        dp += force_;
+      }
+      return;
+    }
     MassOperator(problem).solve(q, p, dq);
     eval_total_force(problem, q, dq, t, dp);
   }
 
-  Vec dq_[4], dp_[4], stage_q_, stage_p_, general_y_;
+  Vec dq_[4], dp_[4], stage_q_, stage_p_, force_;
 };
 
 }  // namespace

@@ -205,6 +205,10 @@ TEST(MapDefect, ConstrainedMethodsOnTheConstraintManifoldAgreeWithTheirStructure
     for (const auto& spec : integrator_test_specs()) {
       const auto method = make_integrator(spec);
       if ((method->info().flags & kAdaptive) || !applicable(*method, *problem).ok) continue;
+      // An engine declares no structure flags (its step is the engine's, identified in
+      // engines_test: Bullet's euler is symplectic Euler, MuJoCo's ball joint renormalises a
+      // quaternion), so this classification by flags does not apply to it.
+      if (method->provider().kind == MethodProvider::Kind::kEngine) continue;
       ASSERT_EQ(map_defect_not_applicable(*method, *problem, 0.02), "") << spec;
       const MapDefect value =
           symplecticity_defect_map(*method, *problem, problem->initial_state(), 0.02);

@@ -23,8 +23,9 @@ namespace {
 
 const char* const kGoldenFile = GEOMINT_SOURCE_DIR "/tests/golden/newton_work.csv";
 
-// Joint angles, polar Kepler and the charged particle run the dense loop (non-separable L);
-// the pendulum and a spring chain the sparse NewtonSolver.
+// Joint angles, polar Kepler and the charged particle run the dense loop (non-separable L) of
+// the methods that still have a general-kind step, and implicit_midpoint's one step through the
+// sparse NewtonSolver; the pendulum and a spring chain the sparse NewtonSolver.
 const std::vector<std::string>& golden_problems() {
   static const std::vector<std::string> problems = {"double_pendulum",
                                                     "kepler:coordinates=polar",
