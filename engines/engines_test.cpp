@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <random>
+#include <thread>
 
 #include "engines/bullet.hpp"
 #include "engines/mujoco.hpp"
@@ -220,6 +221,32 @@ TEST(OdeIdentification, BothSteppersAreFirstOrderOnThePendulum) {
       const double order = std::log2(errors[k - 1] / errors[k]);
       EXPECT_GT(order, 0.8) << errors[k - 1] << " " << errors[k];
       EXPECT_LT(order, 1.3) << errors[k - 1] << " " << errors[k];
+    }
+  }
+}
+
+// A sweep steps several ODE worlds at once, one per worker thread. Each world must step on its own
+// threading implementation: ODE's default is one process-wide job list without locks, and two
+// concurrent dWorldStep calls on it abort the process in ODE's dDebug.
+TEST(OdeThreads, WorldsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
+  for (const std::string spec : {"rod_chain:coordinates=joint,n=4,theta=0.3", "heavy_top"}) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    const int runs = 1000, steps = 50;
+    const State alone = run_steps("ode:step=world", *problem, 0.001, steps);
+    std::vector<std::vector<State>> concurrent(2, std::vector<State>(runs));
+    std::vector<std::thread> threads;
+    for (std::vector<State>& results : concurrent) {
+      threads.emplace_back([&problem, &results] {
+        for (State& result : results) result = run_steps("ode:step=world", *problem, 0.001, steps);
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (const std::vector<State>& results : concurrent) {
+      for (const State& result : results) {
+        EXPECT_EQ(result.q, alone.q);
+        EXPECT_EQ(result.p, alone.p);
+      }
     }
   }
 }

@@ -49,10 +49,16 @@ constexpr unsigned long kQuickStepSeed = 0;
 
 // A world with gravity g along −z; clean: hard joints (CFM = 0) without the Baumgarte correction
 // (ERP = 0), which feeds position errors back as velocity; no damping, sleeping or speed clamp
-// (their defaults, written out).
-dxWorld* make_world(double gravity, const OdeOptions& options) {
+// (their defaults, written out). The world steps on its own job list (`threading`, freed with
+// it by destroy_world): ODE's default one is shared by every world of the process and has no
+// locks, so worlds stepped on two threads at once (a sweep's workers) would corrupt it.
+dxWorld* make_world(double gravity, const OdeOptions& options,
+                    dxThreadingImplementation*& threading) {
   init_ode_for_this_thread();
   dxWorld* world = dWorldCreate();
+  threading = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
+                                       threading);
   dWorldSetGravity(world, 0, 0, -gravity);
   if (!options.shipped_defaults) {
     dWorldSetCFM(world, 0);
@@ -63,6 +69,11 @@ dxWorld* make_world(double gravity, const OdeOptions& options) {
     dWorldSetMaxAngularSpeed(world, dInfinity);
   }
   return world;
+}
+
+void destroy_world(dxWorld* world, dxThreadingImplementation* threading) {
+  if (world != nullptr) dWorldDestroy(world);
+  if (threading != nullptr) dThreadingFreeImplementation(threading);
 }
 
 StepStatus step_world(dxWorld* world, const OdeOptions& options, double h) {
@@ -106,7 +117,7 @@ const std::vector<std::string>& ode_steps() {
 // approximation (tested).
 OdeChain::OdeChain(const PlanarChain& chain, const OdeOptions& options)
     : options_(options), links_(chain.links()) {
-  world_ = make_world(chain.gravity, options);
+  world_ = make_world(chain.gravity, options, threading_);
   for (int i = 0; i < links_; ++i) {
     Link link;
     link.length = chain.length[i];
@@ -127,9 +138,7 @@ OdeChain::OdeChain(const PlanarChain& chain, const OdeOptions& options)
   set_state(Vec::Zero(links_), Vec::Zero(links_));
 }
 
-OdeChain::~OdeChain() {
-  if (world_ != nullptr) dWorldDestroy(world_);
-}
+OdeChain::~OdeChain() { destroy_world(world_, threading_); }
 
 void OdeChain::set_state(const Vec& theta, const Vec& theta_dot) {
   double node_x = 0, node_z = 0, node_vx = 0, node_vz = 0;
@@ -208,7 +217,7 @@ StepStatus OdeChain::step(double h) { return step_world(world_, options_, h); }
 
 OdeRotor::OdeRotor(const Rotor& rotor, const OdeOptions& options)
     : options_(options), centre_(rotor.principal_centre) {
-  world_ = make_world(rotor.gravity, options);
+  world_ = make_world(rotor.gravity, options, threading_);
   Eigen::Vector3d I = rotor.principal_moments;
   double total = rotor.mass;
   const bool point_mass =
@@ -234,9 +243,7 @@ OdeRotor::OdeRotor(const Rotor& rotor, const OdeOptions& options)
   set_state(RotorState{});
 }
 
-OdeRotor::~OdeRotor() {
-  if (world_ != nullptr) dWorldDestroy(world_);
-}
+OdeRotor::~OdeRotor() { destroy_world(world_, threading_); }
 
 void OdeRotor::set_state(const RotorState& principal) {
   const Eigen::Matrix3d& Q = principal.attitude;

@@ -13,6 +13,7 @@
 struct dxWorld;
 struct dxBody;
 struct dxJoint;
+struct dxThreadingImplementation;
 
 namespace geomint::engines {
 
@@ -49,6 +50,9 @@ class OdeChain {
   OdeOptions options_;
   int links_ = 0;
   dxWorld* world_ = nullptr;
+  // The world's own job list: ODE's default one is shared by every world of the process and has
+  // no locks, so worlds stepped on two threads at once would corrupt it.
+  dxThreadingImplementation* threading_ = nullptr;
   std::vector<Link> links_data_;
   Vec angles_;
 };
@@ -74,6 +78,7 @@ class OdeRotor {
   OdeOptions options_;
   Eigen::Vector3d centre_;  // principal frame
   dxWorld* world_ = nullptr;
+  dxThreadingImplementation* threading_ = nullptr;  // the world's own job list (as OdeChain)
   dxBody* body_ = nullptr;
   dxJoint* joint_ = nullptr;
 };

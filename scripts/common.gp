@@ -10,8 +10,8 @@ set grid lw 0.5 lc rgb "#dddddd"
 # the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
 # ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not
 # be prefixes of one another. Line style i is the i-th key; 99 is any method not listed.
-method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake rkn_nystrom4 rkn_dprkn6 rkn_dprkn8 rkn_adaptive_dprkn6 rkn_adaptive_dprkn8"
-method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection) rkn:table=nystrom4 rkn:table=dprkn6 rkn:table=dprkn8 rkn_adaptive:pair=dprkn6 rkn_adaptive:pair=dprkn8"
+method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake rkn_nystrom4 rkn_dprkn6 rkn_dprkn8 rkn_adaptive_dprkn6 rkn_adaptive_dprkn8 mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4"
+method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection) rkn:table=nystrom4 rkn:table=dprkn6 rkn:table=dprkn8 rkn_adaptive:pair=dprkn6 rkn_adaptive:pair=dprkn8 mujoco:integrator=euler mujoco:integrator=rk4 mujoco:integrator=implicit ode:step=world ode:step=quick bullet:integrator=euler bullet:integrator=rk4"
 method_index(name) = sum [i=1:words(method_keys)] (strstrt(name, word(method_keys, i)) == 1 ? i : 0)
 ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 99)
 mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(method_titles, method_found) : name)
@@ -52,6 +52,16 @@ set style line 30 lw 2 lc rgb "#1b9e77" pt 9  ps 1.0 dt (6,2) # rkn_dprkn6: sea 
 set style line 31 lw 2 lc rgb "#d95f02" pt 5  ps 0.9          # rkn_dprkn8: dark orange, filled square
 set style line 32 lw 2 lc rgb "#17becf" pt 8  ps 1.2 dt (4,2) # rkn_adaptive_dprkn6: cyan, open triangle, dashed
 set style line 33 lw 2 lc rgb "#0868ac" pt 12 ps 1.3          # rkn_adaptive_dprkn8: dark blue, open diamond
+# Physics engines (results/engines, docs/ENGINES.md): one colour per engine, one marker per
+# integrator; MuJoCo dashed and Bullet dotted, so the two (equal to round-off where both are
+# semi-implicit Euler or RK4) show on top of each other.
+set style line 34 lw 2 lc rgb "#00897b" pt 4  ps 1.2 dt (6,3) # mujoco_integrator_euler: teal, open square, dashed
+set style line 35 lw 2 lc rgb "#00897b" pt 12 ps 1.4 dt (6,3) # mujoco_integrator_rk4: teal, open diamond, dashed
+set style line 36 lw 2 lc rgb "#00897b" pt 8  ps 1.3 dt (6,3) # mujoco_integrator_implicit: teal, open triangle, dashed
+set style line 37 lw 2 lc rgb "#a0522d" pt 6  ps 1.3          # ode_step_world: sienna, open circle
+set style line 38 lw 2 lc rgb "#a0522d" pt 2  ps 1.3          # ode_step_quick: sienna, cross
+set style line 39 lw 2 lc rgb "#3949ab" pt 5  ps 0.8 dt (2,3) # bullet_integrator_euler: indigo blue, small filled square, dotted
+set style line 40 lw 2 lc rgb "#3949ab" pt 13 ps 0.9 dt (2,3) # bullet_integrator_rk4: indigo blue, small filled diamond, dotted
 set style line 99 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
 # Curves that are not methods (a parameter family, step sizes, energies of one method, bodies):
 # an ordered dark-to-light palette, styles 41-48, so they cannot be mistaken for a method.
