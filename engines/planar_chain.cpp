@@ -87,7 +87,13 @@ Vec chain_velocity(const Problem& problem, const Vec& q, const Vec& p) {
 
 Vec chain_momentum(const Problem& problem, const Vec& q, const Vec& v) {
   if (const LagrangianSystem* lagrangian = problem.as_lagrangian()) {
-    return lagrangian->momentum(q, v);
+    // Through the problem's mass operator, not the dense M(θ): the joint chain's is an O(n)
+    // recursion, and this runs after every engine step (docs/ENGINES.md "Adapter overhead").
+    Vec p;
+    lagrangian->apply_mass(q, v, p);
+    Vec a;
+    lagrangian->gyroscopic(q, a);
+    return p + a;
   }
   return problem.mass().cwiseProduct(v);
 }
