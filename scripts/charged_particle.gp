@@ -3,7 +3,7 @@
 # momentum errors of every method in each field (summary.csv). Run inside results/charged_particle.
 load scripts."/common.gp"
 # Method specs hold commas: read the table with them written as ";" (scripts/csv_plain.awk).
-table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
+table = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." summary.csv"
 # boris has no style of its own in common.gp: a dark green line with filled circles here; the
 # tight CVODE BDF run shares cvode_bdf's grey, dashed.
 set style line 34 lw 2 lc rgb "#006d2c" pt 7 ps 1.1

@@ -6,6 +6,12 @@ set key noenhanced
 set termoption noenhanced
 set grid lw 0.5 lc rgb "#dddddd"
 
+# One shell word for a path in the commands of `system()` and `plot "< ..."`: the scripts folder
+# sits in the clone, whose path may hold spaces, parentheses or quotes ("'" becomes '\'').
+sh_quoted(s) = "'" . sh_escaped(s) . "'"
+sh_escaped(s) = sh_escaped_at(s, strstrt(s, "'"))
+sh_escaped_at(s, at) = at == 0 ? s : s[1:at - 1] . "'\\''" . sh_escaped(s[at + 1:])
+
 # One colour, marker and dash per method in every figure of every scene. A method is found by
 # the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
 # ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not

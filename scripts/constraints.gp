@@ -13,7 +13,7 @@ problem_title(run) = run eq "chain" ? "rod_chain:n=2 (double pendulum, chaotic)"
 
 # summary.csv -> curves/<group>_<curve>.dat: car axis (wall_s error_final) and penalty
 # (k constraint_err_max energy_err_max) per step size.
-system("rm -rf curves && mkdir -p curves && awk -f ".scripts."/csv.awk -f ".scripts."/constraints_curves.awk summary.csv")
+system("rm -rf curves && mkdir -p curves && awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/constraints_curves.awk")." summary.csv")
 
 do for [format in "png pdf svg"] {
   if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }

@@ -17,7 +17,7 @@ sph_ang = "del gauss_s_2 rk4"
 chain_cart = "rattle ida_index_3_rtol_1e-8_atol_1e-10"
 chain_joint = "del gauss_s_2 rk4 cvode_bdf_rtol_1e-10_atol_1e-12"
 
-system("rm -rf curves && mkdir -p curves && awk -f ".scripts."/csv.awk -f ".scripts."/coordinates_cost.awk summary.csv")
+system("rm -rf curves && mkdir -p curves && awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/coordinates_cost.awk")." summary.csv")
 
 # Initial energies, read before any log axis (they are negative).
 stats "series/spherical_cartesian/rattle.csv" using "energy" every ::0::0 nooutput; Es = STATS_min

@@ -14,7 +14,7 @@ H0 = 37.19625000000001
 # the awk filter turns each state row of the shapes series into polylines (the 9 longitudinal
 # node lines and the 9 cross-section outlines), one gnuplot data set per row.
 nx = 8; ny = 2; nz = 2; hx = 0.125; hy = 0.1; hz = 0.1
-bar_lines = sprintf("< awk -F, -v OFS=, -v nx=%d -v ny=%d -v nz=%d -v hx=%g -v hy=%g -v hz=%g -f %s/bar_lines.awk series/shapes/hp_alpha_0.5.csv 2>/dev/null", nx, ny, nz, hx, hy, hz, scripts)
+bar_lines = sprintf("< awk -F, -v OFS=, -v nx=%d -v ny=%d -v nz=%d -v hx=%g -v hy=%g -v hz=%g -f %s series/shapes/hp_alpha_0.5.csv 2>/dev/null", nx, ny, nz, hx, hy, hz, sh_quoted(scripts."/bar_lines.awk"))
 
 do for [format in "png pdf svg"] {
   if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }

@@ -7,7 +7,7 @@ load scripts."/common.gp"
 # pendulum:theta0=1,omega0=2pi: H0 = omega0^2 (1 - cos theta0); the energy oscillates with half
 # the period 1.0663 s, so an envelope window spans at least 0.54 s.
 H0 = (2 * pi)**2 * (1 - cos(1))
-envelope(file) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=0.54 -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", H0, scripts, file)
+envelope(file) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=0.54 -v min_count=5 -f %s %s 2>/dev/null", H0, sh_quoted(scripts."/envelope.awk"), file)
 clip(x) = x > 1e-17 ? x : 1e-17  # exact zeros drawn at 1e-17 on the log axes
 engines = "mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4"
 pendulum_methods = engines." del hp stormer_verlet rk4 implicit_euler"

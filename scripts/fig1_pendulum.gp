@@ -10,8 +10,8 @@ names = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b sto
 long_names = "explicit_euler implicit_euler symplectic_euler_a stormer_verlet rk4"
 # Long-run envelope: max |H - H0|/H0 per window (10 per decade, at least one pendulum period
 # 6.38 wide); the short run (every step to t = 50, same trajectory) supplies the early windows.
-envelope(m) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=6.4 -v min_count=5 -f %s/envelope.awk %s %s 2>/dev/null", \
-                      H0, scripts, (system("test -f ".short(m)." && echo 1") eq "1" ? short(m) : ""), long(m))
+envelope(m) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=6.4 -v min_count=5 -f %s %s %s 2>/dev/null", \
+                      H0, sh_quoted(scripts."/envelope.awk"), (system("test -f ".short(m)." && echo 1") eq "1" ? short(m) : ""), long(m))
 # The explicit Euler spiral is the widest curve of the phase portrait: the axes hold all of it.
 stats short("explicit_euler") using "q_0":"p_0" nooutput
 phase_extent = 1.05 * (abs(STATS_min_x) > STATS_max_x ? abs(STATS_min_x) : STATS_max_x)

@@ -4,7 +4,7 @@
 load scripts."/common.gp"
 file(l, m) = "series/".l."/".m.".csv"
 # Per-window maximum of |H - H0|/|H0| (scripts/envelope.awk); width = one orbital period.
-envelope_at(f, width, ref) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=%g -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", ref, width, scripts, f)
+envelope_at(f, width, ref) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=%g -v min_count=5 -f %s %s 2>/dev/null", ref, width, sh_quoted(scripts."/envelope.awk"), f)
 envelope(f, width) = envelope_at(f, width, H0)
 plain = "composition_scheme_kahan_li8"
 compensated = "composition_scheme_kahan_li8_compensated_true"

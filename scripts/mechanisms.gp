@@ -3,7 +3,7 @@
 # error against wall time. Run inside
 # results/mechanisms (scripts/reproduce.sh does); reads series/rod_*/ and summary.csv.
 load scripts."/common.gp"
-table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
+table = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." summary.csv"
 
 # L = 1, c = 1, F/EA = 1: the tip rises at speed 1 to 2 at t = 2 and falls back to 0 at t = 4.
 dalembert(t) = (phase = t - 4 * floor(t / 4), phase <= 2 ? phase : 4 - phase)

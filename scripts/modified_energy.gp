@@ -3,7 +3,7 @@
 # as the control. Run inside results/modified_energy; reads summary.csv.
 load scripts."/common.gp"
 # Method specs hold commas: read the table with them written as ";" (scripts/csv_plain.awk).
-table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
+table = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." summary.csv"
 methods = "stormer_verlet position_verlet implicit_midpoint rk4"
 # position_verlet has no style of its own in common.gp: a brown line with filled triangles here.
 set style line 34 lw 2 lc rgb "#8c6d31" pt 9 ps 1.3

@@ -3,13 +3,13 @@
 # order of each method in its key. Run inside results/order_high; reads order_points.csv, order.csv.
 load scripts."/common.gp"
 # Method specs hold commas: read the tables with them written as ";" (scripts/csv_plain.awk).
-plain(file) = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk ".file
+plain(file) = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." ".file
 points = plain("order_points.csv")
 orders = "2 4 6 8"
 # Methods of each panel, in the order of the tables (labels order2 ... order8 of scene.toml).
-methods_of(p) = system("awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk order.csv | " . \
+methods_of(p) = system("awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." order.csv | " . \
   "awk -F, '!/^#/ && $1 == \"order".p."\" { print $3 }' | tr '\\n' ' '")
-fitted(p, m) = system("awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk order.csv | " . \
+fitted(p, m) = system("awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." order.csv | " . \
   "awk -F, '!/^#/ && $1 == \"order".p."\" && $3 == \"".m."\" { print $4 }'")
 # A short name for the key: the scheme over its base, or the family and stage count.
 # (Stormer-Verlet as "verlet", as common.gp's titles write it.)

@@ -4,6 +4,9 @@
 # QUICK=1 runs the CI-sized variant into results/<scene>/quick/ instead; PLOTS=0 skips gnuplot;
 # SWEEP=0 only redraws the figures from the CSVs already there.
 set -euo pipefail
+# A gnuplot string constant of $1: single quotes, an embedded one doubled (the clone's path may hold
+# spaces, parentheses or quotes; the .gp scripts shell-quote it again for their awk commands).
+gnuplot_string() { local quote="'"; printf "'%s'" "${1//$quote/$quote$quote}"; }
 geomint=$(realpath "$1")
 shift
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -39,7 +42,7 @@ for scene in "$@"; do
         break
       fi
     done
-    (cd "$out" && gnuplot -e "scripts='$root/scripts'" -e "provenance='$provenance'" \
+    (cd "$out" && gnuplot -e "scripts=$(gnuplot_string "$root/scripts")" -e "provenance='$provenance'" \
       "$root/scripts/$scene.gp")
   fi
   echo "== $scene: $(( $(date +%s) - scene_start )) s" >&2

@@ -10,7 +10,7 @@ names = "Sun Jupiter Saturn Uranus Neptune Pluto"
 max(a, b) = a > b ? a : b
 # Initial energy and angular momentum: the first row of any run (all start from Table 2.1).
 first = file("h10", "stormer_verlet")
-envelope(f) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=4333 -v min_count=5 -f %s/envelope.awk %s 2>/dev/null", E0, scripts, f)
+envelope(f) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=4333 -v min_count=5 -f %s %s 2>/dev/null", E0, sh_quoted(scripts."/envelope.awk"), f)
 stats first using "energy" every ::0::0 nooutput; E0 = STATS_min
 stats first using "angular_momentum_0" every ::0::0 nooutput; L0x = STATS_min
 stats first using "angular_momentum_1" every ::0::0 nooutput; L0y = STATS_min

@@ -3,7 +3,7 @@
 # tolerances or steps. Run inside results/stiff_first_order; reads summary.csv through
 # scripts/stiff_first_order_curves.awk.
 load scripts."/common.gp"
-system("rm -rf curves && mkdir curves && awk -f ".scripts."/stiff_first_order_curves.awk summary.csv")
+system("rm -rf curves && mkdir curves && awk -f ".sh_quoted(scripts."/stiff_first_order_curves.awk")." summary.csv")
 set datafile separator whitespace
 set datafile nocolumnheaders
 titles = "vdpol rober"

@@ -3,7 +3,7 @@
 # each at equal cost on Kepler. Run inside results/structure; reads summary.csv.
 load scripts."/common.gp"
 # Method specs hold commas: read the table with them written as ";" (scripts/csv_plain.awk).
-table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
+table = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." summary.csv"
 
 # The three classes are not methods: the ordered palette (styles 41-48), one marker each. A row's
 # class is the suffix of its label (<problem>_symplectic, _nonsymplectic, _energy).

@@ -4,7 +4,7 @@
 # results/symplecticity; reads summary.csv.
 load scripts."/common.gp"
 # Method specs hold commas: read the table with them written as ";" (scripts/csv_plain.awk).
-table = "< awk -f ".scripts."/csv.awk -f ".scripts."/csv_plain.awk summary.csv"
+table = "< awk -f ".sh_quoted(scripts."/csv.awk")." -f ".sh_quoted(scripts."/csv_plain.awk")." summary.csv"
 
 # Rows, top to bottom: a method is the first prefix its spec starts with; "|" separates classes.
 free_keys = "stormer_verlet position_verlet symplectic_euler_a del: hp:alpha=0.5; hp:alpha=0.25; implicit_midpoint gauss: lobatto3ab: composition:base=stormer_verlet;scheme=yoshida4 composition:base=hp_midpoint;scheme=yoshida4 odeint_velocity_verlet | explicit_euler implicit_euler newmark:beta=0.25;gamma=0.6 newmark:beta=0.25;gamma=0.5 hht: rk4 | adaptive_verlet odeint_dopri5 gsl_rk8pd cvode_bdf cvode_adams"

@@ -10,7 +10,7 @@
 # work_precision_full); the data files under wp/ and time_to_error.md are written first by
 # scripts/work_precision_table.sh from summary.csv.
 load scripts."/common.gp"
-system("bash ".scripts."/work_precision_table.sh summary.csv")
+system("bash ".sh_quoted(scripts."/work_precision_table.sh")." summary.csv")
 set datafile separator whitespace
 set datafile nocolumnheaders
 groups = system("cat wp/groups")

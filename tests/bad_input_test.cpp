@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "harness/paths.hpp"
 #include "harness/table.hpp"
 #include "tests/test_util.hpp"
 
@@ -1847,19 +1848,20 @@ std::string binary() {
 // Run in the case's folder: a relative output path, and results/references/, are the case's
 // own, and a relative output that escapes the checks is caught as a stray file.
 std::string fmt_command(const Case& c, const fs::path& dir) {
-  return "cd " + dir.string() + " && " +
+  return "cd " + shell_quoted(dir.string()) + " && " +
          // timeout found on the suite's PATH: a case may set its own (one without sbatch).
          (c.environment.empty() ? "" : "env " + c.environment + " ") +
          "\"$(command -v timeout)\" -k 5 " + std::to_string(c.timeout_s) + " " +
-         fs::absolute(binary()).string() + " " + replace_all(c.arguments, "{dir}", dir.string()) +
-         " 2>&1";
+         shell_quoted(fs::absolute(binary()).string()) + " " +
+         replace_all(c.arguments, "{dir}", shell_quoted(dir.string())) + " 2>&1";
 }
 
 class BadInput : public testing::TestWithParam<Case> {};
 
 TEST_P(BadInput, ExitCodeMessageAndNoStrayFiles) {
   const Case& c = GetParam();
-  const fs::path base = fs::temp_directory_path() / "geomint_bad_input" / c.name;
+  // A space and parentheses in the folder, as in a clone's path: the command line quotes it.
+  const fs::path base = fs::temp_directory_path() / "geomint bad input (x)" / c.name;
   const fs::path dir = base / "work";
   fs::remove_all(base);
   fs::create_directories(dir);
@@ -1928,10 +1930,11 @@ TEST(BadInputReport, OutInAReadOnlyFolder) {
   } else {
     fs::permissions(dir / "locked", fs::perms::owner_write, fs::perm_options::remove);
   }
-  const std::string command = "cd " + dir.string() + " && " + as_user + "timeout -k 5 30 " +
-                              fs::absolute(binary()).string() + " report --results " +
-                              (dir / "r").string() + " --out " +
-                              (dir / "locked" / "site").string() + " 2>&1";
+  const std::string command = "cd " + shell_quoted(dir.string()) + " && " + as_user +
+                              "timeout -k 5 30 " + shell_quoted(fs::absolute(binary()).string()) +
+                              " report --results " + shell_quoted((dir / "r").string()) +
+                              " --out " + shell_quoted((dir / "locked" / "site").string()) +
+                              " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string output;

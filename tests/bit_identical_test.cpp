@@ -15,15 +15,18 @@
 #include <map>
 #include <sstream>
 
+#include "harness/paths.hpp"
+
 namespace geomint {
 namespace {
 
 namespace fs = std::filesystem;
 
+// `arguments` is shell text: a path in it is written as shell_quoted(path).
 int run_geomint(const std::string& arguments, std::string* output) {
   // Appended, not `std::string(...) + " " + ...`: gcc 12 warns falsely (-Warray-bounds) on the
   // inlined rvalue operator+ when <string> comes from the precompiled header.
-  std::string command = GEOMINT_BINARY;
+  std::string command = shell_quoted(GEOMINT_BINARY);
   command.append(" ").append(arguments).append(" 2>&1");
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return -1;
@@ -94,14 +97,16 @@ std::map<std::string, fs::path> outputs(const fs::path& folder) {
 fs::path sweep(const std::string& name, int jobs) {
   // Every copy sits in a folder named like the scene ("rerun"), so the `# scene:` provenance
   // line — the scene's folder name — is compared too, not excused.
-  const fs::path folder = fs::temp_directory_path() / "geomint_bit_identical_test" / name / "rerun";
+  // A space and parentheses above the scene folder, as in a clone's path: the command quotes it.
+  const fs::path folder = fs::temp_directory_path() / "geomint bit identical (x)" / name / "rerun";
   fs::remove_all(folder);
   fs::create_directories(folder);
   fs::copy_file(fs::path(GEOMINT_SOURCE_DIR) / "tests/scenes/rerun/scene.toml",
                 folder / "scene.toml");
   std::string output;
   const int code = run_geomint(
-      "sweep " + (folder / "scene.toml").string() + " --jobs " + std::to_string(jobs), &output);
+      "sweep " + shell_quoted((folder / "scene.toml").string()) + " --jobs " + std::to_string(jobs),
+      &output);
   EXPECT_EQ(code, 0) << output;
   return folder;
 }

@@ -20,6 +20,8 @@
 #include <tuple>
 #include <vector>
 
+#include "harness/paths.hpp"
+
 namespace geomint {
 namespace {
 
@@ -33,7 +35,7 @@ struct Captured {
 // Runs `geomint ARGUMENTS` with argv[0] = "geomint" (a symlink named geomint first on PATH).
 Captured run_as_geomint(const fs::path& folder, const std::string& arguments) {
   const std::string command =
-      "PATH='" + folder.string() + "':\"$PATH\" geomint " + arguments + " 2>/dev/null";
+      "PATH=" + shell_quoted(folder.string()) + ":\"$PATH\" geomint " + arguments + " 2>/dev/null";
   FILE* pipe = popen(command.c_str(), "r");
   Captured captured;
   std::array<char, 4096> buffer;
@@ -53,7 +55,8 @@ std::string read_text(const fs::path& path) {
 }
 
 TEST(CliHelp, EveryHelpTextEqualsItsGoldenFile) {
-  const fs::path folder = fs::temp_directory_path() / ("geomint_help_" + std::to_string(getpid()));
+  const fs::path folder =
+      fs::temp_directory_path() / ("geomint help (" + std::to_string(getpid()) + ")");
   fs::create_directories(folder);
   fs::remove(folder / "geomint");
   fs::create_symlink(GEOMINT_BINARY, folder / "geomint");
