@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "problems/shell_words.hpp"
+
 namespace geomint {
 
 // File-name-safe form of a spec ("hp:alpha=0.5" → "hp_alpha_0.5").
@@ -23,15 +25,6 @@ void check_output_dir(const std::string& path, const std::string& option);
 // absolute path after resolving `.`, `..` and symbolic links of the existing part.
 bool same_file_path(const std::string& a, const std::string& b);
 
-// A word bash and sbatch may leave bare: they give none of its characters a meaning, so plain
-// paths and arguments keep reading as they always did.
-bool plain_word(const std::string& text);
-// One bash word that is exactly `text` (single-quoted unless plain_word): a folder named
-// `x$(touch PWNED)` stays a name in every command line geomint writes for a shell.
-std::string shell_quoted(const std::string& text);
-// The words of a command line as bash splits it (blanks, '...', "...", backslash escapes; no
-// expansion): the inverse of joining shell_quoted words with spaces. Throws InputError on an
-// unterminated quote.
-std::vector<std::string> shell_words(const std::string& line);
+// plain_word, shell_quoted and shell_words: problems/shell_words.hpp (included above).
 
 }  // namespace geomint

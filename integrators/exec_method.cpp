@@ -13,6 +13,7 @@
 #include "integrators/exec_process.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/tangent.hpp"
+#include "problems/shell_words.hpp"
 
 namespace geomint {
 namespace {
@@ -213,7 +214,7 @@ class ExecMethod final : public Integrator {
   }
 
   void start() {
-    std::vector<std::string> argv = split_command(command_);
+    std::vector<std::string> argv = shell_words(command_);
     try {
       process_ = std::make_unique<ChildProcess>(argv);
       handshake_ = parse_handshake(process_->read_line(timeout_s_, "the handshake"), command_);
@@ -469,9 +470,10 @@ class ExecMethod final : public Integrator {
 }  // namespace
 
 std::unique_ptr<Integrator> make_exec(Params& params) {
-  const std::string command = params.text(
-      "cmd", "",
-      "the program and its arguments, split at blanks (no shell, no quoting, no commas)");
+  const std::string command =
+      params.text("cmd", "",
+                  "the program and its arguments, split at blanks as sh splits "
+                  "them ('a b' is one word; no shell, no commas)");
   const std::string format =
       params.choice("format", "json", {"json", "binary"},
                     "how numbers cross the pipe: JSON lines, or frames of native doubles");
@@ -488,7 +490,13 @@ std::unique_ptr<Integrator> make_exec(Params& params) {
     }
     return std::make_unique<ExecMethod>();
   }
-  if (split_command(command).empty()) {
+  std::vector<std::string> words;
+  try {
+    words = shell_words(command);
+  } catch (const InputError& error) {
+    throw InputError(fmt::format("method 'exec': cmd: {} ({})", error.what(), kHelp));
+  }
+  if (words.empty()) {
     throw InputError(
         fmt::format("method 'exec': cmd='{}' names no program (write exec:cmd=PROGRAM ARGS; {})",
                     command, kHelp));

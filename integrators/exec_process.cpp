@@ -53,21 +53,6 @@ ssize_t write_without_sigpipe(int fd, const char* data, size_t size) {
 
 }  // namespace
 
-std::vector<std::string> split_command(const std::string& command) {
-  std::vector<std::string> argv;
-  std::string word;
-  for (const char c : command) {
-    if (c == ' ' || c == '\t') {
-      if (!word.empty()) argv.push_back(std::move(word));
-      word.clear();
-    } else {
-      word += c;
-    }
-  }
-  if (!word.empty()) argv.push_back(std::move(word));
-  return argv;
-}
-
 std::string describe_wait_status(int status) {
   if (WIFEXITED(status)) return fmt::format("exited with status {}", WEXITSTATUS(status));
   if (WIFSIGNALED(status)) {

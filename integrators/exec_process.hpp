@@ -23,10 +23,6 @@ class PipeError : public std::runtime_error {
   std::string reason_;
 };
 
-// The argv of `command`: split at runs of blanks (spaces and tabs), no quoting, no shell; an empty
-// list for a blank command.
-std::vector<std::string> split_command(const std::string& command);
-
 // "exited with status 3", "killed by signal 9 (Killed)": a waitpid() status in words.
 std::string describe_wait_status(int status);
 

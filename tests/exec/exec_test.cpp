@@ -10,6 +10,7 @@
 
 #include "harness/run.hpp"
 #include "integrators/exec_process.hpp"
+#include "problems/shell_words.hpp"
 #include "tests/test_util.hpp"
 #include "verify/verify.hpp"
 
@@ -17,11 +18,12 @@ namespace geomint {
 namespace {
 
 const std::string kPythonVerlet =
-    "exec:cmd=/usr/bin/python3 " GEOMINT_SOURCE_DIR "/examples/exec/verlet.py";
-const std::string kCVerlet = "exec:cmd=" GEOMINT_EXEC_VERLET_C ",format=binary";
+    "exec:cmd=/usr/bin/python3 " + shell_quoted(GEOMINT_SOURCE_DIR "/examples/exec/verlet.py");
+const std::string kCVerlet = "exec:cmd=" + shell_quoted(GEOMINT_EXEC_VERLET_C) + ",format=binary";
 
 std::string misbehaving(const std::string& mode, const std::string& extra = ",timeout=2") {
-  return "exec:cmd=/usr/bin/python3 " GEOMINT_SOURCE_DIR "/tests/exec/misbehave.py " + mode + extra;
+  return "exec:cmd=/usr/bin/python3 " +
+         shell_quoted(GEOMINT_SOURCE_DIR "/tests/exec/misbehave.py") + " " + mode + extra;
 }
 
 RunConfig quiet(double dt, double t_end) {
@@ -191,7 +193,8 @@ TEST(Exec, BadSpecsAreInputErrorsNamingWhatIsAllowed) {
   using Fragments = std::vector<std::string>;
   EXPECT_TRUE(input_error_names(make_integrator, "exec:cmd=/no/such/program",
                                 Fragments{"cannot start '/no/such/program'", "No such file"}));
-  EXPECT_TRUE(input_error_names(make_integrator, "exec:cmd=" GEOMINT_SOURCE_DIR "/README.md",
+  EXPECT_TRUE(input_error_names(make_integrator,
+                                "exec:cmd=" + shell_quoted(GEOMINT_SOURCE_DIR "/README.md"),
                                 Fragments{"cannot start", "Permission denied"}));
   EXPECT_TRUE(input_error_names(make_integrator, kCVerlet + "x", Fragments{"format"}));
   EXPECT_TRUE(
@@ -212,9 +215,14 @@ TEST(Exec, BadSpecsAreInputErrorsNamingWhatIsAllowed) {
 }
 
 TEST(Exec, CommandsSplitAtBlanksWithoutAShell) {
-  EXPECT_EQ(split_command("  python3\t-u  my prog.py "),
+  EXPECT_EQ(shell_words("  python3\t-u  my prog.py "),
             (std::vector<std::string>{"python3", "-u", "my", "prog.py"}));
-  EXPECT_TRUE(split_command(" \t ").empty());
+  EXPECT_EQ(shell_words("python3 '/a b (x)/it'\\''s.py' -u"),
+            (std::vector<std::string>{"python3", "/a b (x)/it's.py", "-u"}));
+  EXPECT_TRUE(shell_words(" \t ").empty());
+  // cmd= is split as sh splits it, so an unterminated quote is an input error that says so.
+  EXPECT_TRUE(test::input_error_names(make_integrator, "exec:cmd=python3 'unterminated",
+                                      std::vector<std::string>{"unterminated"}));
   EXPECT_EQ(describe_wait_status(3 << 8), "exited with status 3");
 }
 
