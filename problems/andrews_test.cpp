@@ -3,6 +3,7 @@
 // accelerations and multipliers, and the parameter checks.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
 
