@@ -159,6 +159,24 @@ TEST(MujocoFailures, AnUnstableStepEndsTheRunWithMujocosWarning) {
   EXPECT_NE(status.message.find("MuJoCo warning"), std::string::npos) << status.message;
 }
 
+// MuJoCo 2.2.2 loads a chain of kMaxMujocoChainLinks links and no longer one (its XML parser's
+// nesting limit): the longer chain is refused with the measured limit, not a parser error.
+TEST(MujocoChainLength, LoadsTheStatedLimitAndRefusesLongerChainsNamingIt) {
+  PlanarChain chain;
+  chain.mass.assign(kMaxMujocoChainLinks, 1.0);
+  chain.length.assign(kMaxMujocoChainLinks, 1.0);
+  EXPECT_NO_THROW(MujocoChain(chain, MujocoOptions{}));
+  chain.mass.push_back(1.0);
+  chain.length.push_back(1.0);
+  try {
+    MujocoChain refused(chain, MujocoOptions{});
+    ADD_FAILURE() << "a chain of " << chain.links() << " links loaded";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("allowed: 1 to 96 links"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(MujocoApplicability, RefusesOtherProblemsNamingThoseThatApply) {
   const auto method = make_integrator("mujoco");
   for (const std::string spec : {"harmonic", "kepler", "rod_chain"}) {

@@ -23,9 +23,15 @@ struct MujocoOptions {
 // The integrators MuJoCo 2.2.2 offers (mjtIntegrator in mujoco/mjmodel.h), in its order.
 const std::vector<std::string>& mujoco_integrators();
 
+// The longest chain MuJoCo 2.2.2 loads, measured: each link's <body> nests in its parent's, and
+// its MJCF parser (tinyxml2) refuses an XML document nested deeper than 100 elements
+// (XML_ELEMENT_DEPTH_EXCEEDED). The limit is MuJoCo's, not geomint's.
+inline constexpr int kMaxMujocoChainLinks = 96;
+
 class MujocoChain {
  public:
-  // Throws InputError when MuJoCo refuses the model (its message).
+  // Throws InputError when the chain is longer than kMaxMujocoChainLinks (saying why) or MuJoCo
+  // refuses the model (its message).
   MujocoChain(const PlanarChain& chain, const MujocoOptions& options);
   ~MujocoChain();
   MujocoChain(const MujocoChain&) = delete;

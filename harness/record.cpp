@@ -85,6 +85,7 @@ std::vector<RecordColumn> build_schema() {
   schema.push_back(real("wall_s_min", &RunRecord::wall_s_min));
   schema.push_back(real("wall_s_iqr", &RunRecord::wall_s_iqr));
   schema.push_back(integer("wall_s_repeats", &RunRecord::wall_s_repeats));
+  schema.push_back(real("recursive_passes_per_step", &RunRecord::recursive_passes_per_step));
   schema.push_back(integer("order_level", &RunRecord::order_level));
   schema.push_back(text("reference", &RunRecord::reference));
   return schema;

@@ -34,6 +34,8 @@ struct RunRecord {
   // interquartile range, wall_s_repeats their count (fewer than asked: the budget cut them).
   std::optional<double> wall_s, wall_s_min, wall_s_iqr;
   std::optional<long> wall_s_repeats;
+  // Recursive passes per step of the timing pass's warm-up run (tree problems only).
+  std::optional<double> recursive_passes_per_step;
   std::optional<std::string> reference;  // file name of the reference solution used
 };
 

@@ -20,6 +20,7 @@
 #include "harness/run_spec.hpp"
 #include "harness/structure_metrics.hpp"
 #include "integrators/general_step.hpp"
+#include "problems/articulated.hpp"
 #include "problems/lagrangian.hpp"
 #include "problems/mass_operator.hpp"
 
@@ -391,8 +392,11 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
   const bool adaptive = spec.method.adaptive();
   const int wanted = std::max(1, repeats);
   const auto pass_start = Clock::now();
-  // One run from a fresh integrator; its wall time, or nullopt with the failed status.
+  // One run from a fresh integrator; its wall time, or nullopt with the failed status. It also
+  // counts the recursive passes of its steps (this thread's, so parallel runs do not add theirs)
+  // and the steps themselves.
   StepStatus failed = StepStatus::success();
+  long run_passes = 0, run_steps = 0;
   const auto one_run = [&]() -> std::optional<double> {
     if (interrupt_requested()) {
       failed = interrupted_at(problem->initial_state().t);
@@ -402,9 +406,12 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
     State state = problem->initial_state();
     const auto start = Clock::now();
     integrator->reset(*problem, state, config.dt);
+    const long passes_before = articulated::thread_passes();
     LoopOutcome outcome = integrate(
         *problem, *integrator, state, config, adaptive, false,
         [](const State&) { return StepStatus::success(); }, [](const State&, bool) {});
+    run_passes = articulated::thread_passes() - passes_before;
+    run_steps = outcome.steps;
     if (!outcome.status.ok) {
       failed = std::move(outcome.status);
       return std::nullopt;
@@ -438,6 +445,14 @@ TimingOutcome time_run(const RunSpec& spec, int repeats) {
     return {std::move(failed), {}, 0, {}};
   }
   if (over_budget(*warm_up)) return timed_out({*warm_up});
+  // Problems on tree recursions (the joint chains) count their passes: a cost per step that no
+  // machine changes. Any other problem runs none.
+  const LagrangianSystem* lagrangian = problem->as_lagrangian();
+  if (lagrangian != nullptr && run_steps > 0 &&
+      dynamic_cast<const articulated::PlanarTreeLagrangian*>(lagrangian) != nullptr) {
+    outcome.recursive_passes_per_step =
+        static_cast<double>(run_passes) / static_cast<double>(run_steps);
+  }
   std::vector<double> seconds;
   // A repeat starts only when one more run of the longest duration seen so far still ends
   // inside the budget. A warm-up that alone leaves no room is the pass's only sample.
@@ -486,6 +501,7 @@ void record_timing(const TimingOutcome& timing, RunRecord& record) {
   record.wall_s_min = timing.stats.min;
   record.wall_s_iqr = timing.stats.iqr;
   record.wall_s_repeats = timing.stats.count;
+  record.recursive_passes_per_step = timing.recursive_passes_per_step;
   if (!timing.budget_note.empty()) record.message = timing.budget_note;
 }
 

@@ -121,6 +121,10 @@ struct [[nodiscard]] TimingOutcome {
   // A timed run took longer than config.wall_budget_s: the row becomes status `timeout` with
   // wall_s = that run's seconds (stats hold the runs timed up to and including it).
   bool timed_out = false;
+  // The recursive passes per step of the warm-up run's steps (integrator reset excluded) on a
+  // problem whose mechanics are O(n) tree recursions (problems/articulated.hpp): a
+  // machine-independent cost; nullopt on every other problem.
+  std::optional<double> recursive_passes_per_step;
   // "timing pass failed: reason: message", the row's message when the status failed.
   std::string failure_message() const;
 };
@@ -129,8 +133,8 @@ TimingOutcome time_run(const RunSpec& spec, int repeats);
 TimingOutcome time_run(const std::string& problem_spec, const std::string& method_spec,
                        const RunConfig& config, int repeats);
 // Writes a successful outcome's statistics into the record (wall_s = median, wall_s_min,
-// wall_s_iqr, wall_s_repeats) and a budget note as its message; a failed one's message; a
-// timed-out one also sets status `timeout`.
+// wall_s_iqr, wall_s_repeats, recursive_passes_per_step) and a budget note as its message; a failed
+// one's message; a timed-out one also sets status `timeout`.
 void record_timing(const TimingOutcome& timing, RunRecord& record);
 
 // Checks dt, t_end (t_end/dt <= kMaxFixedSteps for fixed-step methods), --every,

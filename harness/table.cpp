@@ -158,7 +158,7 @@ const std::vector<std::string>& standard_columns() {
     for (const char* name :
          {"order", "declared_order", "points_used", "force_evals", "energy_evals", "hessian_evals",
           "newton_iters", "linear_solves", "factorizations", "rejected", "wall_s", "wall_s_min",
-          "wall_s_iqr", "wall_s_repeats"}) {
+          "wall_s_iqr", "wall_s_repeats", "recursive_passes_per_step"}) {
       out.emplace_back(name);
     }
     return out;

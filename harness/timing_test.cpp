@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
+#include "harness/record.hpp"
 #include "harness/run.hpp"
+#include "harness/run_spec.hpp"
 
 namespace geomint {
 namespace {
@@ -81,6 +84,28 @@ TEST(TimingPass, RecordsEveryRepeatOrSaysTheBudgetCutThem) {
 // The interrupt flag (the Python package's Ctrl-C): a metric pass ends at its first step point
 // with status `interrupted`, fixed-step and adaptive alike, a timing pass before any run; once
 // cleared, the same run goes through.
+// The recursive passes per step of a joint chain's steps: RK4 on the articulated-body recursions
+// takes 4 stages of a mass solve (2 passes) and dT/dtheta (2 passes) at every n, and the count
+// is of this run alone while another thread steps the same problem. Problems without tree
+// recursions have no such column.
+TEST(TimingPass, CountsTheRecursivePassesPerStepOfTreeProblems) {
+  RunConfig config;
+  config.dt = 0.01;
+  config.t_end = 0.2;
+  for (const char* spec : {"articulated_chain:n=8", "rod_chain:coordinates=joint,n=64"}) {
+    const RunSpec run = RunSpec::parse(spec, "rk4", config);
+    std::thread other([&] { (void)time_run(run, 3); });
+    const TimingOutcome timing = time_run(run, 1);
+    other.join();
+    ASSERT_TRUE(timing.recursive_passes_per_step.has_value()) << spec;
+    EXPECT_EQ(*timing.recursive_passes_per_step, 16.0) << spec;
+    RunRecord record;
+    record_timing(timing, record);
+    EXPECT_EQ(to_row(record).at("recursive_passes_per_step"), "16") << spec;
+  }
+  EXPECT_FALSE(time_run("harmonic", "rk4", config, 1).recursive_passes_per_step.has_value());
+}
+
 TEST(Interrupt, EndsRunsAtTheNextStepPointUntilCleared) {
   RunConfig config;
   config.dt = 0.01;

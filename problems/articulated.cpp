@@ -16,6 +16,8 @@ namespace geomint {
 namespace articulated {
 namespace {
 
+thread_local long passes_on_this_thread = 0;
+
 // Every 2-vector is stored in its link's frame: components along e′_a = (cos θ_a, sin θ_a) (across
 // the link) and e_a = (sin θ_a, −cos θ_a) (along it). Frames differ by the joint's relative angle
 // δ = θ_a − θ_parent, so a straight chain (δ = 0) rotates exactly and its ∂T/∂θ is exactly 0.
@@ -29,6 +31,13 @@ Eigen::Matrix2d to_child(double delta) {
 const Eigen::Vector2d kAcross(1, 0);  // e′_a in its own frame
 
 }  // namespace
+
+long thread_passes() { return passes_on_this_thread; }
+
+void PlanarTreeDynamics::count(long passes) const {
+  passes_.fetch_add(passes, std::memory_order_relaxed);
+  passes_on_this_thread += passes;
+}
 
 PlanarTreeDynamics::PlanarTreeDynamics(PlanarTree tree) : tree_(std::move(tree)) {
   const int n = size();

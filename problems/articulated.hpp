@@ -73,7 +73,7 @@ class PlanarTreeDynamics {
  private:
   // V_i, and the momentum m_a c_a V_a + l_a S_a that both T-members read (2 passes).
   void link_momenta(const Vec& theta, const Vec& u, Eigen::Matrix2Xd& lever) const;
-  void count(long passes) const { passes_.fetch_add(passes, std::memory_order_relaxed); }
+  void count(long passes) const;
 
   PlanarTree tree_;
   // C_ab between b and its strict ancestor a, visiting each related pair (a, b) once.
@@ -85,6 +85,11 @@ class PlanarTreeDynamics {
   Vec moment_;  // m_b c_b + l_b W_b (C_ab = l_a moment_b)
   mutable std::atomic<long> passes_{0};
 };
+
+// Every recursive pass this thread has run on any tree, a total that only grows. The timing pass
+// reads it around a run (harness/run.cpp, column recursive_passes_per_step): a per-thread count
+// is not disturbed by a parallel run on the same shared problem, as passes() is.
+long thread_passes();
 
 // The general-Lagrangian face of a PlanarTree for a Problem (the problem derives from both):
 // every member the explicit methods reach (apply_mass, solve_mass, kinetic_gradient, gradient,
