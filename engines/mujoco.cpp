@@ -145,8 +145,8 @@ MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
   if (chain.links() > kMaxMujocoChainLinks) {
     throw InputError(fmt::format(
         "mujoco: a chain of {} links is too long for MuJoCo 2.2.2; allowed: 1 to {} links "
-        "(measured: each link's body nests in its parent's, and MuJoCo's XML parser refuses "
-        "nesting deeper than 100 elements, XML_ELEMENT_DEPTH_EXCEEDED)",
+        "(measured: each link's body nests in its parent's, and MuJoCo's XML parser refuses a "
+        "document 100 elements deep, XML_ELEMENT_DEPTH_EXCEEDED)",
         chain.links(), kMaxMujocoChainLinks));
   }
   model_ = load_model(xml_, fmt::format("{} links", chain.links()));

@@ -24,8 +24,8 @@ struct MujocoOptions {
 const std::vector<std::string>& mujoco_integrators();
 
 // The longest chain MuJoCo 2.2.2 loads, measured: each link's <body> nests in its parent's, and
-// its MJCF parser (tinyxml2) refuses an XML document nested deeper than 100 elements
-// (XML_ELEMENT_DEPTH_EXCEEDED). The limit is MuJoCo's, not geomint's.
+// its MJCF parser (tinyxml2) refuses an XML document 100 elements deep (XML_ELEMENT_DEPTH_EXCEEDED;
+// 96 links nest 99 deep: <mujoco>, <worldbody>, the bodies, a joint). MuJoCo's limit, not ours.
 inline constexpr int kMaxMujocoChainLinks = 96;
 
 class MujocoChain {
