@@ -80,6 +80,47 @@ std::string chain_xml(const PlanarChain& chain, const MujocoOptions& options) {
   return xml;
 }
 
+// The same chain as URDF (links and joints side by side, no nesting): what MJCF's header and joint
+// attributes say is set on the compiled model instead (apply_chain_options). Continuous joints
+// have no limits; clean joints get zero damping and friction, as the MJCF ones do.
+std::string chain_urdf(const PlanarChain& chain, const MujocoOptions& options) {
+  std::string urdf =
+      "<robot name=\"geomint_chain\">\n"
+      "  <mujoco><compiler fusestatic=\"false\" balanceinertia=\"false\"/></mujoco>\n"
+      "  <link name=\"pivot\"/>\n";
+  const std::string dynamics =
+      options.shipped_defaults ? "" : R"(<dynamics damping="0" friction="0"/>)";
+  for (int i = 0; i < chain.links(); ++i) {
+    const double l = chain.length[i];
+    const double inertia = point_mass_inertia(chain.mass[i], l);
+    const double offset = i == 0 ? 0.0 : chain.length[i - 1];
+    const std::string parent = i == 0 ? "pivot" : fmt::format("link{}", i - 1);
+    urdf += fmt::format(
+        "  <link name=\"link{0}\"><inertial><origin xyz=\"0 0 {1:.17g}\"/><mass "
+        "value=\"{2:.17g}\"/><inertia ixx=\"{3:.17g}\" iyy=\"{3:.17g}\" izz=\"{3:.17g}\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n"
+        "  <joint name=\"joint{0}\" type=\"continuous\"><parent link=\"{4}\"/><child "
+        "link=\"link{0}\"/><origin xyz=\"0 0 {5:.17g}\"/><axis xyz=\"0 -1 0\"/>{6}</joint>\n",
+        i, -l, chain.mass[i], inertia, parent, -offset, dynamics);
+  }
+  return urdf + "</robot>\n";
+}
+
+// What model_header writes into an MJCF model, on a model compiled from URDF: the integrator,
+// gravity along −z, energies on and, clean, contact, constraints and passive forces off.
+void apply_chain_options(mjModel* model, double gravity, const MujocoOptions& options) {
+  model->opt.integrator = options.integrator == "rk4"        ? mjINT_RK4
+                          : options.integrator == "implicit" ? mjINT_IMPLICIT
+                                                             : mjINT_EULER;
+  model->opt.gravity[0] = 0;
+  model->opt.gravity[1] = 0;
+  model->opt.gravity[2] = -gravity;
+  model->opt.enableflags |= mjENBL_ENERGY;
+  if (!options.shipped_defaults) {
+    model->opt.disableflags |= mjDSBL_CONTACT | mjDSBL_CONSTRAINT | mjDSBL_PASSIVE;
+  }
+}
+
 // One body at the origin on a ball joint (a free joint for the free body), its centre of mass at
 // the principal centre, the principal moments on the body's own axes.
 std::string rotor_xml(const Rotor& rotor, const MujocoOptions& options) {
@@ -97,12 +138,12 @@ std::string rotor_xml(const Rotor& rotor, const MujocoOptions& options) {
 
 // Compiles `xml` from memory (a virtual file system holding the one MJCF file); the warning hook
 // is installed once (it is one global of the library, and sweeps build models on several threads).
-mjModel* load_model(const std::string& xml, const std::string& what) {
+mjModel* load_model(const std::string& xml, const std::string& what,
+                    const char* file_name = "geomint_model.xml") {
   static std::once_flag hook_installed;
   std::call_once(hook_installed, [] { mju_user_warning = &record_mujoco_warning; });
   auto vfs = std::make_unique<mjVFS>();  // mjVFS is large: on the heap
   mj_defaultVFS(vfs.get());
-  const char* file_name = "geomint_model.xml";
   if (mj_makeEmptyFileVFS(vfs.get(), file_name, static_cast<int>(xml.size())) != 0) {
     throw InputError("mujoco: cannot create the model file in MuJoCo's virtual file system");
   }
@@ -140,16 +181,16 @@ const std::vector<std::string>& mujoco_integrators() {
   return names;
 }
 
-MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
-    : xml_(chain.links() <= kMaxMujocoChainLinks ? chain_xml(chain, options) : std::string()) {
-  if (chain.links() > kMaxMujocoChainLinks) {
-    throw InputError(fmt::format(
-        "mujoco: a chain of {} links is too long for MuJoCo 2.2.2; allowed: 1 to {} links "
-        "(measured: each link's body nests in its parent's, and MuJoCo's XML parser refuses a "
-        "document 100 elements deep, XML_ELEMENT_DEPTH_EXCEEDED)",
-        chain.links(), kMaxMujocoChainLinks));
+MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options) {
+  const std::string what = fmt::format("{} links", chain.links());
+  if (chain.links() <= kMaxMjcfChainLinks) {
+    xml_ = chain_xml(chain, options);
+    model_ = load_model(xml_, what);
+  } else {
+    xml_ = chain_urdf(chain, options);
+    model_ = load_model(xml_, what, "geomint_model.urdf");
+    apply_chain_options(model_, chain.gravity, options);
   }
-  model_ = load_model(xml_, fmt::format("{} links", chain.links()));
   data_ = mj_makeData(model_);
 }
 

@@ -23,15 +23,17 @@ struct MujocoOptions {
 // The integrators MuJoCo 2.2.2 offers (mjtIntegrator in mujoco/mjmodel.h), in its order.
 const std::vector<std::string>& mujoco_integrators();
 
-// The longest chain MuJoCo 2.2.2 loads, measured: each link's <body> nests in its parent's, and
-// its MJCF parser (tinyxml2) refuses an XML document 100 elements deep (XML_ELEMENT_DEPTH_EXCEEDED;
-// 96 links nest 99 deep: <mujoco>, <worldbody>, the bodies, a joint). MuJoCo's limit, not ours.
-inline constexpr int kMaxMujocoChainLinks = 96;
+// The longest chain MuJoCo 2.2.2 loads from MJCF, measured: each link's <body> nests in its
+// parent's, and its XML parser (tinyxml2) refuses a document 100 elements deep
+// (XML_ELEMENT_DEPTH_EXCEEDED; 96 links nest 99 deep: <mujoco>, <worldbody>, the bodies, a joint).
+// A longer chain is written as URDF, whose links and joints are siblings: MuJoCo's URDF import
+// builds the same body tree (MujocoChainLength and MujocoFidelity tests).
+inline constexpr int kMaxMjcfChainLinks = 96;
 
 class MujocoChain {
  public:
-  // Throws InputError when the chain is longer than kMaxMujocoChainLinks (saying why) or MuJoCo
-  // refuses the model (its message).
+  // MJCF up to kMaxMjcfChainLinks links, URDF beyond. Throws InputError when MuJoCo refuses the
+  // model (its message).
   MujocoChain(const PlanarChain& chain, const MujocoOptions& options);
   ~MujocoChain();
   MujocoChain(const MujocoChain&) = delete;
@@ -48,6 +50,7 @@ class MujocoChain {
   // One mj_step of length h; a warning MuJoCo raises in it (bad qacc, qpos, qvel: its
   // instability detector, which would also reset the state) is a failed status naming it.
   StepStatus step(double h);
+  // The model text MuJoCo compiled: MJCF (<mujoco ...>) or, for a long chain, URDF (<robot ...>).
   const std::string& xml() const { return xml_; }
 
  private:
