@@ -124,7 +124,7 @@ struct [[nodiscard]] TimingOutcome {
   // The recursive passes per step of the warm-up run's steps (integrator reset excluded) on a
   // problem whose mechanics are O(n) tree recursions (problems/articulated.hpp): a
   // machine-independent cost; nullopt on every other problem.
-  std::optional<double> recursive_passes_per_step;
+  std::optional<double> recursive_passes_per_step = std::nullopt;
   // "timing pass failed: reason: message", the row's message when the status failed.
   std::string failure_message() const;
 };
