@@ -110,6 +110,9 @@ GEOMINT_STEP(hp_cg_ichol_modified, "hp:alpha=0.5,linear_solver=cg_ichol,modified
              2);
 GEOMINT_STEP(hp_cg_amg_modified, "hp:alpha=0.5,linear_solver=cg_amg,modified_newton=true", 1, 2);
 GEOMINT_STEP(hp_auto, "hp:alpha=0.5", 0, 2);
+// The DEL midpoint rule (root-finding Newton with the merit line search), for the DEL step's own
+// same-run comparisons (docs/PERF.md "One step per method").
+GEOMINT_STEP(del_auto, "del", 0, 2);
 // Paper claim 5 at scale: minimiser, Newton on the momentum residual and implicit Euler with the
 // same linear solver and the same stopping rule (tol 1e-12 relative, every method's default).
 GEOMINT_STEP(hp_newton_cg_amg, "hp:alpha=0.5,solver=newton,linear_solver=cg_amg", 1, 3);
