@@ -17,6 +17,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
 
@@ -48,6 +49,16 @@ namespace {
 // iteration for a force linear in v), without the Hessian. Constraints (rule=midpoint only,
 // docs/METHOD.md §3): p_k = −D₁L_d − G(q_k)ᵀΛ with g(q_{k+1}) = 0, by
 // integrators/constrained_step.hpp, then p_{k+1} projected onto the tangent space.
+//
+// The general kind L = ½vᵀM(q)v + a(q)ᵀv − V(q) (docs/MECHANICS_GENERAL.md §2) runs the same step
+// for the one-node rules (α = a₁ ∈ (0, 1), L_d = h L(q̄, v) with q̄ = q_k + αhv): with ∇V(q^j)
+// read as g_j = −L_q(q^j, v) and Mv as L_v(q̄, v) the equation for v is
+//   R(v) = L_v(q̄, v) − p_k + h(1−α)g(v) − F_d⁻ = 0,
+//   ∂R/∂v = M(q̄) + hα L_vq − h(1−α) L_qv − h²α(1−α) L_qq   (GeneralVelocityJacobian; not
+//   symmetric, so SparseLU), started at v(q_k, p_k) = M(q_k)⁻¹(p_k − a(q_k)),
+// and p_{k+1} = p_k − h g + F_d⁻ + F_d⁺ (= L_v(q̄, v) − hαg + F_d⁺ at R = 0), which keeps the
+// momentum of a cyclic coordinate (L_q ≡ 0: polar Kepler's p_φ) exact whatever residual the solve
+// left.
 struct Node {
   double a;  // position along the step, in [0, 1]
   double w;  // weight, Σ w = 1
@@ -103,16 +114,19 @@ class DiscreteLagrangianVI final : public Integrator {
     damping_symmetric_.reset();
   }
 
+  // The one step of both kinds (integrators/step_implementation.hpp): they differ only in what
+  // the view gives at the nodes — Mv through the mass operator, ∇V and its Hessian on the
+  // separable kind; L_v, −L_q and the GeneralVelocityJacobian blocks of the problem's
+  // LagrangianSystem on the general one (one interior node there, info()).
   StepStatus step(const Problem& problem, State& state, double h) override {
+    mark_step_implementation();
     constraint_impulses_.reset();
-    if (problem.kind() == ProblemKind::kLagrangian) {
-      return general_del_step(*problem.as_lagrangian(), state, h, nodes_.front().a,
-                              {newton_.options().tolerance, newton_.options().max_iterations},
-                              counters_);
-    }
-    const Vec& mass = MassOperator(problem).constant_diagonal();
-    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
-    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
+    const MassOperator mass_operator(problem);
+    general_ = problem.as_lagrangian();
+    // The constant diagonal M on the separable kind (its products below are those of the
+    // separable step before the kinds shared it, bit for bit); unused on the general kind.
+    const Vec* diagonal = general_ != nullptr ? nullptr : &mass_operator.constant_diagonal();
+    if (general_ == nullptr) update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
     const bool forced = problem.has(kForce);
     const double minus = forced ? forcing_.minus_weight() : 0.0;
     const double plus = forced ? forcing_.plus_weight() : 0.0;
@@ -128,10 +142,13 @@ class DiscreteLagrangianVI final : public Integrator {
       constant_ += (h * start_weight_) * gradient_start_;
     }
 
-    Vec v = inverse_mass.cwiseProduct(state.p);
+    // v₀ = v(q_k, p_k): M⁻¹p_k, or M(q_k)⁻¹(p_k − a(q_k)) on the general kind.
+    Vec v = general_ != nullptr ? general_->velocity(state.q, state.p)
+                                : mass_operator.solve(state.q, state.p);
     if (interior_.empty() && minus == 0.0) {
-      // Explicit rule and no implicit impulse: M v = p_k − h Σ_{a_j=0} w_j ∇V(q_k).
-      v = -inverse_mass.cwiseProduct(constant_);
+      // Explicit rule and no implicit impulse: M v = p_k − h Σ_{a_j=0} w_j ∇V(q_k) (separable
+      // kind only: info() declares no general kind for rules without an interior node).
+      v = -mass_operator.constant_inverse_diagonal().cwiseProduct(constant_);
     } else {
       // Start from v₀ = M⁻¹p_k: the residual's linear momentum Σ(Mv − p_k) is then zero and the
       // Newton updates (whose matrix has the translations in the kernel of its ∇²V and C parts)
@@ -144,9 +161,24 @@ class DiscreteLagrangianVI final : public Integrator {
       system.inner_term_scale = [&] { return inner_scale; };
       system.residual = [&](const Vec& x, Vec& residual) {
         implicit_terms(problem, x);
-        residual = mass.cwiseProduct(x) + constant_ + implicit_term_;
+        if (general_ != nullptr) {
+          residual = general_->momentum(q0_ + (interior_.front().a * h) * x, x) + constant_ +
+                     implicit_term_;
+        } else {
+          residual = diagonal->cwiseProduct(x) + constant_ + implicit_term_;
+        }
       };
       system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
+        if (general_ != nullptr) {
+          const double alpha = interior_.front().a;  // the one node, weight 1
+          inner_scale =
+              general_jacobian_.assemble(*general_, q0_ + (alpha * h) * x, x, h, alpha, jacobian);
+          if (minus > 0.0) {
+            add_minus_impulse_jacobian(problem, forcing_, impulse_step(), x, jacobian, damping_,
+                                       counters_);
+          }
+          return;
+        }
         jacobian = mass_matrix_;
         inner_scale = 0.0;
         for (const Node& node : interior_) {
@@ -160,32 +192,23 @@ class DiscreteLagrangianVI final : public Integrator {
                                      counters_);
         }
       };
-      system.symmetric = minus == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_);
+      // The general kind's matrix has the non-symmetric part hα L_vq − h(1−α) L_qv.
+      system.symmetric = general_ == nullptr &&
+                         (minus == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_));
 
       implicit_terms(problem, v);
       // The sizes of the terms the residual balances, at the start iterate.
       const double residual_scale =
           robust_norm(state.p) + robust_norm(constant_ + state.p) + robust_norm(implicit_term_);
-      if (problem.has(kConstraints)) {
-        // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
-        const ConstrainedStepResult constrained = solve_constrained_step(
-            problem, q0_, t0_, h, system, newton_.options(), residual_scale, v);
-        count_solve(constrained.newton);
-        if (!constrained.newton.converged) {
-          return StepStatus::failure(constrained.newton.reason, describe(constrained));
-        }
-        constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h};
-      } else {
-        const NewtonResult result = newton_.solve(system, v, residual_scale);
-        count_solve(result);
-        if (!result.converged) return StepStatus::failure(result.reason, describe(result));
-      }
+      const StepStatus solved = solve_velocity_equation(problem, system, residual_scale, v);
+      if (!solved.ok) return solved;
       implicit_terms(problem, v);  // no-op unless the last evaluation was elsewhere
     }
 
-    // p_{k+1} = D₂L_d + F_d⁺ = M v − h Σ_j w_j a_j ∇V(q^j) + F_d⁺.
+    // p_{k+1} = D₂L_d + F_d⁺ = M v − h Σ_j w_j a_j ∇V(q^j) + F_d⁺; on the general kind
+    // L_v(q̄, v) = p_k + F_d⁻ − h(1−α)g is read from the equation (the comment above Node).
     const Vec q1 = state.q + h * v;
-    Vec p1 = mass.cwiseProduct(v);
+    Vec p1 = general_ != nullptr ? Vec(state.p - implicit_term_) : Vec(diagonal->cwiseProduct(v));
     for (size_t j = 0; j < interior_.size(); ++j) {
       p1 -= (h * interior_[j].w * interior_[j].a) * interior_gradients_[j];
     }
@@ -225,6 +248,27 @@ class DiscreteLagrangianVI final : public Integrator {
   }
 
  private:
+  // Solves the step's velocity equation R(v) = 0 (`system`, from the start v): the one place
+  // where how it is solved is chosen — NewtonSolver, in the constrained KKT form with G(q_k)ᵀΛ
+  // and g(q_k + hv) = 0 when the problem has constraints (docs/METHOD.md §3).
+  StepStatus solve_velocity_equation(const Problem& problem, const NewtonSystem& system,
+                                     double residual_scale, Vec& v) {
+    if (problem.has(kConstraints)) {
+      const ConstrainedStepResult constrained = solve_constrained_step(
+          problem, q0_, t0_, h_, system, newton_.options(), residual_scale, v);
+      count_solve(constrained.newton);
+      if (!constrained.newton.converged) {
+        return StepStatus::failure(constrained.newton.reason, describe(constrained));
+      }
+      constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h_};
+      return StepStatus::success();
+    }
+    const NewtonResult result = newton_.solve(system, v, residual_scale);
+    count_solve(result);
+    if (!result.converged) return StepStatus::failure(result.reason, describe(result));
+    return StepStatus::success();
+  }
+
   void count_solve(const NewtonResult& result) {
     counters_.newton_iters += result.iterations;
     counters_.linear_solves += result.linear_solves;
@@ -241,8 +285,9 @@ class DiscreteLagrangianVI final : public Integrator {
     }
   }
 
-  // implicit_term_ = h Σ_interior w_j (1 − a_j) ∇V(q^j(v)) − F_d⁻(v), memoised on v so that the
-  // gradients of the accepted iterate are reused for p_{k+1}.
+  // implicit_term_ = h Σ_interior w_j (1 − a_j) g_j(v) − F_d⁻(v) with g_j = ∇V(q^j(v)), or
+  // −L_q(q^j(v), v) on the general kind, memoised on v so that the gradients of the accepted
+  // iterate are reused for p_{k+1}.
   void implicit_terms(const Problem& problem, const Vec& v) {
     if (memo_valid_ && memo_v_.size() == v.size() && memo_v_ == v && memo_q_ == q0_ &&
         memo_h_ == h_ && memo_problem_ == &problem) {
@@ -251,7 +296,14 @@ class DiscreteLagrangianVI final : public Integrator {
     interior_gradients_.resize(interior_.size());
     implicit_term_.setZero(v.size());
     for (size_t j = 0; j < interior_.size(); ++j) {
-      eval_gradient(problem, q0_ + (interior_[j].a * h_) * v, interior_gradients_[j]);
+      const Vec q_node = q0_ + (interior_[j].a * h_) * v;
+      if (general_ != nullptr) {
+        ++counters_.force_evals;
+        general_->lagrangian_q(q_node, v, interior_gradients_[j]);
+        interior_gradients_[j] = -interior_gradients_[j];
+      } else {
+        eval_gradient(problem, q_node, interior_gradients_[j]);
+      }
       implicit_term_ += (h_ * interior_[j].w * (1 - interior_[j].a)) * interior_gradients_[j];
     }
     if (minus_ > 0.0) {
@@ -286,6 +338,8 @@ class DiscreteLagrangianVI final : public Integrator {
   double memo_h_ = 0.0;
   const Problem* memo_problem_ = nullptr;
 
+  const LagrangianSystem* general_ = nullptr;  // this step's problem's, on the general kind
+  GeneralVelocityJacobian general_jacobian_;
   Vec mass_diagonal_;
   SparseMatrix mass_matrix_, hessian_, damping_;
   std::optional<bool> damping_symmetric_;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "integrators/dense_newton.hpp"
+#include "integrators/newton.hpp"
 
 namespace geomint {
 namespace {
@@ -28,6 +29,26 @@ std::string spec_on(const Integrator& method, const Problem& problem) {
     }
   }
   return method.spec();
+}
+
+double GeneralVelocityJacobian::assemble(const LagrangianSystem& system, const Vec& q_bar,
+                                         const Vec& v, double h, double alpha,
+                                         SparseMatrix& jacobian) {
+  system.mass_matrix(q_bar, dense_);
+  system.lagrangian_vq(q_bar, v, lagrangian_vq_);
+  system.lagrangian_qq(q_bar, v, lagrangian_qq_);
+  dense_ += (h * alpha) * lagrangian_vq_ - (h * (1 - alpha)) * lagrangian_vq_.transpose() -
+            (h * h * alpha * (1 - alpha)) * lagrangian_qq_;
+  const Eigen::Index n = dense_.rows();
+  triplets_.clear();
+  triplets_.reserve(static_cast<size_t>(n * n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = 0; i < n; ++i) triplets_.emplace_back(i, j, dense_(i, j));
+  }
+  jacobian.resize(n, n);
+  jacobian.setFromTriplets(triplets_.begin(), triplets_.end());
+  return std::abs(h * (1 - alpha)) *
+         robust_norm((lagrangian_qq_.cwiseAbs() * q_bar.cwiseAbs()).eval());
 }
 
 StepStatus general_del_step(const LagrangianSystem& system, State& state, double h, double alpha,

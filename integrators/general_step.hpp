@@ -46,6 +46,23 @@ struct GeneralNewtonSettings {
   int max_iterations = 50;
 };
 
+// ∂R/∂v of the velocity equation that del and hp solve on every kind at one node α,
+//   R(v) = L_v(q̄, v) − p₀ − h(1−α)L_q(q̄, v) (− F_d⁻),   q̄ = q₀ + αhv,
+// on the general kind: M(q̄) + hα L_vq − h(1−α) L_qv − h²α(1−α) L_qq (not symmetric unless L_vq
+// is). Stored with every entry, zeros included, so that NewtonSolver keeps one sparsity pattern
+// per run; the dense blocks are kept between calls.
+class GeneralVelocityJacobian {
+ public:
+  // Assembles the matrix at (q̄, v) into `jacobian` and returns the size of the terms inside the
+  // residual's L_q part, |h(1−α)|·‖|L_qq||q̄|‖ (NewtonSystem::inner_term_scale).
+  double assemble(const LagrangianSystem& system, const Vec& q_bar, const Vec& v, double h,
+                  double alpha, SparseMatrix& jacobian);
+
+ private:
+  DenseMatrix dense_, lagrangian_vq_, lagrangian_qq_;
+  std::vector<Eigen::Triplet<double>> triplets_;
+};
+
 // The α-rule DEL step, L_d = h L((1−α)q₀ + αq₁, (q₁ − q₀)/h), in position–momentum form:
 //   solve  L_v(q̄, v̄) − h(1−α) L_q(q̄, v̄) = p₀   for v̄ = (q₁ − q₀)/h,
 //   then   p₁ = L_v(q̄, v̄) + hα L_q(q̄, v̄).

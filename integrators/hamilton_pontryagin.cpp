@@ -16,6 +16,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
 #include "problems/parallel.hpp"
@@ -95,13 +96,16 @@ bool diagonal_plus_scaled(const Vec& m, double c, const SparseMatrix& H, SparseM
 // a case: on a forced problem minimize is a line-searched Newton on R; force_at=node keeps the
 // exact objective.
 //
-// The general Lagrangian kind (L = ½vᵀM(q)v + a(q)ᵀv − V, ../shared/MECHANICS.md §3): the step
-// solves L_v(q^α, v) = p_k + (1−α)h L_q(q^α, v), then q_{k+1} = q_k + hv, p_{k+1} = p_k + hL_q —
-// the α-rule DEL step in position–momentum form, so general_del_step (dense Newton with a
-// partially pivoted LU on the non-symmetric Jacobian) solves it. That Jacobian is the Hessian of
-// no scalar E_k unless L_vq is symmetric, so the minimiser does not exist there: `solver=minimize`
-// written out is refused on non-separable problems (general_lagrangian_refusal), while the default
-// (solver not given) runs the Newton step; 0 < α < 1 only, as for del (α = 0, 1 are declared
+// The general Lagrangian kind (L = ½vᵀM(q)v + a(q)ᵀv − V, ../shared/MECHANICS.md §3) runs the
+// same step, with ∇V(q^α) read as g = −L_q(q^α, v) and Mv as L_v(q^α, v): it solves
+// R(v) = L_v(q^α, v) − p_k + (1−α)h g − F_d⁻ = 0, then q_{k+1} = q_k + hv and
+// p_{k+1} = p_k − hg + F_d⁻ + F_d⁺ (= L_v − αhg + F_d⁺ at R = 0; exact for a cyclic coordinate
+// whatever residual the solve left) — the α-rule DEL step in position–momentum form, with the
+// matrix M(q^α) + hα L_vq − h(1−α) L_qv − h²α(1−α) L_qq (GeneralVelocityJacobian, SparseLU).
+// That matrix is the Hessian of no scalar E_k unless L_vq is symmetric, so the minimiser does
+// not exist there: `solver=minimize` written out is refused on non-separable problems
+// (general_lagrangian_refusal), while the default (solver not given) runs the Newton form, no
+// line search, exactly as solver=newton; 0 < α < 1 only, as for del (α = 0, 1 are declared
 // explicit, which they are not when M depends on q).
 //
 // Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
@@ -170,12 +174,21 @@ class HamiltonPontryagin final : public Integrator,
   // 0).
   const Vec& velocity() const { return velocity_; }
 
+  // The one step of both kinds (integrators/step_implementation.hpp): they differ only in what
+  // the view gives at q^α — Mv through the mass operator, ∇V and its Hessian on the separable
+  // kind; L_v, −L_q and the GeneralVelocityJacobian blocks of the problem's LagrangianSystem on
+  // the general one, where the minimiser has no objective and the Newton form runs.
   StepStatus step(const Problem& problem, State& state, double h) override {
+    mark_step_implementation();
     constraint_impulses_.reset();
-    if (problem.kind() == ProblemKind::kLagrangian) return general_step(problem, state, h);
-    const Vec& mass = MassOperator(problem).constant_diagonal();
-    const Vec& inverse_mass = MassOperator(problem).constant_inverse_diagonal();
-    update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
+    const MassOperator mass_operator(problem);
+    general_ = problem.as_lagrangian();
+    // The constant diagonal M on the separable kind (its products below are those of the
+    // separable step before the kinds shared it, bit for bit); unused on the general kind.
+    diagonal_ = general_ != nullptr ? nullptr : &mass_operator.constant_diagonal();
+    if (general_ == nullptr) update_sparse_mass_matrix(problem, mass_diagonal_, mass_matrix_);
+    minimizing_ = minimize_ && general_ == nullptr;
+    newton_.options().line_search = minimizing_;
     const bool forced = problem.has(kForce);
     minus_ = forced ? forcing_.minus_weight() : 0.0;
     const double plus = forced ? forcing_.plus_weight() : 0.0;
@@ -193,18 +206,23 @@ class HamiltonPontryagin final : public Integrator,
       b_ -= h * gradient_;
     }
 
-    Vec v = inverse_mass.cwiseProduct(state.p);
+    // v₀ = v(q_k, p_k): M⁻¹p_k, or M(q_k)⁻¹(p_k − a(q_k)) on the general kind.
+    Vec v = general_ != nullptr ? general_->velocity(state.q, state.p)
+                                : mass_operator.solve(state.q, state.p);
     const bool coupled = alpha_ > 0.0 && alpha_ < 1.0;  // ∇V(q^α) depends on v
     if (!coupled && minus_ == 0.0) {
-      v = inverse_mass.cwiseProduct(b_);  // E_k is quadratic with Hessian M: no solve
+      // E_k is quadratic with Hessian M: no solve (separable kind only, info()).
+      v = mass_operator.constant_inverse_diagonal().cwiseProduct(b_);
     } else {
       const StepStatus status = solve(problem, state, coupled, v);
       if (!status.ok) return status;
     }
 
-    // p_{k+1} = Mv − αh∇V(q^α) + F_d⁺.
+    // p_{k+1} = Mv − αh∇V(q^α) + F_d⁺; on the general kind L_v(q^α, v) = p_k − implicit_term_ is
+    // read from the equation (the comment above the class).
     const Vec q1 = state.q + h * v;
-    Vec p1 = mass.cwiseProduct(v);
+    if (general_ != nullptr) implicit_terms(problem, v);  // memoised: the accepted v's
+    Vec p1 = general_ != nullptr ? Vec(state.p - implicit_term_) : Vec(diagonal_->cwiseProduct(v));
     if (coupled) {
       implicit_terms(problem, v);  // no-op unless the last evaluation was elsewhere
       p1 -= (alpha_ * h) * gradient_;
@@ -239,28 +257,16 @@ class HamiltonPontryagin final : public Integrator,
   }
 
  private:
-  StepStatus general_step(const Problem& problem, State& state, double h) {
-    const Vec q0 = state.q;
-    const StepStatus status = general_del_step(
-        *problem.as_lagrangian(), state, h, alpha_,
-        {newton_.options().tolerance, newton_.options().max_iterations}, counters_);
-    if (!status.ok) {
-      return StepStatus::failure(
-          status.reason, fmt::format("hp:alpha={}: {}", format_number(alpha_), status.message));
-    }
-    velocity_ = (state.q - q0) / h;
-    return status;
-  }
-
+  // Builds the step's velocity equation R(v) = 0 (and, for the minimiser, E_k) and solves it
+  // from v through solve_velocity_equation.
   StepStatus solve(const Problem& problem, const State& state, bool coupled, Vec& v) {
-    const Vec& mass = MassOperator(problem).constant_diagonal();
     if (minus_ > 0.0) {
       decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
     }
     // The exact-objective form needs −F_d⁻ to be a gradient in v (see the file comment).
     linearised_ = false;
-    if (minimize_ && minus_ > 0.0 && forcing_.at == ForceAt::kNode && problem.has(kForceJacobian) &&
-        *damping_symmetric_) {
+    if (minimizing_ && minus_ > 0.0 && forcing_.at == ForceAt::kNode &&
+        problem.has(kForceJacobian) && *damping_symmetric_) {
       if (!dissipation_potential_) dissipation_potential_ = force_is_affine(problem, state, v);
       if (*dissipation_potential_) {
         // F(q_k, v) = F₀ − C₀v for this step; the residual uses the same model, so ∇E_k = R.
@@ -269,22 +275,29 @@ class HamiltonPontryagin final : public Integrator,
         linearised_ = true;
       }
     }
-    const bool exact_objective = minimize_ && (minus_ == 0.0 || linearised_);
+    const bool exact_objective = minimizing_ && (minus_ == 0.0 || linearised_);
 
     double inner_scale = 0.0;
     NewtonSystem system;
     system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& x, Vec& residual) {
       implicit_terms(problem, x);
-      residual = mass.cwiseProduct(x) - b_ + implicit_term_;
+      if (general_ != nullptr) {
+        residual = general_->momentum(q0_ + (alpha_ * h_) * x, x) - b_ + implicit_term_;
+      } else {
+        residual = diagonal_->cwiseProduct(x) - b_ + implicit_term_;
+      }
     };
     system.jacobian = [&](const Vec& x, SparseMatrix& jacobian) {
-      if (coupled) {
+      if (general_ != nullptr) {  // coupled: the general kind runs 0 < α < 1 only
+        inner_scale =
+            general_jacobian_.assemble(*general_, q0_ + (alpha_ * h_) * x, x, h_, alpha_, jacobian);
+      } else if (coupled) {
         const Vec q_alpha = q0_ + (alpha_ * h_) * x;
         eval_hessian(problem, q_alpha, hessian_);
         inner_scale = std::abs((1 - alpha_) * h_) * gradient_term_scale(hessian_, q_alpha);
         const double weight = alpha_ * (1 - alpha_) * h_ * h_;
-        if (!diagonal_plus_scaled(mass, weight, hessian_, jacobian)) {
+        if (!diagonal_plus_scaled(*diagonal_, weight, hessian_, jacobian)) {
           jacobian = mass_matrix_;
           jacobian += weight * hessian_;
         }
@@ -293,11 +306,13 @@ class HamiltonPontryagin final : public Integrator,
       }
       if (minus_ > 0.0) add_impulse_jacobian(problem, x, jacobian);
     };
-    system.symmetric = minus_ == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_);
+    // The general kind's matrix has the non-symmetric part hα L_vq − h(1−α) L_qv.
+    system.symmetric = general_ == nullptr &&
+                       (minus_ == 0.0 || (problem.has(kForceJacobian) && *damping_symmetric_));
     if (exact_objective) {
       // E_k and the sum of its terms' magnitudes (its round-off scale).
       const auto terms = [&](const Vec& x, double& scale) {
-        const double kinetic = 0.5 * x.dot(mass.cwiseProduct(x));
+        const double kinetic = 0.5 * x.dot(diagonal_->cwiseProduct(x));
         const double linear = b_.dot(x);
         double energy = kinetic - linear;
         scale = std::abs(kinetic) + std::abs(linear);
@@ -345,8 +360,16 @@ class HamiltonPontryagin final : public Integrator,
     implicit_terms(problem, v);
     const double residual_scale =
         robust_norm(state.p) + robust_norm(b_ - state.p) + robust_norm(implicit_term_);
+    return solve_velocity_equation(problem, system, residual_scale, v);
+  }
+
+  // Solves the step's velocity equation R(v) = 0 (`system`, from the start v): the one place
+  // where how it is solved is chosen — NewtonSolver (the minimiser when `system` has an
+  // objective), in the constrained KKT form with G(q_k)ᵀΛ and g(q_k + hv) = 0 when the problem
+  // has constraints (docs/METHOD.md §3).
+  StepStatus solve_velocity_equation(const Problem& problem, const NewtonSystem& system,
+                                     double residual_scale, Vec& v) {
     if (problem.has(kConstraints)) {
-      // The same system with G(q_k)ᵀΛ added and g(q_k + hv) = 0 (docs/METHOD.md §3).
       const ConstrainedStepResult constrained = solve_constrained_step(
           problem, q0_, t0_, h_, system, newton_.options(), residual_scale, v);
       count_solve(constrained.newton);
@@ -370,7 +393,7 @@ class HamiltonPontryagin final : public Integrator,
   StepStatus failure(const NewtonResult& result, const std::string& description) const {
     return StepStatus::failure(result.reason,
                                fmt::format("hp:alpha={},solver={}: {}", format_number(alpha_),
-                                           minimize_ ? "minimize" : "newton", description));
+                                           minimizing_ ? "minimize" : "newton", description));
   }
 
   // F(q_k, v) = F(q_k, 0) − C(q_k)v at a test velocity, and C independent of v: the structure
@@ -407,14 +430,19 @@ class HamiltonPontryagin final : public Integrator,
     }
   }
 
-  // implicit_term_ = (1−α)h∇V(q^α(v)) − F_d⁻(v), memoised on v so that the gradient at the
+  // implicit_term_ = (1−α)h g(v) − F_d⁻(v) with g = ∇V(q^α(v)), or −L_q(q^α(v), v) on the
+  // general kind, memoised on v so that the gradient at the
   // accepted iterate is reused for p_{k+1}.
   void implicit_terms(const Problem& problem, const Vec& v) {
     if (memo_valid_ && memo_v_ == v) return;
     implicit_term_.setZero(v.size());
     if (alpha_ > 0.0 && alpha_ < 1.0) {
       const Vec q_alpha = q0_ + (alpha_ * h_) * v;
-      if (potential_with_gradient_) {
+      if (general_ != nullptr) {
+        ++counters_.force_evals;
+        general_->lagrangian_q(q_alpha, v, gradient_);
+        gradient_ = -gradient_;  // g = −L_q, ∇V on the separable kind
+      } else if (potential_with_gradient_) {
         double potential = 0.0;
         if (eval_gradient_with_potential(problem, q_alpha, gradient_, potential)) {
           potential_memo_ = potential;
@@ -471,6 +499,12 @@ class HamiltonPontryagin final : public Integrator,
   // minimiser, whose line search takes E_k wherever it takes R, solves.
   bool potential_with_gradient_ = false;
 
+  // This step's view: the problem's LagrangianSystem on the general kind, the constant diagonal M
+  // on the separable one; and whether the minimiser runs (separable kind, solver=minimize).
+  const LagrangianSystem* general_ = nullptr;
+  const Vec* diagonal_ = nullptr;
+  bool minimizing_ = false;
+  GeneralVelocityJacobian general_jacobian_;
   Vec mass_diagonal_;
   SparseMatrix mass_matrix_, hessian_, damping_;
   std::optional<bool> damping_symmetric_;      // C = Cᵀ, decided on the first forced solve

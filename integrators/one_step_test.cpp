@@ -17,11 +17,11 @@
 namespace geomint {
 namespace {
 
-// The methods whose separable and general steps are one function today. del, hp and
-// generalized_leapfrog still carry a second step for the general kind
-// (integrators/general_step.hpp); each joins this list when its steps are merged.
-constexpr std::string_view kOneStepMethods[] = {"gauss", "implicit_midpoint", "lobatto3ab", "rk4",
-                                                "tao"};
+// The methods whose separable and general steps are one function today. generalized_leapfrog
+// still carries a second step for the general kind (integrators/general_step.hpp); it joins this
+// list when its steps are merged.
+constexpr std::string_view kOneStepMethods[] = {"del",        "gauss", "hp", "implicit_midpoint",
+                                                "lobatto3ab", "rk4",   "tao"};
 
 // A problem of each kind with the same physics: Kepler in Cartesian and in polar coordinates.
 constexpr const char* kSeparableSpec = "kepler:e=0.5";
