@@ -159,11 +159,19 @@ mjModel* load_model(const std::string& xml, const std::string& what,
 
 // One mj_step of length h; a warning MuJoCo raises in it (bad qacc, qpos, qvel: its instability
 // detector, which would also reset the state) is a failed status naming it.
-StepStatus step_model(mjModel* model, mjData* data, double h) {
+// `split`: mj_step2 then mj_step1 instead of mj_step (Euler and implicit only, MuJoCo's documented
+// equivalent, bit for bit): the step ends with the position stage at the new state, so its mass
+// matrix qM is there for the copy out (MujocoChain::momentum_absolute).
+StepStatus step_model(mjModel* model, mjData* data, double h, bool split = false) {
   model->opt.timestep = h;
   std::array<int, mjNWARNING> before{};
   for (int i = 0; i < mjNWARNING; ++i) before[i] = data->warning[i].number;
-  mj_step(model, data);
+  if (split) {
+    mj_step2(model, data);
+    mj_step1(model, data);
+  } else {
+    mj_step(model, data);
+  }
   for (int i = 0; i < mjNWARNING; ++i) {
     if (data->warning[i].number != before[i]) {
       return StepStatus::failure(
@@ -192,6 +200,8 @@ MujocoChain::MujocoChain(const PlanarChain& chain, const MujocoOptions& options)
     apply_chain_options(model_, chain.gravity, options);
   }
   data_ = mj_makeData(model_);
+  // mj_step2 integrates with Euler when the model asks for RK4: RK4 keeps mj_step.
+  split_step_ = options.integrator != "rk4";
 }
 
 MujocoChain::~MujocoChain() {
@@ -230,7 +240,18 @@ DenseMatrix MujocoChain::mass_matrix_absolute() const {
 double MujocoChain::potential() const { return data_->energy[0]; }
 double MujocoChain::kinetic() const { return data_->energy[1]; }
 
-StepStatus MujocoChain::step(double h) { return step_model(model_, data_, h); }
+StepStatus MujocoChain::step(double h) { return step_model(model_, data_, h, split_step_); }
+
+bool MujocoChain::momentum_absolute(Vec& p) {
+  if (!split_step_) return false;
+  // p_θ = DᵀM_φDθ̇ = Dᵀ(M_φ φ̇): MuJoCo's sparse product with qvel, then (Dᵀy)ᵢ = yᵢ − yᵢ₊₁.
+  const int n = model_->nv;
+  relative_rate_.resize(n);
+  mj_mulM(model_, data_, relative_rate_.data(), data_->qvel);
+  p.resize(n);
+  for (int i = 0; i < n; ++i) p[i] = relative_rate_[i] - (i + 1 < n ? relative_rate_[i + 1] : 0.0);
+  return true;
+}
 
 MujocoRotor::MujocoRotor(const Rotor& rotor, const MujocoOptions& options)
     : xml_(rotor_xml(rotor, options)) {

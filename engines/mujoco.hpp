@@ -50,6 +50,11 @@ class MujocoChain {
   // One mj_step of length h; a warning MuJoCo raises in it (bad qacc, qpos, qvel: its
   // instability detector, which would also reset the state) is a failed status naming it.
   StepStatus step(double h);
+  // p = M(θ)θ̇ in absolute angles from MuJoCo's own mass matrix at the current state, which the
+  // Euler and implicit steps leave computed (they end with mj_step1 at the new state, see
+  // step_model): O(nnz) and no trigonometry. False for RK4 (its mj_step leaves qM at the old
+  // state): the caller then uses the problem's mass operator.
+  bool momentum_absolute(Vec& p);
   // The model text MuJoCo compiled: MJCF (<mujoco ...>) or, for a long chain, URDF (<robot ...>).
   const std::string& xml() const { return xml_; }
 
@@ -58,6 +63,7 @@ class MujocoChain {
   mjData_* data_ = nullptr;
   std::string xml_;
   Vec relative_, relative_rate_;
+  bool split_step_ = false;
 };
 
 // One rigid body about a fixed point (engines/rotor.hpp) as a MuJoCo body on a ball joint at the
