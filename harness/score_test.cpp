@@ -49,7 +49,7 @@ std::string npy_bytes(const std::vector<double>& values, size_t rows, size_t col
 std::string method_for(const std::shared_ptr<const Problem>& problem) {
   // Stiff first-order problems (van der Pol at mu = 1000) need an implicit adaptive method.
   if (problem->has(kFirstOrderOnly)) return "cvode_bdf";
-  // Constraints on a mass M(q) (andrews): IDA's index-2 form is the method that takes them.
+  // Constraints on a mass M(q) (andrews): rattle takes them too (its general step).
   for (const char* method : {"stormer_verlet", "rattle", "lie_poisson", "boris", "rk4", "del",
                              "ida:index=2,multiplier_atol=1"}) {
     RunSpec spec{problem, MethodFactory(method), {}};

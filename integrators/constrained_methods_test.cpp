@@ -277,21 +277,6 @@ TEST(IdaDae, AndrewsReproducesTheTestSetReference) {
   }
 }
 
-// The constrained fixed-step methods assume a constant diagonal mass: they refuse the general
-// kind's constraints and say which methods take them.
-TEST(ConstrainedMethods, RefuseConstraintsOnAPositionDependentMass) {
-  const auto problem = make_problem("andrews");
-  for (const auto& spec : constrained_methods()) {
-    SCOPED_TRACE(spec);
-    const Applicability verdict = applicable(*make_integrator(spec), *problem);
-    const bool general = spec.rfind("ida:index", 0) == 0;
-    EXPECT_EQ(verdict.ok, general) << verdict.reason;
-    if (!verdict.ok) {
-      EXPECT_NE(verdict.reason.find("M(q)"), std::string::npos) << verdict.reason;
-    }
-  }
-}
-
 // RATTLE on the rheonomic constraints (g(q, t), velocity constraint G v + g_t = 0 at t + h) and
 // the sixth-order composition over it reproduce the same reference with fixed steps; both keep
 // the time-dependent constraints at round-off at every step point.

@@ -14,6 +14,7 @@
 
 #include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
+#include "integrators/general_constrained_step.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
@@ -59,6 +60,8 @@ namespace {
 // and p_{k+1} = p_k − h g + F_d⁻ + F_d⁺ (= L_v(q̄, v) − hαg + F_d⁺ at R = 0), which keeps the
 // momentum of a cyclic coordinate (L_q ≡ 0: polar Kepler's p_φ) exact whatever residual the solve
 // left.
+// On constrained problems of the general kind (a mass M(q)) the step is
+// integrators/general_constrained_step.hpp's, forced the same way.
 struct Node {
   double a;  // position along the step, in [0, 1]
   double w;  // weight, Σ w = 1
@@ -121,6 +124,14 @@ class DiscreteLagrangianVI final : public Integrator {
   StepStatus step(const Problem& problem, State& state, double h) override {
     mark_step_implementation();
     constraint_impulses_.reset();
+    if (problem.kind() == ProblemKind::kLagrangian && problem.has(kConstraints)) {
+      std::vector<QuadratureNode> nodes;
+      for (const Node& node : nodes_) nodes.push_back({node.a, node.w});
+      return general_constrained_step(
+          problem, *problem.as_lagrangian(), {.nodes = std::move(nodes), .forcing = forcing_},
+          state, h, {newton_.options().tolerance, newton_.options().max_iterations}, counters_,
+          constraint_impulses_, "del");
+    }
     const MassOperator mass_operator(problem);
     general_ = problem.as_lagrangian();
     // The constant diagonal M on the separable kind (its products below are those of the

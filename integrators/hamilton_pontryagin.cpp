@@ -13,6 +13,7 @@
 
 #include "integrators/constrained_step.hpp"
 #include "integrators/forcing.hpp"
+#include "integrators/general_constrained_step.hpp"
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
@@ -110,7 +111,8 @@ bool diagonal_plus_scaled(const Vec& m, double c, const SparseMatrix& H, SparseM
 //
 // Constraints (α = ½ only, docs/METHOD.md §3): the same system with the multiplier impulse
 // G(q_k)ᵀΛ and g(q_k + hv) = 0, solved by integrators/constrained_step.hpp, then p_{k+1}
-// projected onto the tangent space at q_{k+1}.
+// projected onto the tangent space at q_{k+1}. On the general kind (a mass M(q): andrews) the
+// same constrained, forced α-rule DEL step by integrators/general_constrained_step.hpp.
 class HamiltonPontryagin final : public Integrator,
                                  public ExplainsGeneralRefusal,
                                  public ResolvesOnGeneralLagrangian {
@@ -181,6 +183,15 @@ class HamiltonPontryagin final : public Integrator,
   StepStatus step(const Problem& problem, State& state, double h) override {
     mark_step_implementation();
     constraint_impulses_.reset();
+    if (problem.kind() == ProblemKind::kLagrangian && problem.has(kConstraints)) {
+      const Vec q0 = state.q;
+      const StepStatus status = general_constrained_step(
+          problem, *problem.as_lagrangian(), {.nodes = {{alpha_, 1.0}}, .forcing = forcing_}, state,
+          h, {newton_.options().tolerance, newton_.options().max_iterations}, counters_,
+          constraint_impulses_, "hp");
+      if (status.ok) velocity_ = (state.q - q0) / h;
+      return status;
+    }
     const MassOperator mass_operator(problem);
     general_ = problem.as_lagrangian();
     // The constant diagonal M on the separable kind (its products below are those of the

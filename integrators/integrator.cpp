@@ -279,18 +279,6 @@ std::string structure_refusal(const Integrator& method, const Problem& problem,
                      structure.what, structure.offered_by, problem.name());
 }
 
-// The registry test specs that constrain the general kind (kConstraintsOnly with
-// kGeneralLagrangian, applicable() below), for the refusal message.
-std::vector<std::string> general_constrained_methods() {
-  std::vector<std::string> specs;
-  for (const auto& spec : integrator_test_specs()) {
-    const unsigned flags = make_integrator(spec)->info().flags;
-    if ((flags & kConstraintsOnly) && (flags & kGeneralLagrangian)) specs.push_back(spec);
-  }
-  if (specs.empty()) specs.push_back("(none registered)");
-  return specs;
-}
-
 std::string lagrangian_kind_refusal(const Integrator& method, const Problem& problem) {
   const auto* explains = dynamic_cast<const ExplainsGeneralRefusal*>(&method);
   const std::string specific = explains ? explains->general_lagrangian_refusal() : "";
@@ -362,17 +350,10 @@ Applicability applicable(const Integrator& method, const Problem& problem) {
                         method.spec(), problem.name(), fmt::join(constrained_methods(), ", "))};
   }
   // Constraints on the general kind (a mass M(q): andrews) need a constrained step built on the
-  // problem's LagrangianSystem. A method that exists only for constraints and runs the general
-  // kind (kConstraintsOnly with kGeneralLagrangian: ida:index=2|3, whose residual takes
-  // p' = L_q + F − Gᵀλ) has one; HP and DEL run the general kind unconstrained and constrain a
-  // constant diagonal mass only (their KKT blocks and projections use M⁻¹ = diag).
-  if (kind == ProblemKind::kLagrangian && problem.has(kConstraints) && !needs.needs_constraints) {
-    return {false, fmt::format("method '{}' constrains a constant diagonal mass only (its "
-                               "constrained step uses M⁻¹ = diag); problem '{}' has constraints "
-                               "on a position-dependent mass M(q); methods that apply: {}",
-                               method.spec(), problem.name(),
-                               fmt::join(general_constrained_methods(), ", "))};
-  }
+  // problem's LagrangianSystem: every method flagged both constrained and general_lagrangian has
+  // one (ida:index=2|3's residual p' = L_q + F − Gᵀλ; rattle, hp and del:rule=midpoint through
+  // integrators/general_constrained_step.hpp; compositions over them), and the kind check above
+  // has refused the others.
   if (problem.has(kTimeDependentConstraints) && !needs.handles_rheonomic) {
     return {false, fmt::format("method '{}' handles only time-free constraints; problem '{}' has "
                                "time-dependent ones (rattle, hp, del:rule=midpoint, compositions "

@@ -16,6 +16,7 @@
 #include "harness/sweep.hpp"
 #include "harness/table.hpp"
 #include "integrators/integrator.hpp"
+#include "problems/mass_operator.hpp"
 #include "verify/verify.hpp"
 
 namespace geomint {
@@ -88,7 +89,7 @@ Scales scales_of(const std::string& problem_spec) {
   // Released from rest the speed is set by gravity: |v| ~ length / time unit.
   const double unit = problem->default_dt() * 100;
   const double speed = std::max(
-      problem->inverse_mass().cwiseProduct(start.p).lpNorm<Eigen::Infinity>(), length / unit);
+      MassOperator(*problem).solve(start.q, start.p).lpNorm<Eigen::Infinity>(), length / unit);
   return {length, speed};
 }
 
