@@ -39,12 +39,14 @@ do for [format in "png pdf svg"] {
   unset logscale; set format x "% h"; set format y "% h"; set xrange [*:*]; set yrange [*:*]
 
   # Andrews' squeezer: error against the Test Set reference at t = 0.03 against wall time, IDA's
-  # two forms over rtol 1e-4 ... 1e-12 (one point per tolerance).
+  # two forms over rtol 1e-4 ... 1e-12 (one point per tolerance), and the fixed-step RATTLE, HP
+  # and DEL midpoint steps on the mass M(q) over h = 1e-4 ... 1e-5 (one point per step).
   set output "andrews_wp.".format
-  set title "andrews (IVP Test Set) to t = 0.03: error against the Test Set reference vs wall time\nIDA index 3 over rtol 1e-4 ... 1e-10, index 2 over 1e-4 ... 1e-12 (multiplier_atol = 1)"
+  set title "andrews (IVP Test Set) to t = 0.03: error against the Test Set reference vs wall time\nIDA index 3 (rtol 1e-4 ... 1e-10) and index 2 (1e-4 ... 1e-12); rattle, hp, del:rule=midpoint at h = 1e-4 ... 1e-5"
   set xlabel "wall time [s]"; set ylabel "||(q,p) - reference|| at t = 0.03"
   set logscale xy; set format x "1e%T"; set format y "1e%T"
   plot table using (strcol("label") eq "andrews_ida" && strstrt(strcol("method"), "index=3") ? column("wall_s") : NaN):(column("error_final")) with points ls 41 ps 1.5 title "ida:index=3", \
-       table using (strcol("label") eq "andrews_ida" && strstrt(strcol("method"), "index=2") ? column("wall_s") : NaN):(column("error_final")) with points ls 43 ps 1.5 title "ida:index=2"
+       table using (strcol("label") eq "andrews_ida" && strstrt(strcol("method"), "index=2") ? column("wall_s") : NaN):(column("error_final")) with points ls 43 ps 1.5 title "ida:index=2", \
+       for [m in "rattle hp del"] table using (strcol("label") eq "andrews_variational" && strstrt(strcol("method"), m.":") == 1 ? column("wall_s") : NaN):(column("error_final")) with linespoints ls (m eq "rattle" ? 44 : m eq "hp" ? 45 : 46) ps 1.2 title (m eq "del" ? "del:rule=midpoint" : m)
   unset logscale; set format x "% h"; set format y "% h"
 }
