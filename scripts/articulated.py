@@ -16,16 +16,9 @@ import re
 import shutil
 import sys
 
+from geomint_tables import read_table
+
 FIT_RANGES = [(64, 1024), (16, 64)]
-
-
-def read_table(path):
-    """Rows of a geomint CSV (provenance lines start with '#') and its provenance lines."""
-    with open(path, newline="") as handle:
-        lines = handle.read().splitlines()
-    provenance = [line for line in lines if line.startswith("#")]
-    rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))
-    return rows, provenance
 
 
 def links_of(problem):

@@ -17,6 +17,8 @@ import math
 import os
 import sys
 
+from geomint_tables import read_table
+
 # Every method's step is capped per axis: about 30 steps per period of the slow mode. stiff_spring's
 # slow frequency is ~0.71 and fpu_stiff's soft springs oscillate at O(1), hence 0.3; the bar's first
 # bending mode has a period of ~3.1 s at E = 1e5 (beam theory: omega_1 = 1.875^2 sqrt(E I/(rho A
@@ -51,15 +53,6 @@ STIFFNESS = {
 def panel_of(problem, axis):
     """Name of the figure panel and curve files: the problem, or elastic_bar_<axis>."""
     return f"{problem}_{axis}" if problem == "elastic_bar" else problem
-
-
-def read_table(path):
-    """Rows of a geomint CSV (provenance lines start with '#') and its provenance lines."""
-    with open(path, newline="") as handle:
-        lines = handle.read().splitlines()
-    provenance = [line for line in lines if line.startswith("#")]
-    rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))
-    return rows, provenance
 
 
 def split_problem(spec):
