@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engines/bullet.hpp"
+#include "engines/dart.hpp"
 #include "engines/mujoco.hpp"
 #include "engines/ode.hpp"
 #include "engines/planar_chain.hpp"
@@ -131,6 +132,8 @@ BENCHMARK(BM_MomentumOnly);
 
 using geomint::engines::BulletChain;
 using geomint::engines::BulletOptions;
+using geomint::engines::DartChain;
+using geomint::engines::DartOptions;
 using geomint::engines::MujocoChain;
 using geomint::engines::MujocoOptions;
 using geomint::engines::OdeChain;
@@ -169,6 +172,16 @@ void BM_CopyOut_bullet(benchmark::State& state) {
 void BM_CopyIn_bullet(benchmark::State& state) {
   run_copy_in<BulletChain>(state, BulletOptions{"euler", false});
 }
+void BM_EngineStep_dart(benchmark::State& state) {
+  run_engine_step<DartChain>(state, DartOptions{"world", false});
+}
+void BM_MethodStep_dart(benchmark::State& state) { run_method_step(state, "dart"); }
+void BM_CopyOut_dart(benchmark::State& state) {
+  run_copy_out<DartChain>(state, DartOptions{"world", false});
+}
+void BM_CopyIn_dart(benchmark::State& state) {
+  run_copy_in<DartChain>(state, DartOptions{"world", false});
+}
 BENCHMARK(BM_EngineStep_mujoco);
 BENCHMARK(BM_MethodStep_mujoco);
 BENCHMARK(BM_CopyOut_mujoco);
@@ -182,6 +195,10 @@ BENCHMARK(BM_EngineStep_bullet);
 BENCHMARK(BM_MethodStep_bullet);
 BENCHMARK(BM_CopyOut_bullet);
 BENCHMARK(BM_CopyIn_bullet);
+BENCHMARK(BM_EngineStep_dart);
+BENCHMARK(BM_MethodStep_dart);
+BENCHMARK(BM_CopyOut_dart);
+BENCHMARK(BM_CopyIn_dart);
 
 // Console output plus each benchmark's CPU time (the median over --benchmark_repetitions when
 // there are repetitions), for the ratios printed at the end.
@@ -240,7 +257,7 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  for (const char* engine : {"mujoco", "ode", "bullet"}) reporter.print_overhead(engine);
+  for (const char* engine : {"mujoco", "ode", "bullet", "dart"}) reporter.print_overhead(engine);
   benchmark::Shutdown();
   return 0;
 }

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "engines/bullet.hpp"
+#include "engines/dart.hpp"
 #include "engines/mujoco.hpp"
 #include "engines/ode.hpp"
 #include "engines/planar_chain.hpp"
@@ -359,6 +360,204 @@ TEST(BulletApplicability, RefusesOtherProblemsNamingThoseThatApply) {
   EXPECT_EQ(method->provider().label(), "engine:Bullet");
 }
 
+// DART's own joint-space mass matrix (Skeleton::getMassMatrix, mapped to absolute angles), its
+// potential and kinetic energy equal the problem's, on the chain specs and on a 256-link chain,
+// for both defaults= variants; the state survives the trip into the joints and back.
+TEST(DartFidelity, MassMatrixPotentialAndKineticEnergyAreTheProblems) {
+  std::vector<std::string> specs = kChainSpecs;
+  specs.push_back("rod_chain:coordinates=joint,n=256,mass_ratio=0.99,length_ratio=1.002,theta=0.4");
+  for (const auto& spec : specs) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    std::string why;
+    const auto chain = planar_chain_of(*problem, why);
+    ASSERT_TRUE(chain) << why;
+    for (const bool shipped : {false, true}) {
+      DartChain engine(*chain, {"world", shipped});
+      const Vec down = Vec::Zero(problem->dof());
+      engine.set_state(down, down);
+      const double engine_down = engine.potential();
+      const double problem_down = problem->potential(down);
+      for (const auto& [q, v] : test_states(*problem)) {
+        engine.set_state(q, v);
+        const DenseMatrix M = problem_mass_matrix(*problem, q);
+        EXPECT_LE((engine.mass_matrix_absolute() - M).norm(), 1e-9 * M.norm())
+            << "M(θ) at θ = " << q.transpose();
+        EXPECT_LE(relative_difference(engine.kinetic(), 0.5 * v.dot(M * v)), 1e-9);
+        const double V = problem->potential(q) - problem_down;
+        EXPECT_LE(std::abs(engine.potential() - engine_down - V),
+                  1e-9 * std::max(std::abs(problem_down), std::abs(V)));
+        Vec q_back, v_back;
+        engine.get_state(q_back, v_back);
+        EXPECT_LE((q_back - q).norm(), 1e-12 * (1 + q.norm()));
+        EXPECT_LE((v_back - v).norm(), 1e-12 * (1 + v.norm()));
+      }
+    }
+  }
+}
+
+// DART's World::step and the dart::integration classes on the pendulum, each against the geomint
+// method of the scheme it is, and not the contrasting one.
+TEST(DartIdentification, EachIntegratorIsItsTextbookSchemeToRoundOff) {
+  const auto problem = make_problem("pendulum:omega0=2.5,theta0=1.2,v0=0.3");
+  constexpr double h = 0.01;
+  constexpr int kSteps = 1000;
+  const std::vector<Identification> schemes = {
+      {"dart:integrator=world", "symplectic_euler_a",
+       "semi-implicit (symplectic) Euler, kick then drift: World::step integrates the velocities, "
+       "solves the (absent) constraints, then integrates the positions with the new velocities"},
+      {"dart:integrator=semi_implicit_euler", "symplectic_euler_a",
+       "semi-implicit (symplectic) Euler, kick then drift"},
+      // EulerIntegrator::integrate (DART 6.12, its compiled code): integrateConfigs(getGenVels())
+      // first, then integrateGenVels(evalGenAccs()) at the moved configuration.
+      {"dart:integrator=euler", "symplectic_euler_b",
+       "semi-implicit (symplectic) Euler, drift then kick: EulerIntegrator moves the positions "
+       "with the old velocities, then the velocities with the accelerations at the new positions "
+       "(not explicit Euler)"},
+  };
+  for (const auto& [engine_spec, geomint_spec, scheme] : schemes) {
+    SCOPED_TRACE(engine_spec + " is " + scheme + " (" + geomint_spec + ")");
+    const State engine = run_steps(engine_spec, *problem, h, kSteps);
+    const State reference = run_steps(geomint_spec, *problem, h, kSteps);
+    EXPECT_LE(std::abs(engine.q[0] - reference.q[0]), 1e-12 * std::abs(reference.q[0]));
+    EXPECT_LE(std::abs(engine.p[0] - reference.p[0]), 1e-12 * std::abs(reference.p[0]));
+    for (const std::string other :
+         {"symplectic_euler_a", "symplectic_euler_b", "explicit_euler", "rk4"}) {
+      if (other == geomint_spec) continue;
+      const State contrast = run_steps(other, *problem, h, kSteps);
+      EXPECT_GT(std::abs(engine.q[0] - contrast.q[0]), 1e-6) << "also " << other;
+    }
+  }
+}
+
+// DART 6.12's RK4Integrator::integrate, written out on the pendulum θ̈ = a(θ) = −M⁻¹∇V(θ): the
+// stages of classical RK4, except that the fourth is evaluated at θ + (h/2)v₂ + h v₃ (it advances
+// the configuration of the third stage by h v₃ without first resetting it to θ).
+State dart_rk4_as_shipped(const Problem& problem, double h, int steps) {
+  const auto a = [&](double theta) {
+    Vec g;
+    problem.gradient(Vec::Constant(1, theta), g);
+    return -problem.inverse_mass()[0] * g[0];
+  };
+  State state = problem.initial_state();
+  double theta = state.q[0], v = problem.inverse_mass()[0] * state.p[0];
+  for (int k = 0; k < steps; ++k) {
+    const double v1 = v, a1 = a(theta);
+    const double v2 = v + h / 2 * a1, a2 = a(theta + h / 2 * v1);
+    const double v3 = v + h / 2 * a2, a3 = a(theta + h / 2 * v2);
+    const double v4 = v + h * a3, a4 = a(theta + h / 2 * v2 + h * v3);
+    theta += h / 6 * (v1 + 2 * v2 + 2 * v3 + v4);
+    v += h / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+  }
+  state.q[0] = theta;
+  state.p[0] = problem.mass()[0] * v;
+  state.t = h * steps;
+  return state;
+}
+
+// DART's rk4 is that scheme to round-off, not geomint's classical rk4, and it is first order:
+// halving h halves its error against the exact pendulum.
+TEST(DartIdentification, Rk4IntegratorAsShippedIsAFirstOrderVariantOfRk4) {
+  const auto problem = make_problem("pendulum:omega0=2.5,theta0=1.2,v0=0.3");
+  constexpr double h = 0.01;
+  constexpr int kSteps = 1000;
+  const State engine = run_steps("dart:integrator=rk4", *problem, h, kSteps);
+  const State written_out = dart_rk4_as_shipped(*problem, h, kSteps);
+  EXPECT_LE(std::abs(engine.q[0] - written_out.q[0]), 1e-12 * std::abs(written_out.q[0]));
+  EXPECT_LE(std::abs(engine.p[0] - written_out.p[0]), 1e-12 * std::abs(written_out.p[0]));
+  const State classical = run_steps("rk4", *problem, h, kSteps);
+  EXPECT_GT(std::abs(engine.q[0] - classical.q[0]), 1e-3);
+  const double t_end = 1.0;
+  const State exact = problem->exact(t_end);
+  std::vector<double> errors;
+  for (const int steps : {400, 800, 1600}) {
+    errors.push_back(std::abs(
+        run_steps("dart:integrator=rk4", *problem, t_end / steps, steps).q[0] - exact.q[0]));
+  }
+  for (int k = 1; k < 3; ++k) {
+    const double order = std::log2(errors[k - 1] / errors[k]);
+    EXPECT_GT(order, 0.8) << errors[k - 1] << " " << errors[k];
+    EXPECT_LT(order, 1.3) << errors[k - 1] << " " << errors[k];
+  }
+}
+
+// DART's shipped defaults are the values the clean model writes out: the two variants take the
+// same steps, bit for bit, on a chain and on a top.
+TEST(DartDefaults, ShippedDefaultsTakeTheCleanSteps) {
+  for (const std::string problem_spec :
+       {"rod_chain:coordinates=joint,n=4,theta=0.3", "heavy_top"}) {
+    const auto problem = make_problem(problem_spec);
+    for (const std::string integrator : {"world", "rk4"}) {
+      SCOPED_TRACE(problem_spec + " with " + integrator);
+      const std::string spec = "dart:integrator=" + integrator;
+      const State clean = run_steps(spec, *problem, 0.01, 200);
+      const State shipped = run_steps(spec + ",defaults=shipped", *problem, 0.01, 200);
+      EXPECT_EQ(clean.q, shipped.q);
+      EXPECT_EQ(clean.p, shipped.p);
+    }
+  }
+}
+
+// A sweep builds and steps DART skeletons on several worker threads at once: they take the steps
+// they take alone (DART keeps no per-process state in a step).
+TEST(DartThreads, SkeletonsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
+  for (const std::string spec : {"rod_chain:coordinates=joint,n=4,theta=0.3", "heavy_top"}) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    const int runs = 200, steps = 50;
+    const State alone = run_steps("dart", *problem, 0.001, steps);
+    std::vector<std::vector<State>> concurrent(2, std::vector<State>(runs));
+    std::vector<std::thread> threads;
+    for (std::vector<State>& results : concurrent) {
+      threads.emplace_back([&problem, &results] {
+        for (State& result : results) result = run_steps("dart", *problem, 0.001, steps);
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (const std::vector<State>& results : concurrent) {
+      for (const State& result : results) {
+        EXPECT_EQ(result.q, alone.q);
+        EXPECT_EQ(result.p, alone.p);
+      }
+    }
+  }
+}
+
+// Every DART step far beyond any stable step on a stiff 3-link chain: the state grows until the
+// adapter stops the run as a failed status naming the blow-up, before DART sees a state its joint
+// transform asserts on (DART 6.12's assertion in RevoluteJoint aborted the process instead).
+TEST(DartFailures, ABlowUpEndsTheRunAsAFailedStatusNotAnAbort) {
+  const auto problem = make_problem("rod_chain:coordinates=joint,n=3,theta=1.5,gravity=100");
+  for (const std::string& integrator : dart_integrators()) {
+    SCOPED_TRACE(integrator);
+    const auto method = make_integrator("dart:integrator=" + integrator);
+    State state = problem->initial_state();
+    constexpr double h = 2.5;
+    method->reset(*problem, state, h);
+    StepStatus status;
+    int steps = 0;
+    for (; steps < 10000 && status.ok; ++steps) status = method->step(*problem, state, h);
+    ASSERT_FALSE(status.ok) << "still running after " << steps << " steps";
+    EXPECT_TRUE(status.reason == "dart_blowup" || status.reason == "dart_nan") << status.reason;
+    EXPECT_NE(status.message.find("DART"), std::string::npos) << status.message;
+  }
+}
+
+TEST(DartApplicability, RefusesOtherProblemsAndChainsLongerThanItBuilds) {
+  const auto method = make_integrator("dart");
+  const Applicability verdict = applicable(*method, *make_problem("kepler"));
+  EXPECT_FALSE(verdict.ok);
+  EXPECT_NE(verdict.reason.find("rod_chain:coordinates=joint"), std::string::npos)
+      << verdict.reason;
+  for (const auto& spec : kChainSpecs) EXPECT_TRUE(applicable(*method, *make_problem(spec)).ok);
+  EXPECT_TRUE(applicable(*method, *make_problem("rod_chain:coordinates=joint,n=1024")).ok);
+  const Applicability longer =
+      applicable(*method, *make_problem("rod_chain:coordinates=joint,n=1025"));
+  EXPECT_FALSE(longer.ok);
+  EXPECT_NE(longer.reason.find("at most 1024 links"), std::string::npos) << longer.reason;
+  EXPECT_EQ(method->provider().label(), "engine:DART");
+}
+
 // ----- One rigid body about a fixed point: spherical_pendulum, heavy_top, rigid_body -----
 
 // Every rotor problem at its defaults and at non-unit parameters; the second heavy top has its
@@ -510,11 +709,35 @@ TEST(RotorFidelity, BulletPotentialAndKineticEnergyAreTheProblems) {
   }
 }
 
+TEST(RotorFidelity, DartInertiaPotentialAndKineticEnergyAreTheProblems) {
+  for (const bool shipped : {false, true}) {
+    check_rotor_engine<DartRotor>(DartOptions{"world", shipped});
+  }
+  // DART's own mass matrix of the ball (free) joint, mapped from the principal frame to the
+  // problem's body frame, is the problem's inertia about the origin.
+  for (const auto& spec : kRotorSpecs) {
+    SCOPED_TRACE(spec);
+    const auto problem = make_problem(spec);
+    std::string why;
+    const auto rotor = rotor_of(*problem, why);
+    ASSERT_TRUE(rotor) << why;
+    if (rotor->kind == Rotor::Kind::kSphericalAngles) continue;  // the Cartesian form covers it
+    DartRotor engine(*rotor, {});
+    engine.set_state(RotorState{});
+    const Eigen::Matrix3d J = problem_body_inertia(*problem, *rotor);
+    const Eigen::Matrix3d engine_J =
+        rotor->principal * engine.rotational_mass_matrix() * rotor->principal.transpose();
+    EXPECT_LE((engine_J - J).norm(), 1e-9 * J.norm()) << "engine\n"
+                                                      << engine_J << "\nproblem\n"
+                                                      << J;
+  }
+}
+
 // Every engine method runs every rotor problem; Bullet's options that do not fit a problem refuse
 // it, saying why; other problems are refused with the list of those that apply.
 TEST(RotorApplicability, EveryEngineRunsTheRotorProblemsAndRefusesTheRest) {
   for (const std::string spec : {"mujoco", "mujoco:integrator=rk4", "mujoco:integrator=implicit",
-                                 "ode", "ode:step=quick", "bullet"}) {
+                                 "ode", "ode:step=quick", "bullet", "dart"}) {
     const auto method = make_integrator(spec);
     for (const auto& problem : kRotorSpecs) {
       const Applicability verdict = applicable(*method, *make_problem(problem));
@@ -592,7 +815,9 @@ TEST(RotorIdentification, FreeBodyStepsAreLieEulerWithExplicitOrNewtonImplicitGy
                  {"bullet:gyro=explicit", false},
                  {"mujoco:integrator=implicit", true},
                  {"bullet:gyro=implicit_body", true},
-                 {"bullet:gyro=implicit_world", true}};
+                 {"bullet:gyro=implicit_world", true},
+                 {"dart", false},
+                 {"dart:integrator=semi_implicit_euler", false}};
   const State initial = problem->initial_state();
   const auto lie_euler = [&](bool implicit) {
     RotorStateMap map(*rotor);
@@ -643,8 +868,9 @@ TEST(RotorIdentification, MujocoRk4IsClassicalRk4OnEulersEquationsOnly) {
 // inertia would not be). ODE's clean ball joint lets the pivot drift (ERP = 0), so its spherical
 // pendulum gets the looser bound of the run it has.
 TEST(RotorRuns, EveryEngineFollowsTheEnergyOfEveryRotorProblem) {
-  for (const std::string spec : {"mujoco", "mujoco:integrator=rk4", "mujoco:integrator=implicit",
-                                 "ode", "ode:step=quick", "bullet", "bullet:integrator=rk4"}) {
+  for (const std::string spec :
+       {"mujoco", "mujoco:integrator=rk4", "mujoco:integrator=implicit", "ode", "ode:step=quick",
+        "bullet", "bullet:integrator=rk4", "dart", "dart:integrator=rk4"}) {
     const auto method = make_integrator(spec);
     for (const auto& problem_spec : kRotorSpecs) {
       const auto problem = make_problem(problem_spec);

@@ -20,7 +20,7 @@ PACKAGES=(
   libxml2-utils tidy chromium python3-yaml python3-jsonschema
   libcmark-gfm-dev libcmark-gfm-extensions-dev
   pybind11-dev python3-dev python3-numpy python3-pandas python3-pytest
-  libmujoco-dev libode-dev libbullet-dev
+  libmujoco-dev libode-dev libbullet-dev libdart-dev
 )
 if [ "${1:-}" = cluster ]; then
   shift

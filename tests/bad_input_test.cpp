@@ -208,6 +208,12 @@ const std::vector<Case>& cases() {
       {"BulletGyroOnAMultiBody",
        "run --problem heavy_top --method bullet:gyro=explicit --dt 0.1 --t-end 1", 2,
        "only the free body (rigid_body) is"},
+      {"DartUnknownIntegrator",
+       "run --problem pendulum --method dart:integrator=implicit --dt 0.1 --t-end 1", 2,
+       "(allowed: world, semi_implicit_euler, euler, rk4)"},
+      {"DartChainLongerThanItBuilds",
+       "run --problem rod_chain:coordinates=joint,n=2048 --method dart --dt 0.01 --t-end 1", 2,
+       "builds chains of at most 1024 links"},
       // --- holonomic constraints (applicable()): the message names what applies ---
       {"UnconstrainedMethodOnConstrainedProblem",
        "run --problem rod_chain --method stormer_verlet --dt 0.01 --t-end 1", 2,
