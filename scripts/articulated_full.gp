@@ -13,7 +13,7 @@ do for [format in "png pdf svg"] {
   if (format eq "png") { set term @png_term } else { if (format eq "pdf") { set term @pdf_term } else { set term @svg_term } }
   set termoption noenhanced
   set output "cost_long.".format
-  set title "Wall time per step against n: the long runs (points) on the curves of results/articulated\n(rod chain, h = 1/240; MuJoCo at 1024: (120-step - 24-step run) / 96, no model compile)"
+  set title "Wall time per step against n: the long runs (points) on the curves of results/articulated\n(rod chain, h = 1/240; MuJoCo and DART at 1024: (120-step - 24-step run) / 96, no model build)"
   set xlabel "links n"; set ylabel "seconds per step"
   set logscale xy; set format y "1e%T"; set xrange [3:1400]; set yrange [5e-7:1]; set xtics (4, 16, 64, 256, 1024)
   set key outside right top font ",10"

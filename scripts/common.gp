@@ -15,11 +15,12 @@ sh_escaped_at(s, at) = at == 0 ? s : s[1:at - 1] . "'\\''" . sh_escaped(s[at + 1
 # One colour, marker and dash per method in every figure of every scene. A method is found by
 # the first key its name starts with: a spec ("hp:alpha=0.5,..."), a series file name
 # ("hp_alpha_0.5") or a work-precision curve ("composition_yoshida4") all match. Keys must not
-# be prefixes of one another. Line style i is the i-th key; 99 is any method not listed.
-method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake rkn_nystrom4 rkn_dprkn6 rkn_dprkn8 rkn_adaptive_dprkn6 rkn_adaptive_dprkn8 mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4"
-method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection) rkn:table=nystrom4 rkn:table=dprkn6 rkn:table=dprkn8 rkn_adaptive:pair=dprkn6 rkn_adaptive:pair=dprkn8 mujoco:integrator=euler mujoco:integrator=rk4 mujoco:integrator=implicit ode:step=world ode:step=quick bullet:integrator=euler bullet:integrator=rk4"
+# be prefixes of one another. Line style i is the i-th key, from the 41st key on style i + 8 (41-48
+# are the palette below); 99 is any method not listed.
+method_keys = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del hp newmark implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd composition_yoshida4 composition_kahan_li8 gauss_s2 gauss_s3 lobatto3ab_s3 rattle composition_rattle_yoshida4 composition_rattle_kahan_li6 composition_rattle_kahan_li8 ida_index_2 ida_index_3 penalty shake rkn_nystrom4 rkn_dprkn6 rkn_dprkn8 rkn_adaptive_dprkn6 rkn_adaptive_dprkn8 mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4 dart_integrator_world dart_integrator_euler dart_integrator_rk4"
+method_titles = "explicit_euler implicit_euler symplectic_euler_a symplectic_euler_b stormer_verlet rk4 del:midpoint hp:alpha=0.5 newmark(1/4,1/2) implicit_midpoint cvode_bdf cvode_adams odeint_dopri5 odeint_mclachlan4 gsl_rk8pd yoshida4(verlet) kahan_li8(verlet) gauss_s2 gauss_s3 lobatto3ab_s3 rattle yoshida4(rattle) kahan_li6(rattle) kahan_li8(rattle) ida:index=2 ida:index=3 penalty:k=1e6(verlet) shake(rattle,no_velocity_projection) rkn:table=nystrom4 rkn:table=dprkn6 rkn:table=dprkn8 rkn_adaptive:pair=dprkn6 rkn_adaptive:pair=dprkn8 mujoco:integrator=euler mujoco:integrator=rk4 mujoco:integrator=implicit ode:step=world ode:step=quick bullet:integrator=euler bullet:integrator=rk4 dart:integrator=world dart:integrator=euler dart:integrator=rk4"
 method_index(name) = sum [i=1:words(method_keys)] (strstrt(name, word(method_keys, i)) == 1 ? i : 0)
-ms(name) = (method_found = method_index(name), method_found > 0 ? method_found : 99)
+ms(name) = (method_found = method_index(name), method_found > 40 ? method_found + 8 : method_found > 0 ? method_found : 99)
 mtitle(name) = (method_found = method_index(name), method_found > 0 ? word(method_titles, method_found) : name)
 set style line 1  lw 2 lc rgb "#d62728" pt 5  ps 1.1          # explicit_euler: red, filled square
 set style line 2  lw 2 lc rgb "#1f77b4" pt 6  ps 1.6          # implicit_euler: blue, large open circle
@@ -68,6 +69,9 @@ set style line 37 lw 2 lc rgb "#a0522d" pt 6  ps 1.3          # ode_step_world: 
 set style line 38 lw 2 lc rgb "#a0522d" pt 2  ps 1.3          # ode_step_quick: sienna, cross
 set style line 39 lw 2 lc rgb "#3949ab" pt 5  ps 0.8 dt (2,3) # bullet_integrator_euler: indigo blue, small filled square, dotted
 set style line 40 lw 2 lc rgb "#3949ab" pt 13 ps 0.9 dt (2,3) # bullet_integrator_rk4: indigo blue, small filled diamond, dotted
+set style line 49 lw 2 lc rgb "#c2185b" pt 4  ps 1.0 dt (8,3,2,3) # dart_integrator_world: crimson, open square, dash-dot
+set style line 50 lw 2 lc rgb "#c2185b" pt 10 ps 1.2 dt (8,3,2,3) # dart_integrator_euler: crimson, open triangle down, dash-dot
+set style line 51 lw 2 lc rgb "#c2185b" pt 3  ps 1.2 dt (8,3,2,3) # dart_integrator_rk4: crimson, asterisk, dash-dot
 set style line 99 lw 1 lc rgb "#aaaaaa" pt 0                  # a method not in method_keys
 # Curves that are not methods (a parameter family, step sizes, energies of one method, bodies):
 # an ordered dark-to-light palette, styles 41-48, so they cannot be mistaken for a method.

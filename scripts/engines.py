@@ -14,7 +14,7 @@ def series_name(method):
     """The series file name of a canonical method spec: an engine keeps its options but the
     default defaults=clean, geomint's methods keep their name only (their options are defaults)."""
     name, _, options = method.partition(":")
-    if name not in ("mujoco", "ode", "bullet"):
+    if name not in ("mujoco", "ode", "bullet", "dart"):
         return name
     parts = [o for o in options.split(",") if o and o != "defaults=clean"]
     # Options in the order the series files write them (the spec's own option first).
@@ -70,6 +70,8 @@ def selftest():
         "ode:defaults=clean,step=quick": "ode_step_quick",
         "bullet:defaults=shipped,integrator=rk4": "bullet_integrator_rk4_defaults_shipped",
         "del:force_at=midpoint,tol=1e-12": "del",
+        "dart:defaults=clean,integrator=world": "dart_integrator_world",
+        "dart:defaults=shipped,integrator=world": "dart_integrator_world_defaults_shipped",
         "rk4": "rk4",
     }
     for spec, expected in cases.items():
