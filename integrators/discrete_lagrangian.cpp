@@ -18,6 +18,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/operator_del_solve.hpp"
 #include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
@@ -70,8 +71,12 @@ struct Node {
 class DiscreteLagrangianVI final : public Integrator {
  public:
   DiscreteLagrangianVI(std::string rule, std::vector<Node> nodes, Forcing forcing,
-                       const NewtonOptions& newton)
-      : rule_(std::move(rule)), nodes_(std::move(nodes)), forcing_(forcing), newton_(newton) {
+                       const NewtonOptions& newton, VelocitySolve solve)
+      : rule_(std::move(rule)),
+        nodes_(std::move(nodes)),
+        forcing_(forcing),
+        newton_(newton),
+        solve_(solve) {
     newton_.options().polish = true;  // momentum maps to round-off, not to the tolerance
     double first_moment = 0.0;
     for (const Node& node : nodes_) {
@@ -168,13 +173,16 @@ class DiscreteLagrangianVI final : public Integrator {
         decide_damping_symmetry(problem, state.q, v, state.t, damping_, damping_symmetric_);
       }
       double inner_scale = 0.0;
+      const bool matrix_free = resolve_velocity_solve(solve_, problem) != VelocitySolve::kDense;
       NewtonSystem system;
       system.inner_term_scale = [&] { return inner_scale; };
       system.residual = [&](const Vec& x, Vec& residual) {
         implicit_terms(problem, x);
         if (general_ != nullptr) {
-          residual = general_->momentum(q0_ + (interior_.front().a * h) * x, x) + constant_ +
-                     implicit_term_;
+          const Vec q_bar = q0_ + (interior_.front().a * h) * x;
+          residual = (matrix_free ? general_->momentum_by_operator(q_bar, x)
+                                  : general_->momentum(q_bar, x)) +
+                     constant_ + implicit_term_;
         } else {
           residual = diagonal->cwiseProduct(x) + constant_ + implicit_term_;
         }
@@ -260,7 +268,8 @@ class DiscreteLagrangianVI final : public Integrator {
 
  private:
   // Solves the step's velocity equation R(v) = 0 (`system`, from the start v): the one place
-  // where how it is solved is chosen — NewtonSolver, in the constrained KKT form with G(q_k)ᵀΛ
+  // where how it is solved is chosen — NewtonSolver, or matrix-free (solve=,
+  // operator_del_solve.hpp; auto on a recursive mass), in the constrained KKT form with G(q_k)ᵀΛ
   // and g(q_k + hv) = 0 when the problem has constraints (docs/METHOD.md §3).
   StepStatus solve_velocity_equation(const Problem& problem, const NewtonSystem& system,
                                      double residual_scale, Vec& v) {
@@ -274,7 +283,15 @@ class DiscreteLagrangianVI final : public Integrator {
       constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h_};
       return StepStatus::success();
     }
-    const NewtonResult result = newton_.solve(system, v, residual_scale);
+    const VelocitySolve solve = resolve_velocity_solve(solve_, problem);
+    const NewtonResult result =
+        solve == VelocitySolve::kDense
+            ? newton_.solve(system, v, residual_scale)
+            : matrix_free_velocity_solve(
+                  system,
+                  velocity_equation_preconditioner(problem, q0_, h_,
+                                                   interior_.empty() ? 0.0 : interior_.front().a),
+                  v, residual_scale, newton_.options(), solve == VelocitySolve::kNewtonKrylov);
     count_solve(result);
     if (!result.converged) return StepStatus::failure(result.reason, describe(result));
     return StepStatus::success();
@@ -338,6 +355,7 @@ class DiscreteLagrangianVI final : public Integrator {
   bool midpoint_ = false;  // the constrained step is enabled (and tested) for the midpoint rule
   Forcing forcing_;
   NewtonSolver newton_;
+  VelocitySolve solve_;
 
   // Per-step data used by the residual.
   Vec q0_;
@@ -389,7 +407,8 @@ std::unique_ptr<Integrator> make_del(Params& params) {
   }
   const Forcing forcing = read_forcing(params);
   const NewtonOptions newton = read_newton_options(params, "|p| + h|grad V| + |F_d-|");
-  return std::make_unique<DiscreteLagrangianVI>(label, std::move(nodes), forcing, newton);
+  const VelocitySolve solve = read_velocity_solve_option(params);
+  return std::make_unique<DiscreteLagrangianVI>(label, std::move(nodes), forcing, newton, solve);
 }
 
 }  // namespace geomint

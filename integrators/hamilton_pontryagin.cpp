@@ -17,6 +17,7 @@
 #include "integrators/general_step.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/newton.hpp"
+#include "integrators/operator_del_solve.hpp"
 #include "integrators/step_implementation.hpp"
 #include "integrators/tangent.hpp"
 #include "problems/mass_operator.hpp"
@@ -118,12 +119,13 @@ class HamiltonPontryagin final : public Integrator,
                                  public ResolvesOnGeneralLagrangian {
  public:
   HamiltonPontryagin(double alpha, bool minimize, bool minimize_written, Forcing forcing,
-                     const NewtonOptions& newton)
+                     const NewtonOptions& newton, VelocitySolve solve)
       : alpha_(alpha),
         minimize_(minimize),
         minimize_written_(minimize_written),
         forcing_(forcing),
-        newton_(newton) {
+        newton_(newton),
+        solve_(solve) {
     NewtonOptions& options = newton_.options();
     options.polish = true;  // momentum maps to round-off, not to the tolerance
     options.line_search = minimize;
@@ -289,12 +291,16 @@ class HamiltonPontryagin final : public Integrator,
     const bool exact_objective = minimizing_ && (minus_ == 0.0 || linearised_);
 
     double inner_scale = 0.0;
+    const bool matrix_free = resolve_velocity_solve(solve_, problem) != VelocitySolve::kDense;
     NewtonSystem system;
     system.inner_term_scale = [&] { return inner_scale; };
     system.residual = [&](const Vec& x, Vec& residual) {
       implicit_terms(problem, x);
       if (general_ != nullptr) {
-        residual = general_->momentum(q0_ + (alpha_ * h_) * x, x) - b_ + implicit_term_;
+        const Vec q_alpha = q0_ + (alpha_ * h_) * x;
+        residual = (matrix_free ? general_->momentum_by_operator(q_alpha, x)
+                                : general_->momentum(q_alpha, x)) -
+                   b_ + implicit_term_;
       } else {
         residual = diagonal_->cwiseProduct(x) - b_ + implicit_term_;
       }
@@ -388,7 +394,13 @@ class HamiltonPontryagin final : public Integrator,
       constraint_impulses_ = ConstraintImpulses{constrained.impulse, Vec(), h_};
       return StepStatus::success();
     }
-    const NewtonResult result = newton_.solve(system, v, residual_scale);
+    const VelocitySolve solve = resolve_velocity_solve(solve_, problem);
+    const NewtonResult result =
+        solve == VelocitySolve::kDense
+            ? newton_.solve(system, v, residual_scale)
+            : matrix_free_velocity_solve(
+                  system, velocity_equation_preconditioner(problem, q0_, h_, alpha_), v,
+                  residual_scale, newton_.options(), solve == VelocitySolve::kNewtonKrylov);
     count_solve(result);
     if (!result.converged) return failure(result, describe(result));
     return StepStatus::success();
@@ -489,6 +501,7 @@ class HamiltonPontryagin final : public Integrator,
   bool minimize_written_;  // solver=minimize given explicitly: refused on non-separable problems
   Forcing forcing_;
   NewtonSolver newton_;
+  VelocitySolve solve_;
   Vec velocity_;  // HP velocity v_{k+1}
 
   // Per-step data used by the residual and objective.
@@ -534,8 +547,9 @@ std::unique_ptr<Integrator> make_hp(Params& params) {
   const bool minimize_written = params.given("solver") && solver == "minimize";
   const Forcing forcing = read_forcing(params);
   const NewtonOptions newton = read_newton_options(params, "|p| + h|grad V| + |F_d-|");
+  const VelocitySolve solve = read_velocity_solve_option(params);
   return std::make_unique<HamiltonPontryagin>(alpha, solver == "minimize", minimize_written,
-                                              forcing, newton);
+                                              forcing, newton, solve);
 }
 
 }  // namespace geomint

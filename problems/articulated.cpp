@@ -124,7 +124,8 @@ double PlanarTreeDynamics::kinetic_energy(const Vec& theta, const Vec& u) const 
 // p_a = D_a u_a + h_a·U_a + l_a e′_a·k̄_a (K̄, k̄: the sums over a's children), so
 // u_a = (r_a − h_a·U_a)/D_a with r_a = p_a − l_a e′_a·k̄_a, and a's own subtree has
 // K_a = m_a 1 + K̄_a − h_a h_aᵀ/D_a, k_a = k̄_a + h_a r_a/D_a (all in link a's frame).
-void PlanarTreeDynamics::solve_mass(const Vec& theta, const Vec& p, Vec& u) const {
+void PlanarTreeDynamics::solve_mass(const Vec& theta, const Vec& p, Vec& u,
+                                    const Vec* inertia_shift) const {
   const int n = size();
   std::vector<Eigen::Matrix2d> inertia_sum(n, Eigen::Matrix2d::Zero());  // K̄_a
   std::vector<Eigen::Matrix2d> rotation(n);
@@ -136,6 +137,7 @@ void PlanarTreeDynamics::solve_mass(const Vec& theta, const Vec& p, Vec& u) cons
     const Eigen::Vector2d K_across = inertia_sum[a].col(0);
     coupling.col(a) = m * c * kAcross + l * K_across;
     pivot_inertia[a] = tree_.inertia[a] + m * c * c + l * l * K_across[0];
+    if (inertia_shift != nullptr) pivot_inertia[a] += (*inertia_shift)[a];
     rest[a] = p[a] - l * bias_sum(0, a);
     const int up = tree_.parent[a];
     if (up == PlanarTree::kPivot) continue;  // the pivot does not move: K_a is not needed

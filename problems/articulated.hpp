@@ -47,8 +47,10 @@ class PlanarTreeDynamics {
   void apply_mass(const Vec& theta, const Vec& u, Vec& Mu) const;
   // Featherstone's articulated-body recursion in the plane: a pass from the leaves builds each
   // subtree's joint-velocity-to-momentum map P_a = K_a U_a + k_a (K_a 2 × 2), a pass from the
-  // pivot reads off u_a and the joint velocities.
-  void solve_mass(const Vec& theta, const Vec& p, Vec& u) const;
+  // pivot reads off u_a and the joint velocities. With `inertia_shift`, (M + diag(shift))⁻¹p: in
+  // absolute angles a diagonal added to M is extra rotational inertia of each link, so the same
+  // recursion solves it (shift ≥ 0).
+  void solve_mass(const Vec& theta, const Vec& p, Vec& u, const Vec* inertia_shift = nullptr) const;
   void kinetic_gradient(const Vec& theta, const Vec& u, Vec& T_q) const;
   double kinetic_energy(const Vec& theta, const Vec& u) const;
   // V = Σ m_i g y_i = −Σ_a w_a cos θ_a, ∇V_a = w_a sin θ_a, w_a = g (m_a c_a + l_a W_a) with
@@ -122,6 +124,13 @@ class PlanarTreeLagrangian : public LagrangianSystem {
   }
   void solve_mass(const Vec& q, const Vec& p, Vec& v) const override {
     dynamics_.solve_mass(q, p, v);
+  }
+  bool mass_is_recursive() const override { return true; }
+  // ∇²V = diag(w_a cos θ_a) is diagonal in absolute angles: its non-negative part goes into the
+  // articulated-body solve as link inertia (2 passes, as solve_mass).
+  void solve_mass_with_stiffness(const Vec& q, double c, const Vec& r, Vec& x) const override {
+    const Vec shift = c * dynamics_.weight().cwiseProduct(q.array().cos().matrix()).cwiseMax(0.0);
+    dynamics_.solve_mass(q, r, x, &shift);
   }
 
  private:

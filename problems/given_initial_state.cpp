@@ -146,6 +146,10 @@ class GivenInitialLagrangian final : public GivenInitialState, public Lagrangian
   void solve_mass(const Vec& q, const Vec& p, Vec& v) const override {
     system_.solve_mass(q, p, v);
   }
+  bool mass_is_recursive() const override { return system_.mass_is_recursive(); }
+  void solve_mass_with_stiffness(const Vec& q, double c, const Vec& r, Vec& x) const override {
+    system_.solve_mass_with_stiffness(q, c, r, x);
+  }
   // One override each for Problem's and LagrangianSystem's V and ∇V (the same functions).
   double potential(const Vec& q) const override { return system_.potential(q); }
   void gradient(const Vec& q, Vec& g) const override { system_.gradient(q, g); }

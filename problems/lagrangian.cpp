@@ -60,6 +60,14 @@ Vec LagrangianSystem::momentum(const Vec& q, const Vec& v) const {
   return M * v + a;
 }
 
+Vec LagrangianSystem::momentum_by_operator(const Vec& q, const Vec& v) const {
+  Vec Mv;
+  apply_mass(q, v, Mv);
+  Vec a;
+  gyroscopic(q, a);
+  return Mv + a;
+}
+
 Vec LagrangianSystem::velocity(const Vec& q, const Vec& p) const {
   Vec a;
   gyroscopic(q, a);

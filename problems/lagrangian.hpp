@@ -50,6 +50,17 @@ class LagrangianSystem {
   // structure (sparse, or an O(n) recursion) overrides them and need never form M.
   virtual void apply_mass(const Vec& q, const Vec& v, Vec& Mv) const;
   virtual void solve_mass(const Vec& q, const Vec& p, Vec& v) const;
+  // Whether apply_mass, solve_mass, kinetic_gradient, gradient and the gyroscopic force are O(n)
+  // recursions, so that a method is to avoid every dense n × n member: del and hp then solve
+  // their step matrix-free by default (integrators/operator_del_solve.hpp). Default: false.
+  virtual bool mass_is_recursive() const { return false; }
+  // x = (M(q) + c K₊(q))⁻¹ r, c ≥ 0, with K₊ a non-negative diagonal part of ∇²V(q) that the mass
+  // solve can take at no extra cost: the matrix-free DEL/HP preconditioner, which with
+  // c = h²α(1−α) is the step's Jacobian without its velocity terms, so that stiff potential
+  // modes (hω ≫ 1 on a long chain) do not slow the iteration. Default: solve_mass (K₊ = 0).
+  virtual void solve_mass_with_stiffness(const Vec& q, double /*c*/, const Vec& r, Vec& x) const {
+    solve_mass(q, r, x);
+  }
 
   // ---- The Lagrangian and its derivatives, assembled from the primitives ----
   double lagrangian(const Vec& q, const Vec& v) const;
@@ -57,6 +68,9 @@ class LagrangianSystem {
   void lagrangian_q(const Vec& q, const Vec& v, Vec& L_q) const;
   // L_v = p = M(q)v + a(q).
   Vec momentum(const Vec& q, const Vec& v) const;
+  // The same through apply_mass, O(n) on a recursive mass (momentum() forms M: its rounding is
+  // that of the committed dense results): the matrix-free del and hp residual.
+  Vec momentum_by_operator(const Vec& q, const Vec& v) const;
   // v = M(q)⁻¹(p − a(q)): the inverse Legendre map (a Cholesky solve).
   Vec velocity(const Vec& q, const Vec& p) const;
   // L_vq = ∂L_v/∂q = D + A (not symmetric in general; L_qv = L_vqᵀ).

@@ -7,7 +7,8 @@ files = system("ls curves")
 # before it: the articulated_chain block is marked so, the other blocks are the rod chain.
 method_of(f) = f[strstrt(f, "__") + 2:strlen(f) - 4]
 block_of(f) = f[1:strstrt(f, "__") - 1]
-title_of(f) = mtitle(method_of(f)) . (block_of(f) eq "cost_articulated" ? " (articulated_chain)" : "")
+title_of(f) = mtitle(method_of(f)) . (block_of(f) eq "cost_articulated" ? " (articulated_chain)" : \
+  (block_of(f) eq "cost_dense" ? " (dense Newton)" : ""))
 # References through RK4's cost at n = 64 (slope 1) and the dense DEL step's at n = 16 (slope 3).
 stats "curves/cost_recursive__rk4.csv" using (column("n") == 64 ? column("wall_s_per_step") : NaN) nooutput
 c1 = STATS_min / 64
@@ -24,7 +25,7 @@ do for [format in "png pdf svg"] {
   set key outside right top font ",10"
   set rmargin 30
   plot for [f in files] "curves/".f using "n":"wall_s_per_step" with linespoints ls ms(method_of(f)) \
-         dt 1 + 2 * (block_of(f) eq "cost_articulated") title title_of(f), \
+         dt 1 + 2 * (block_of(f) eq "cost_articulated") + 3 * (block_of(f) eq "cost_dense") title title_of(f), \
        c1 * x with lines lw 1 dt (4,4) lc rgb "#888888" title "slope 1 (O(n))", \
        (x <= 100 ? c3 * x**3 : 1/0) with lines lw 1 dt (2,2) lc rgb "#444444" title "slope 3 (O(n^3))"
   unset output
