@@ -1,6 +1,7 @@
 // Per-step cost of del and hp solved matrix-free (integrators/operator_del_solve.hpp) and of RK4,
 // all on the O(n) articulated recursions, on the rope at n = 64, 256, 1024 at its default step and
-// at h = 0.01 (docs/PERF.md "Articulated bodies"); counters: tree passes and iterations per step.
+// at h = 0.01 (docs/PERF.md "Articulated chains: DEL and HP in O(n)"); counters: tree passes and
+// iterations per step.
 #include <benchmark/benchmark.h>
 
 #include <memory>

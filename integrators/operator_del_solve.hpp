@@ -13,7 +13,7 @@ namespace geomint {
 
 class Params;
 
-// How del and hp solve R(v) = 0 on an unconstrained problem (docs/METHODS.md "del", "hp"):
+// How del and hp solve R(v) = 0 on an unconstrained problem (docs/METHODS.md "Articulated bodies"):
 //  - kDense: NewtonSolver on the assembled Jacobian (SparseLU / LDLT);
 //  - kMatrixFree: quasi-Newton v ← v − P⁻¹R(v) with P = M(q̄) + h²α(1−α)K₊(q̄) applied by the
 //    problem's O(n) solve (LagrangianSystem::solve_mass_with_stiffness), after Lee, Liu, Park &
