@@ -16,6 +16,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace chaos_metrics_test {
 namespace {
 
 // H = p²/2m − ½kq²: every tangent vector grows like e^{λt}, λ = √(k/m), on every orbit.
@@ -200,4 +201,5 @@ TEST(PoincareSection, CrossingsLieOnTheSectionAtTheExactTimes) {
 }
 
 }  // namespace
+}  // namespace chaos_metrics_test
 }  // namespace geomint

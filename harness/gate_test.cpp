@@ -15,6 +15,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace gate_test {
 namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
@@ -444,4 +445,5 @@ TEST(Gate, RepositoryGatesPassOnTheCommittedResults) {
 }
 
 }  // namespace
+}  // namespace gate_test
 }  // namespace geomint

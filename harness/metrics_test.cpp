@@ -13,6 +13,7 @@
 #include "harness/table.hpp"
 
 namespace geomint {
+namespace metrics_test {
 namespace {
 
 TEST(MetricTable, NamesAreUniqueAndFoundByName) {
@@ -85,4 +86,5 @@ TEST(MetricTable, MetricOptionsAreTheDeclaredOptionsInRankOrder) {
 }
 
 }  // namespace
+}  // namespace metrics_test
 }  // namespace geomint

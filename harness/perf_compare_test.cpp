@@ -18,6 +18,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace perf_compare_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -276,4 +277,5 @@ TEST_F(BenchmarkJson, RefusesTruncatedMalformedAndDuplicatedInput) {
 }
 
 }  // namespace
+}  // namespace perf_compare_test
 }  // namespace geomint

@@ -12,6 +12,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace record_test {
 namespace {
 
 std::vector<std::string> schema_names() {
@@ -155,4 +156,5 @@ TEST(OrderRecord, FitColumnsOnlyForStudiesThatRan) {
 }
 
 }  // namespace
+}  // namespace record_test
 }  // namespace geomint

@@ -15,6 +15,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace reference_test {
 namespace {
 
 std::filesystem::path temp_dir(const std::string& name) {
@@ -217,4 +218,5 @@ TEST(Reference, BadOptionsAreInputErrors) {
 }
 
 }  // namespace
+}  // namespace reference_test
 }  // namespace geomint

@@ -18,6 +18,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace report_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -477,4 +478,5 @@ TEST_F(ReportTest, FlagsTablesOfAnEditedScene) {
 }
 
 }  // namespace
+}  // namespace report_test
 }  // namespace geomint

@@ -10,6 +10,7 @@
 #include <vector>
 
 namespace geomint {
+namespace run_spec_test {
 namespace {
 
 bool mentions(const std::vector<std::string>& errors, const std::string& fragment) {
@@ -111,4 +112,5 @@ TEST(RunSpec, RunOneOfObjectsMatchesTheSpecStringForm) {
 }
 
 }  // namespace
+}  // namespace run_spec_test
 }  // namespace geomint

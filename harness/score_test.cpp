@@ -24,6 +24,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace score_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -223,4 +224,5 @@ TEST(Score, ReaderRefusesDamagedFiles) {
 }
 
 }  // namespace
+}  // namespace score_test
 }  // namespace geomint

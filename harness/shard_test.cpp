@@ -21,6 +21,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace shard_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -357,4 +358,5 @@ TEST(Paths, MessageNamesTheFileUnderADeepFolder) {
 }
 
 }  // namespace
+}  // namespace shard_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace stability_test {
 namespace {
 
 // A search from the specs the test names.
@@ -167,4 +168,5 @@ TEST(StabilityScene, BlockIsParsedRunAndWritten) {
 }
 
 }  // namespace
+}  // namespace stability_test
 }  // namespace geomint

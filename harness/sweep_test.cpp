@@ -18,6 +18,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace sweep_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -329,4 +330,5 @@ TEST(SweepSpecs, EachSpecIsParsedOncePerSweep) {
 }
 
 }  // namespace
+}  // namespace sweep_test
 }  // namespace geomint

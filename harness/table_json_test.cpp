@@ -12,6 +12,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace table_json_test {
 namespace {
 
 CsvTable odd_table() {
@@ -114,4 +115,5 @@ TEST(TableJson, FormatsAreCsvAndJson) {
 }
 
 }  // namespace
+}  // namespace table_json_test
 }  // namespace geomint

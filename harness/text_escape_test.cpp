@@ -8,6 +8,7 @@
 #include <string>
 
 namespace geomint {
+namespace text_escape_test {
 namespace {
 
 const std::string kFffd = "\xEF\xBF\xBD";
@@ -52,4 +53,5 @@ TEST(TextEscape, JsonEscapesQuotesBackslashesAndControls) {
 }
 
 }  // namespace
+}  // namespace text_escape_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "harness/run_spec.hpp"
 
 namespace geomint {
+namespace timing_test {
 namespace {
 
 // Samples at a non-unit scale (0.25 s steps): every expected value below is exact in binary.
@@ -128,4 +129,5 @@ TEST(Interrupt, EndsRunsAtTheNextStepPointUntilCleared) {
 }
 
 }  // namespace
+}  // namespace timing_test
 }  // namespace geomint

@@ -8,6 +8,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace adaptive_verlet_test {
 namespace {
 
 struct EnergyHistory {
@@ -77,4 +78,5 @@ TEST(AdaptiveVerlet, ErrorFollowsTheTolerance) {
 }
 
 }  // namespace
+}  // namespace adaptive_verlet_test
 }  // namespace geomint

@@ -37,6 +37,7 @@ extern "C" void* malloc(std::size_t size) noexcept {
 #endif
 
 namespace geomint {
+namespace advance_test {
 namespace {
 
 // The harness's per-step path: step() on each grid step, t set to the grid time after it.
@@ -161,4 +162,5 @@ TEST(Advance, ExplicitLoopsDoNotAllocate) {
 #endif
 
 }  // namespace
+}  // namespace advance_test
 }  // namespace geomint

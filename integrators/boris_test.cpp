@@ -14,6 +14,7 @@
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
+namespace boris_test {
 namespace {
 
 double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
@@ -239,4 +240,5 @@ TEST(Boris, RunsOnChargedParticlesOnly) {
 }
 
 }  // namespace
+}  // namespace boris_test
 }  // namespace geomint

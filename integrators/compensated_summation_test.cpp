@@ -8,6 +8,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace compensated_summation_test {
 namespace {
 
 struct RunResult {
@@ -61,4 +62,5 @@ TEST(CompensatedSummation, OnlyTheVerletBaseImplementsIt) {
 }
 
 }  // namespace
+}  // namespace compensated_summation_test
 }  // namespace geomint

@@ -16,6 +16,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace conjugate_gradient_test {
 namespace {
 
 // A sparse SPD matrix of n unknowns, stored in full: diagonal 4.5 + sin(i) (unequal, so the
@@ -155,4 +156,5 @@ TEST(ConjugateGradient, BothLoopsReportNegativeCurvature) {
 }
 
 }  // namespace
+}  // namespace conjugate_gradient_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "problems/mass_operator.hpp"
 
 namespace geomint {
+namespace constrained_methods_test {
 namespace {
 
 struct Outcome {
@@ -406,4 +407,5 @@ TEST(Penalty, RefusesUnconstrainedProblemsAndConstrainedBases) {
 }
 
 }  // namespace
+}  // namespace constrained_methods_test
 }  // namespace geomint

@@ -10,6 +10,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace energy_preserving_test {
 namespace {
 
 // Two bodies of masses 3 and 0.5 at G = 0.7 on an eccentric relative orbit (Kepler at non-unit
@@ -145,4 +146,5 @@ TEST(EnergyPreservingFlags, NeitherDeclaresSymplecticBothDeclareEnergy) {
 }
 
 }  // namespace
+}  // namespace energy_preserving_test
 }  // namespace geomint

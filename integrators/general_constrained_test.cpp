@@ -15,6 +15,7 @@
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
+namespace general_constrained_test {
 namespace {
 
 // The methods that constrain the general kind through general_constrained_step.
@@ -173,4 +174,5 @@ TEST(GeneralConstrainedStep, EveryConstrainedMethodRunsAndrewsOrSaysWhyNot) {
 }
 
 }  // namespace
+}  // namespace general_constrained_test
 }  // namespace geomint

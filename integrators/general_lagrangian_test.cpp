@@ -16,6 +16,7 @@
 #include "problems/lagrangian.hpp"
 
 namespace geomint {
+namespace general_lagrangian_test {
 namespace {
 
 double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
@@ -355,4 +356,5 @@ TEST(ArticulatedRk4, SixteenRecursivePassesPerStep) {
 }
 
 }  // namespace
+}  // namespace general_lagrangian_test
 }  // namespace geomint

@@ -16,6 +16,7 @@
 #include <vector>
 
 namespace geomint {
+namespace high_order_coefficients_test {
 namespace {
 
 using Real = long double;
@@ -340,4 +341,5 @@ TEST(CompositionSchemes, NegativeControlAWrongDigitIsSeen) {
 }
 
 }  // namespace
+}  // namespace high_order_coefficients_test
 }  // namespace geomint

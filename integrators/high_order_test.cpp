@@ -12,6 +12,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace high_order_test {
 namespace {
 
 // Largest relative distance in (q, p) between two methods' trajectories over `steps` steps.
@@ -213,4 +214,5 @@ TEST(HighOrderFailure, NewtonFailureIsAStatus) {
 }
 
 }  // namespace
+}  // namespace high_order_test
 }  // namespace geomint

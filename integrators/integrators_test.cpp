@@ -18,6 +18,7 @@
 #include "problems/structures/free_rigid_body.hpp"
 
 namespace geomint {
+namespace integrators_test {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
@@ -789,4 +790,5 @@ TEST(Registry, ProviderIsTheEntrysDataNotTheName) {
 }
 
 }  // namespace
+}  // namespace integrators_test
 }  // namespace geomint

@@ -18,6 +18,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace library_wrappers_test {
 namespace {
 
 double state_error(const State& a, const State& b) {
@@ -740,4 +741,5 @@ TEST(Parameters, ErkTablesListTheValidNames) {
 }
 
 }  // namespace
+}  // namespace library_wrappers_test
 }  // namespace geomint

@@ -12,6 +12,7 @@
 #include "problems/rigid_body.hpp"
 
 namespace geomint {
+namespace lie_poisson_test {
 namespace {
 
 // Away from the separatrix (|Π|² > 2E I₂ here), non-unit and unequal moments.
@@ -146,4 +147,5 @@ TEST(LiePoisson, AppliesToFreeRigidBodiesOnlyAndSaysWhy) {
 }
 
 }  // namespace
+}  // namespace lie_poisson_test
 }  // namespace geomint

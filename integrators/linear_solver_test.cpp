@@ -13,6 +13,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace linear_solver_test {
 namespace {
 
 const std::vector<std::string> kSolvers = {"ldlt", "ldlt_metis", "cholmod",
@@ -414,4 +415,5 @@ TEST(LinearSolvers, BadValueIsAnInputErrorNamingTheAllowedValues) {
 }
 
 }  // namespace
+}  // namespace linear_solver_test
 }  // namespace geomint

@@ -14,6 +14,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace nbody_reference_test {
 namespace {
 
 // The Test Set orders y = (x1…x7, y1…y7, ẋ1…ẋ7, ẏ1…ẏ7); nbody stores q = (x1, y1, x2, y2, …).
@@ -94,4 +95,5 @@ TEST(Pleiades, TightRunsReproduceTheTestSetReferenceAtTThree) {
 }
 
 }  // namespace
+}  // namespace nbody_reference_test
 }  // namespace geomint

@@ -15,6 +15,7 @@
 #include "integrators/step_implementation.hpp"
 
 namespace geomint {
+namespace one_step_test {
 namespace {
 
 // The methods whose separable and general steps are one function today. generalized_leapfrog
@@ -80,4 +81,5 @@ TEST(OneStepPerMethod, SeparableAndGeneralKindsRunTheSameStep) {
 }
 
 }  // namespace
+}  // namespace one_step_test
 }  // namespace geomint

@@ -19,6 +19,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace operator_del_solve_test {
 namespace {
 
 double inf_norm(const Vec& x) { return x.cwiseAbs().maxCoeff(); }
@@ -209,4 +210,5 @@ TEST(MatrixFreeVelocitySolve, NonConvergingStepIsAFailureStatus) {
 }
 
 }  // namespace
+}  // namespace operator_del_solve_test
 }  // namespace geomint

@@ -12,6 +12,7 @@
 #include "problems/rigid_body.hpp"
 
 namespace geomint {
+namespace quaternion_test {
 namespace {
 
 // Away from the separatrix, non-unit and unequal moments, a general initial attitude.
@@ -120,4 +121,5 @@ TEST(Quaternion, AppliesToFreeRigidBodiesOnlyAndSaysWhy) {
 }
 
 }  // namespace
+}  // namespace quaternion_test
 }  // namespace geomint

@@ -11,6 +11,7 @@
 #include <vector>
 
 namespace geomint {
+namespace rkn_coefficients_test {
 namespace {
 
 using Real = long double;
@@ -170,4 +171,5 @@ TEST(RknTables, AWrongDigitIsSeen) {
 }
 
 }  // namespace
+}  // namespace rkn_coefficients_test
 }  // namespace geomint

@@ -15,6 +15,7 @@ namespace coefficients {
 // gtest names a failing table by its name, not by its bytes.
 void PrintTo(const RknTable& table, std::ostream* out) { *out << table.name; }
 }  // namespace coefficients
+namespace rkn_test {
 namespace {
 
 std::string spec(const coefficients::RknTable& table) {
@@ -146,4 +147,5 @@ TEST(Rkn, DefaultsFlagsAndFamilies) {
 }
 
 }  // namespace
+}  // namespace rkn_test
 }  // namespace geomint

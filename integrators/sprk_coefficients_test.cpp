@@ -11,6 +11,7 @@
 #include <vector>
 
 namespace geomint {
+namespace sprk_coefficients_test {
 namespace {
 
 using Real = long double;
@@ -202,4 +203,5 @@ TEST(SprkTables, AWrongDigitIsSeen) {
 }
 
 }  // namespace
+}  // namespace sprk_coefficients_test
 }  // namespace geomint

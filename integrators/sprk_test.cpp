@@ -16,6 +16,7 @@ namespace coefficients {
 // gtest names a failing table by its spec value, not by its bytes.
 void PrintTo(const SprkTable& table, std::ostream* out) { *out << table.name; }
 }  // namespace coefficients
+namespace sprk_test {
 namespace {
 
 std::string spec(const coefficients::SprkTable& table) {
@@ -151,4 +152,5 @@ TEST(Sprk, DefaultAndFlags) {
 }
 
 }  // namespace
+}  // namespace sprk_test
 }  // namespace geomint

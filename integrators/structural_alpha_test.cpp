@@ -11,6 +11,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace structural_alpha_test {
 namespace {
 
 constexpr double kHugeStep = 1e6;  // h·ω with ω = 1: the hω → ∞ limit up to O((hω)⁻²)
@@ -118,4 +119,5 @@ TEST(GeneralizedAlpha, RestartingFromTheConsistentAccelerationLosesTheRequestedD
 }
 
 }  // namespace
+}  // namespace structural_alpha_test
 }  // namespace geomint

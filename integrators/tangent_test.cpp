@@ -13,6 +13,7 @@
 #include <vector>
 
 namespace geomint {
+namespace tangent_test {
 namespace {
 
 // One step of a fresh, reset integrator from `start`, as (q, p).
@@ -106,4 +107,5 @@ TEST(StepTangent, IsNotOfferedWhereItIsNotDerived) {
 }
 
 }  // namespace
+}  // namespace tangent_test
 }  // namespace geomint

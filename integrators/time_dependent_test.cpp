@@ -16,6 +16,7 @@
 #include "integrators/time_treatment.hpp"
 
 namespace geomint {
+namespace time_dependent_test {
 namespace {
 
 constexpr const char* kProblem = "damped_harmonic_td";
@@ -169,4 +170,5 @@ TEST(TimeDependent, SprkOrdersByTimeTreatment) {
 }
 
 }  // namespace
+}  // namespace time_dependent_test
 }  // namespace geomint

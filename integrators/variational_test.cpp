@@ -17,6 +17,7 @@
 #include "verify/verify.hpp"
 
 namespace geomint {
+namespace variational_test {
 namespace {
 
 std::string test_name(const testing::TestParamInfo<std::string>& info) {
@@ -785,4 +786,5 @@ TEST(NewtonExtensions, CentralDifferenceJacobianMatchesTheAnalyticOne) {
 }
 
 }  // namespace
+}  // namespace variational_test
 }  // namespace geomint

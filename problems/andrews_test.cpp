@@ -13,6 +13,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace andrews_test {
 namespace {
 
 // The Test Set's data (andrews.f).
@@ -156,4 +157,5 @@ TEST(Andrews, OutOfRangeParametersAreInputErrorsNamingTheRange) {
 }
 
 }  // namespace
+}  // namespace andrews_test
 }  // namespace geomint

@@ -16,6 +16,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace articulated_test {
 namespace {
 
 double inf_norm(const Eigen::MatrixXd& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
@@ -326,4 +327,5 @@ TEST(Articulated, BadInputNamesParameterAndRange) {
 }
 
 }  // namespace
+}  // namespace articulated_test
 }  // namespace geomint

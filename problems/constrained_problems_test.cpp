@@ -11,6 +11,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace constrained_problems_test {
 namespace {
 
 std::vector<std::string> constrained_specs() {
@@ -117,4 +118,5 @@ TEST(CartesianPendulum, FollowsTheAnglePendulum) {
 }
 
 }  // namespace
+}  // namespace constrained_problems_test
 }  // namespace geomint

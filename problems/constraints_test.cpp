@@ -11,6 +11,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace constraints_test {
 namespace {
 
 std::vector<std::string> constrained_specs() {
@@ -273,4 +274,5 @@ TEST(ConstrainedProblems, BadParametersNameTheKey) {
 }
 
 }  // namespace
+}  // namespace constraints_test
 }  // namespace geomint

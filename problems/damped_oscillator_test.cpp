@@ -14,6 +14,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace damped_oscillator_test {
 namespace {
 
 struct Case {
@@ -268,4 +269,5 @@ TEST(NonConservativeForce, CapabilitiesFollowTheQueryAndCannotBeClaimed) {
 }
 
 }  // namespace
+}  // namespace damped_oscillator_test
 }  // namespace geomint

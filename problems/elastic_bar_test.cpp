@@ -19,6 +19,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace elastic_bar_test {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
@@ -537,4 +538,5 @@ TEST(ElasticBar, HundredThousandTetrahedra) {
 }
 
 }  // namespace
+}  // namespace elastic_bar_test
 }  // namespace geomint

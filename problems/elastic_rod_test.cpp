@@ -14,6 +14,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace elastic_rod_test {
 namespace {
 
 // K and M of a rod as dense matrices: K from its Hessian (lumped) or potential Hessian
@@ -113,4 +114,5 @@ TEST(ElasticRod, ExactTipConvergesToTheDalembertTriangleWave) {
 }
 
 }  // namespace
+}  // namespace elastic_rod_test
 }  // namespace geomint

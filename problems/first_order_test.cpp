@@ -13,6 +13,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace first_order_test {
 namespace {
 
 std::vector<std::string> first_order_specs() {
@@ -173,4 +174,5 @@ TEST(FirstOrderProblems, KindFollowsTheQueryAndCannotBeClaimed) {
 }
 
 }  // namespace
+}  // namespace first_order_test
 }  // namespace geomint

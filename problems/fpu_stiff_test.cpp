@@ -13,6 +13,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace fpu_stiff_test {
 namespace {
 
 // GNI (5.2)–(5.3): x₀,ᵢ = (q_{2i} + q_{2i−1})/√2, x₁,ᵢ = (q_{2i} − q_{2i−1})/√2, y likewise.
@@ -114,4 +115,5 @@ TEST(FpuStiff, OmegaMaxIsTheStiffFrequencyAtRest) {
 }
 
 }  // namespace
+}  // namespace fpu_stiff_test
 }  // namespace geomint

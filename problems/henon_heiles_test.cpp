@@ -10,6 +10,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace henon_heiles_test {
 namespace {
 
 TEST(HenonHeiles, InitialStateHasTheRequestedEnergy) {
@@ -44,4 +45,5 @@ TEST(HenonHeiles, EnergyBelowThePotentialNamesTheKey) {
 }
 
 }  // namespace
+}  // namespace henon_heiles_test
 }  // namespace geomint

@@ -16,6 +16,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace lagrangian_test {
 namespace {
 
 double inf_norm(const Eigen::MatrixXd& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
@@ -337,4 +338,5 @@ TEST(KeplerPolar, ExactIsTheCartesianOrbitInPolarCoordinates) {
 }
 
 }  // namespace
+}  // namespace lagrangian_test
 }  // namespace geomint

@@ -10,6 +10,7 @@
 #include <string>
 
 namespace geomint {
+namespace mass_operator_test {
 namespace {
 
 // A configuration away from the initial one and a vector with no zero entry, so that a q-dependent
@@ -73,4 +74,5 @@ TEST(MassOperator, AgreesWithTheDenseMassOnEveryProblem) {
 }
 
 }  // namespace
+}  // namespace mass_operator_test
 }  // namespace geomint

@@ -14,6 +14,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace nbody_test {
 namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
@@ -208,4 +209,5 @@ TEST(ParametricOscillator, ResonatesAtTwiceTheFrequency) {
 }
 
 }  // namespace
+}  // namespace nbody_test
 }  // namespace geomint

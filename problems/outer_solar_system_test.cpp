@@ -9,6 +9,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace outer_solar_system_test {
 namespace {
 
 struct BodyData {
@@ -88,4 +89,5 @@ TEST(OuterSolarSystem, PlanetCountSelectsTheInnermostBodies) {
 }
 
 }  // namespace
+}  // namespace outer_solar_system_test
 }  // namespace geomint

@@ -36,6 +36,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace problems_test {
 namespace {
 
 // gtest names allow only [A-Za-z0-9_]: "pendulum:theta0=-2.0" -> "pendulum_theta0_m2p0".
@@ -1074,4 +1075,5 @@ TEST(KeplerProblem, ExactSolutionConvergesWhereNewtonAlternatesBetweenTwoFloats)
 }
 
 }  // namespace
+}  // namespace problems_test
 }  // namespace geomint

@@ -18,6 +18,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace rigid_body_test {
 namespace {
 
 std::string message_of(const std::string& spec) {
@@ -229,4 +230,5 @@ TEST(RigidBodyEuler, IsEulersEquationsWithTheEllipticSolution) {
 }
 
 }  // namespace
+}  // namespace rigid_body_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace spring_chain_test {
 namespace {
 
 // Squared frequencies of M⁻¹K from the assembled Hessian, ascending.
@@ -113,4 +114,5 @@ TEST(SpringChain, RejectsModeOutsideTheChain) {
 }
 
 }  // namespace
+}  // namespace spring_chain_test
 }  // namespace geomint

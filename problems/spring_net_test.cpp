@@ -15,6 +15,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace spring_net_test {
 namespace {
 
 int dimension_of(const Problem& problem) {
@@ -385,4 +386,5 @@ TEST(SpringNet, BadParametersNameTheKey) {
 }
 
 }  // namespace
+}  // namespace spring_net_test
 }  // namespace geomint

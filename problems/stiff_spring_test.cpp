@@ -9,6 +9,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace stiff_spring_test {
 namespace {
 
 TEST(StiffSpring, FrequenciesSolveTheCharacteristicPolynomial) {
@@ -59,4 +60,5 @@ TEST(StiffSpring, StiffSpringBarelyStretchesWhenOnlyTheSlowModeIsExcited) {
 }
 
 }  // namespace
+}  // namespace stiff_spring_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "problems/structures/kepler_orbit.hpp"
 
 namespace geomint {
+namespace toda_test {
 namespace {
 
 // RK4 on the first-order view with `steps` steps to t_end: h·ω ≈ 1e-3 makes its error ~1e-13.
@@ -112,4 +113,5 @@ TEST(KeplerOrbit, EccentricityVectorIsTheOrbitsAndIsKept) {
 }
 
 }  // namespace
+}  // namespace toda_test
 }  // namespace geomint

@@ -29,6 +29,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace bad_input_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -2017,4 +2018,5 @@ TEST(Debris, SigintLeavesNoTemporaryFile) {
 }
 
 }  // namespace
+}  // namespace bad_input_test
 }  // namespace geomint

@@ -18,6 +18,7 @@
 #include "harness/paths.hpp"
 
 namespace geomint {
+namespace bit_identical_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -164,4 +165,5 @@ TEST(BitIdentical, RerunsAndJobsOneOrTwoWriteTheSameNonTimingBytes) {
 }
 
 }  // namespace
+}  // namespace bit_identical_test
 }  // namespace geomint

@@ -6,6 +6,7 @@
 
 #include <string>
 
+namespace blas_binding_test {
 namespace {
 
 // The shared object that defines `symbol` in this process's global lookup scope, where GSL's own
@@ -43,3 +44,4 @@ TEST(BlasBinding, SolvesThroughItGiveTheExactAnswer) {
 }
 
 }  // namespace
+}  // namespace blas_binding_test

@@ -12,6 +12,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace catalogue_runs_test {
 namespace {
 
 double run_metric(const std::string& problem, const std::string& method, double dt, double t_end,
@@ -153,4 +154,5 @@ TEST(ElasticBarRuns, VariationalMethodsKeepTheFreeBarsMomenta) {
 }
 
 }  // namespace
+}  // namespace catalogue_runs_test
 }  // namespace geomint

@@ -23,6 +23,7 @@
 #include "harness/paths.hpp"
 
 namespace geomint {
+namespace cli_help_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -153,4 +154,5 @@ TEST(CliHelp, EveryVerbShowsItsDefaultsAndNotTheExitCodes) {
 }
 
 }  // namespace
+}  // namespace cli_help_test
 }  // namespace geomint

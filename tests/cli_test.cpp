@@ -26,6 +26,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -927,4 +928,5 @@ TEST(Cli, SeriesAndOutThroughASymbolicLinkAreOneFile) {
 }
 
 }  // namespace
+}  // namespace cli_test
 }  // namespace geomint

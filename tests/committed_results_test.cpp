@@ -20,6 +20,7 @@
 #include "harness/table.hpp"
 
 namespace geomint {
+namespace committed_results_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -139,4 +140,5 @@ INSTANTIATE_TEST_SUITE_P(Results, CommittedScene, ::testing::ValuesIn(scenes_wit
                          });
 
 }  // namespace
+}  // namespace committed_results_test
 }  // namespace geomint

@@ -13,6 +13,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace constrained_kkt_test {
 namespace {
 
 // A bead of unit mass on the unit circle in the concave potential V = −(c/4)(x⁴ + y⁴) (four
@@ -264,4 +265,5 @@ TEST(ConstrainedKkt, BeadInConcaveWellsIsKeptSymmetricAndSecondOrder) {
 }
 
 }  // namespace
+}  // namespace constrained_kkt_test
 }  // namespace geomint

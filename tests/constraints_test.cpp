@@ -20,6 +20,7 @@
 #include "verify/verify.hpp"
 
 namespace geomint {
+namespace constraints_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -362,4 +363,5 @@ TEST(Constraints, InapplicablePairsAreSkippedRowsInASweep) {
 }
 
 }  // namespace
+}  // namespace constraints_test
 }  // namespace geomint

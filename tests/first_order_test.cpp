@@ -12,6 +12,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace first_order_test {
 namespace {
 
 RunResult run(const std::string& problem, const std::string& method, double dt, double t_end) {
@@ -109,4 +110,5 @@ TEST(FirstOrderRuns, LagrangianOnlyOptionsRefuseOrSkip) {
 }
 
 }  // namespace
+}  // namespace first_order_test
 }  // namespace geomint

@@ -21,6 +21,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace general_problems_test {
 namespace {
 
 double inf_norm(const Vec& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
@@ -338,4 +339,5 @@ TEST(GeneralRows, ChargedParticleFromAFileKeepsItsFields) {
 }
 
 }  // namespace
+}  // namespace general_problems_test
 }  // namespace geomint

@@ -15,6 +15,7 @@
 #include "harness/table.hpp"
 
 namespace geomint {
+namespace harness_test {
 namespace {
 
 TEST(Spec, ParsesNameAndValues) {
@@ -207,4 +208,5 @@ TEST(Scene, RejectsBadFiles) {
 }
 
 }  // namespace
+}  // namespace harness_test
 }  // namespace geomint

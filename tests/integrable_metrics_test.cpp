@@ -15,6 +15,7 @@
 #include "problems/structures/kepler_orbit.hpp"
 
 namespace geomint {
+namespace integrable_metrics_test {
 namespace {
 
 RunRecord run_with(const std::string& problem, const std::string& method, double dt, double t_end,
@@ -128,4 +129,5 @@ TEST(LoopActionMetric, RoundOffForSymplecticMethodsAndNotForRk4) {
 }
 
 }  // namespace
+}  // namespace integrable_metrics_test
 }  // namespace geomint

@@ -15,6 +15,7 @@
 #include "harness/structure_metrics.hpp"
 
 namespace geomint {
+namespace map_defect_test {
 namespace {
 
 // A nonlinear problem with unit masses (Kepler, e = 0.5) and one with non-unit masses and
@@ -387,4 +388,5 @@ TEST(MapDefect, AppliesOnlyToCanonicalUnconstrainedMaps) {
 }
 
 }  // namespace
+}  // namespace map_defect_test
 }  // namespace geomint

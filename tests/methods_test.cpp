@@ -15,6 +15,7 @@
 #include "verify/verify.hpp"
 
 namespace geomint {
+namespace methods_test {
 namespace {
 
 // Constraints-only methods (rattle, penalty) are checked on constrained problems instead
@@ -309,4 +310,5 @@ INSTANTIATE_TEST_SUITE_P(Registry, EveryImplicitMethod, testing::ValuesIn(implic
                          test_name);
 
 }  // namespace
+}  // namespace methods_test
 }  // namespace geomint

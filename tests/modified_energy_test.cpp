@@ -13,6 +13,7 @@
 #include "harness/run.hpp"
 
 namespace geomint {
+namespace modified_energy_test {
 namespace {
 
 // Non-unit scales: a pendulum with ω₀ = 1.7 at a large amplitude, Kepler at e = 0.5, and an FPU-β
@@ -109,4 +110,5 @@ TEST(ModifiedEnergy, AppliesOnlyWhereTheCorrectionIsKnown) {
 }
 
 }  // namespace
+}  // namespace modified_energy_test
 }  // namespace geomint

@@ -19,6 +19,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace newton_golden_test {
 namespace {
 
 const char* const kGoldenFile = GEOMINT_SOURCE_DIR "/tests/golden/newton_work.csv";
@@ -98,4 +99,5 @@ TEST(NewtonGolden, EveryImplicitMethodReproducesItsWorkAndFinalStateBitForBit) {
 }
 
 }  // namespace
+}  // namespace newton_golden_test
 }  // namespace geomint

@@ -12,6 +12,7 @@
 #include "harness/run.hpp"
 
 namespace geomint {
+namespace phase_metrics_test {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -113,4 +114,5 @@ TEST(PhaseMetrics, StormerVerletOnHarmonicMatchesDiscreteFrequency) {
 }
 
 }  // namespace
+}  // namespace phase_metrics_test
 }  // namespace geomint

@@ -17,6 +17,7 @@
 #include "integrators/integrator.hpp"
 
 namespace geomint {
+namespace rigid_body_test {
 namespace {
 
 // Non-unit moments, Π circulating about the largest axis, attitude away from I.
@@ -305,4 +306,5 @@ TEST(RigidBodyRuns, IdaIndex3RunsFromAStartInMotion) {
 }
 
 }  // namespace
+}  // namespace rigid_body_test
 }  // namespace geomint

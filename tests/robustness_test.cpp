@@ -17,6 +17,7 @@
 #include "problems/problem.hpp"
 
 namespace geomint {
+namespace robustness_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -245,4 +246,5 @@ TEST(Scene, EveryCommittedSceneLoads) {
 }
 
 }  // namespace
+}  // namespace robustness_test
 }  // namespace geomint

@@ -19,6 +19,7 @@
 #include "harness/run_spec.hpp"
 
 namespace geomint {
+namespace structure_metrics_test {
 namespace {
 
 // Round-off: DΦ is the exact linearised step (Integrator::step_tangent), and for an implicit
@@ -368,4 +369,5 @@ TEST(DivergeFactor, LowFactorStopsAndInfinityRunsToTheEnd) {
 }
 
 }  // namespace
+}  // namespace structure_metrics_test
 }  // namespace geomint

@@ -35,6 +35,7 @@
 #include "problems/spec.hpp"
 
 namespace geomint {
+namespace table_roundtrip_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -340,4 +341,5 @@ TEST(StaleTemporaries, WriterNamesCarryThisMachinesTag) {
 }
 
 }  // namespace
+}  // namespace table_roundtrip_test
 }  // namespace geomint

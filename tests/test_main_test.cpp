@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+namespace test_main_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -22,3 +23,4 @@ TEST(TestScratchFolder, IsPrivateToTheProcessAndSharedByBothLookups) {
 }
 
 }  // namespace
+}  // namespace test_main_test

@@ -26,6 +26,7 @@
 #include "tests/test_util.hpp"
 
 namespace geomint {
+namespace threads_test {
 namespace {
 
 // 24·8·8 cells = 9216 tets: 4 chunks at 4 threads (2048 elements per chunk at least), so every
@@ -347,4 +348,5 @@ TEST(ThreadSetting, RefusesCountsOutsideItsRangeAndLimitsChunks) {
 }
 
 }  // namespace
+}  // namespace threads_test
 }  // namespace geomint

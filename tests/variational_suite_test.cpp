@@ -10,6 +10,7 @@
 #include "harness/run.hpp"
 
 namespace geomint {
+namespace variational_suite_test {
 namespace {
 
 double fitted_order(const std::string& method) {
@@ -58,4 +59,5 @@ TEST(VariationalMomenta, HpKeepsSpringNetMomentaNewmarkLosesAngularMomentum) {
 }
 
 }  // namespace
+}  // namespace variational_suite_test
 }  // namespace geomint
