@@ -266,20 +266,20 @@ TEST(OdeIdentification, BothSteppersAreFirstOrderOnThePendulum) {
   }
 }
 
-// A sweep steps several ODE worlds at once, one per worker thread. Each world must step on its own
-// threading implementation: ODE's default is one process-wide job list without locks, and two
-// concurrent dWorldStep calls on it abort the process in ODE's dDebug.
-TEST(OdeThreads, WorldsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
+// Runs `method_spec` `runs` times on each of two threads at once, on a chain and on the heavy top,
+// and expects every run to end where one run alone does: no state shared between an engine's
+// models across threads (a sweep runs them on its worker threads).
+void expect_concurrent_runs_match_one_alone(const std::string& method_spec, int runs) {
   for (const std::string spec : {"rod_chain:coordinates=joint,n=4,theta=0.3", "heavy_top"}) {
     SCOPED_TRACE(spec);
     const auto problem = make_problem(spec);
-    const int runs = 1000, steps = 50;
-    const State alone = run_steps("ode:step=world", *problem, 0.001, steps);
+    const int steps = 50;
+    const State alone = run_steps(method_spec, *problem, 0.001, steps);
     std::vector<std::vector<State>> concurrent(2, std::vector<State>(runs));
     std::vector<std::thread> threads;
     for (std::vector<State>& results : concurrent) {
-      threads.emplace_back([&problem, &results] {
-        for (State& result : results) result = run_steps("ode:step=world", *problem, 0.001, steps);
+      threads.emplace_back([&problem, &results, &method_spec] {
+        for (State& result : results) result = run_steps(method_spec, *problem, 0.001, steps);
       });
     }
     for (std::thread& thread : threads) thread.join();
@@ -290,6 +290,13 @@ TEST(OdeThreads, WorldsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
       }
     }
   }
+}
+
+// A sweep steps several ODE worlds at once, one per worker thread. Each world must step on its own
+// threading implementation: ODE's default is one process-wide job list without locks, and two
+// concurrent dWorldStep calls on it abort the process in ODE's dDebug.
+TEST(OdeThreads, WorldsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
+  expect_concurrent_runs_match_one_alone("ode:step=world", 1000);
 }
 
 TEST(OdeApplicability, RefusesOtherProblemsNamingThoseThatApply) {
@@ -501,26 +508,7 @@ TEST(DartDefaults, ShippedDefaultsTakeTheCleanSteps) {
 // A sweep builds and steps DART skeletons on several worker threads at once: they take the steps
 // they take alone (DART keeps no per-process state in a step).
 TEST(DartThreads, SkeletonsBuiltAndSteppedOnTwoThreadsStepAsTheyDoAlone) {
-  for (const std::string spec : {"rod_chain:coordinates=joint,n=4,theta=0.3", "heavy_top"}) {
-    SCOPED_TRACE(spec);
-    const auto problem = make_problem(spec);
-    const int runs = 200, steps = 50;
-    const State alone = run_steps("dart", *problem, 0.001, steps);
-    std::vector<std::vector<State>> concurrent(2, std::vector<State>(runs));
-    std::vector<std::thread> threads;
-    for (std::vector<State>& results : concurrent) {
-      threads.emplace_back([&problem, &results] {
-        for (State& result : results) result = run_steps("dart", *problem, 0.001, steps);
-      });
-    }
-    for (std::thread& thread : threads) thread.join();
-    for (const std::vector<State>& results : concurrent) {
-      for (const State& result : results) {
-        EXPECT_EQ(result.q, alone.q);
-        EXPECT_EQ(result.p, alone.p);
-      }
-    }
-  }
+  expect_concurrent_runs_match_one_alone("dart", 200);
 }
 
 // Every DART step far beyond any stable step on a stiff 3-link chain: the state grows until the

@@ -303,8 +303,8 @@ TEST(GeneralRows, InitialStateFileUsesThePositionDependentMass) {
 }
 
 // A charged particle started from a file keeps its mass, charge and fields
-// (Problem::as<ChargedParticleStructure>() forwarded by the initial= wrapper): Boris runs, and it and the
-// magnetic-moment metric give the direct run's bits from the same start.
+// (Problem::as<ChargedParticleStructure>() forwarded by the initial= wrapper): Boris runs, and it
+// and the magnetic-moment metric give the direct run's bits from the same start.
 TEST(GeneralRows, ChargedParticleFromAFileKeepsItsFields) {
   const std::filesystem::path dir =
       std::filesystem::path(testing::TempDir()) / "geomint_charged_initial";
