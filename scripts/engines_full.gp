@@ -6,9 +6,9 @@ load scripts."/common.gp"
 H0 = (2 * pi)**2 * (1 - cos(1))
 envelope(file) = sprintf("< awk -F, -v column=energy -v ref=%.17g -v per_decade=10 -v min_width=0.54 -v min_count=5 -f %s %s 2>/dev/null", H0, sh_quoted(scripts."/envelope.awk"), file)
 clip(x) = x > 1e-17 ? x : 1e-17  # exact zeros drawn at 1e-17 on the log axes
-engines = "mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4"
+engines = "mujoco_integrator_euler mujoco_integrator_rk4 mujoco_integrator_implicit ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4 dart_integrator_world dart_integrator_euler dart_integrator_rk4"
 pendulum_methods = engines." del hp stormer_verlet rk4 implicit_euler"
-shipped = "mujoco_integrator_euler ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4"
+shipped = "mujoco_integrator_euler ode_step_world ode_step_quick bullet_integrator_euler bullet_integrator_rk4 dart_integrator_world"
 has(file) = system("test -f ".file." && echo 1") eq "1"
 maybe(file) = has(file) ? file : "< printf 't,max\n'"
 panels = "pendulum_h60 pendulum_h240 pendulum_h1000"
