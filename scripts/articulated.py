@@ -3,8 +3,11 @@
 blocks of summary.csv (labels cost_*) per step and per method against the number of links n
 (cost.csv: wall time, recursive passes, force evaluations and Newton iterations per step), the
 least-squares exponent of wall time per step against n over n = 64 ... 1024, and over 16 ... 64
-where the dense and capped forms stop (cost_fit.csv, a row per range with two n or more), and
-one curve file per block and method under curves/ for scripts/articulated.gp.
+where the dense and capped forms stop (cost_fit.csv, a row per range with two n or more; column
+exponent), the same exponent of the work per step that no machine changes, n times the recursive
+passes per step (each pass visits every link once; column work_exponent, only for the blocks
+whose methods do nothing else: RECURSIVE_BLOCKS, engines aside), and one curve file per block and method under curves/ for
+scripts/articulated.gp.
 
 Usage: articulated.py FOLDER     (results/articulated or results/articulated/quick)
        articulated.py --selftest (the fit and the n parser on made-up rows)
@@ -19,6 +22,13 @@ import sys
 from geomint_tables import read_table
 
 FIT_RANGES = [(64, 1024), (16, 64)]
+# The blocks whose geomint methods do nothing per step but O(n) recursive passes (no dense or
+# sparse factorisation: cost_dense's LU and cost_rattle's KKT solve are not passes), so that n ×
+# the passes per step is their whole work; and the methods of provider `engine` (geomint list
+# methods), whose counted passes are the adapter's (the momentum read back after each engine
+# step), not the engine's own work.
+RECURSIVE_BLOCKS = ("cost_recursive", "cost_articulated")
+ENGINES = ("mujoco", "ode", "bullet", "dart")
 
 
 def links_of(problem):
@@ -43,6 +53,18 @@ def fit_exponent(points):
     mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
     sxx = sum((x - mx) ** 2 for x in xs)
     return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx
+
+
+def fit_work_exponent(label, method, points, n_low, n_high):
+    """The exponent of n × recursive passes per step over n_low ... n_high (each pass visits every
+    link once); None outside RECURSIVE_BLOCKS, for an engine, and unless every point in the range
+    counted its passes."""
+    if label not in RECURSIVE_BLOCKS or method.partition(":")[0] in ENGINES:
+        return None
+    in_range = [p for p in points if n_low <= p["n"] <= n_high]
+    if not in_range or not all(p["recursive_passes_per_step"] for p in in_range):
+        return None
+    return fit_exponent([(p["n"], p["n"] * p["recursive_passes_per_step"]) for p in in_range])
 
 
 def fmt(value):
@@ -95,17 +117,20 @@ def main(folder):
             exponent = fit_exponent(in_range)
             if exponent is None:
                 continue
+            work_exponent = fit_work_exponent(label, method, points, n_low, n_high)
             fits.append({
                 "label": label, "method": method, "problem": problem,
                 "n_range": f"{n_low}-{n_high}",
                 "n_min": min(n for n, _ in in_range), "n_max": max(n for n, _ in in_range),
                 "points": len(in_range), "exponent": round(exponent, 3),
+                "work_exponent": round(work_exponent, 3) if work_exponent is not None else None,
             })
     write(os.path.join(folder, "cost.csv"), header, cost,
           ["label", "method", "problem", "n", "steps", "wall_s_per_step",
            "recursive_passes_per_step", "force_evals_per_step", "newton_iters_per_step"])
     write(os.path.join(folder, "cost_fit.csv"), header, fits,
-          ["label", "method", "problem", "n_range", "n_min", "n_max", "points", "exponent"])
+          ["label", "method", "problem", "n_range", "n_min", "n_max", "points", "exponent",
+           "work_exponent"])
     curves = os.path.join(folder, "curves")
     shutil.rmtree(curves, ignore_errors=True)
     os.makedirs(curves)
@@ -134,6 +159,17 @@ def selftest():
     assert abs(fit_exponent([(n, 3e-7 * n ** 1.0) for n in (64, 128, 256)]) - 1.0) < 1e-12
     assert abs(fit_exponent([(n, 2e-9 * n ** 3.0) for n in (64, 128)]) - 3.0) < 1e-12
     assert fit_exponent([(64, 1.0)]) is None
+    # Passes per step constant in n: work exactly O(n); passes growing as n^0.25: n^1.25; a point
+    # without a pass count (an engine) leaves the work exponent empty.
+    flat = [{"n": n, "recursive_passes_per_step": 16.0} for n in (64, 256, 1024)]
+    assert abs(fit_work_exponent("cost_recursive", "rk4", flat, 64, 1024) - 1.0) < 1e-12
+    growing = [{"n": n, "recursive_passes_per_step": 3.0 * n ** 0.25} for n in (64, 128, 1024)]
+    assert abs(fit_work_exponent("cost_recursive", "del:tol=1e-12", growing, 64, 1024) - 1.25) < 1e-12
+    assert fit_work_exponent("cost_recursive", "rk4", flat + [{"n": 512, "recursive_passes_per_step": None}], 64, 1024) \
+        is None
+    assert fit_work_exponent("cost_recursive", "rk4", flat, 2, 32) is None
+    assert fit_work_exponent("cost_recursive", "bullet:integrator=euler", flat, 64, 1024) is None
+    assert fit_work_exponent("cost_dense", "del:solve=dense", flat, 64, 1024) is None
     assert curve_name("cost_mujoco", "mujoco:defaults=clean,integrator=rk4") == \
         "cost_mujoco__mujoco_integrator_rk4"
     assert curve_name("cost_dense", "del:force_at=midpoint,tol=1e-12") == "cost_dense__del"
