@@ -3,6 +3,7 @@
 // engine model it builds for each, and the state's trip into the engine and back.
 #pragma once
 
+#include <concepts>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -13,15 +14,40 @@
 
 namespace geomint::engines {
 
+// An engine's model of a planar chain (engines/planar_chain.hpp), built from the problem's own
+// parameters: set_state(θ, θ̇) and get_state(θ, θ̇) in the problem's absolute angles, one engine
+// step of length h (a failure is a status naming the engine's message), and the engine's own
+// potential and kinetic energy at the state last set, which the fidelity tests set against the
+// problem's. Optional: bool momentum_absolute(Vec& p), p = M(θ)θ̇ from the engine's own mass
+// matrix where it holds one at the new state (false: the caller uses the problem's).
+template <class Engine, class Options>
+concept ChainEngineModel = std::constructible_from<Engine, const PlanarChain&, const Options&> &&
+    requires(Engine& engine, const Vec& in, Vec& out, double h) {
+  engine.set_state(in, in);
+  engine.get_state(out, out);
+  { engine.step(h) } -> std::same_as<StepStatus>;
+  { engine.potential() } -> std::convertible_to<double>;
+  { engine.kinetic() } -> std::convertible_to<double>;
+};
+
+// An engine's model of one rigid body about a fixed point (engines/rotor.hpp): its state is the
+// attitude and body angular velocity of the rotor's principal frame (RotorStateMap::to_principal);
+// step and energies as ChainEngineModel.
+template <class Engine, class Options>
+concept RotorEngineModel = std::constructible_from<Engine, const Rotor&, const Options&> &&
+    requires(Engine& engine, const RotorState& state, double h) {
+  engine.set_state(state);
+  { engine.get_state() } -> std::same_as<RotorState>;
+  { engine.step(h) } -> std::same_as<StepStatus>;
+  { engine.potential() } -> std::convertible_to<double>;
+  { engine.kinetic() } -> std::convertible_to<double>;
+};
+
 // The problem's state goes into the engine only when it is not the state the previous step wrote
 // (a fresh run, a reversibility check), so a run follows the engine's own trajectory without a
 // round trip through the problem's momenta per step.
-// ChainEngine: constructed from (const PlanarChain&, const Options&), with set_state(θ, θ̇),
-// StepStatus step(h) and get_state(θ, θ̇) in the problem's absolute angles.
-// RotorEngine: constructed from (const Rotor&, const Options&), with set_state(RotorState),
-// StepStatus step(h) and RotorState get_state(), the attitude and body angular velocity of the
-// rotor's principal frame (RotorStateMap::to_principal).
 template <class ChainEngine, class RotorEngine, class Options>
+requires ChainEngineModel<ChainEngine, Options> && RotorEngineModel<RotorEngine, Options>
 class EngineMethod : public Integrator, public RunsListedProblems {
  public:
   EngineMethod(Options options, std::string engine)

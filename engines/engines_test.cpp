@@ -10,6 +10,7 @@
 
 #include "engines/bullet.hpp"
 #include "engines/dart.hpp"
+#include "engines/engine_method.hpp"
 #include "engines/mujoco.hpp"
 #include "engines/ode.hpp"
 #include "engines/planar_chain.hpp"
@@ -21,6 +22,25 @@
 
 namespace geomint::engines {
 namespace {
+
+// The contracts of engines/engine_method.hpp hold for every adapter, and refuse a model that
+// lacks a member EngineMethod or the fidelity tests use (here: the energies).
+struct ChainWithoutEnergies {
+  ChainWithoutEnergies(const PlanarChain&, const OdeOptions&) {}
+  void set_state(const Vec&, const Vec&) {}
+  void get_state(Vec&, Vec&) {}
+  StepStatus step(double) { return StepStatus::success(); }
+};
+static_assert(ChainEngineModel<MujocoChain, MujocoOptions> &&
+              ChainEngineModel<OdeChain, OdeOptions> &&
+              ChainEngineModel<BulletChain, BulletOptions> &&
+              ChainEngineModel<DartChain, DartOptions>);
+static_assert(RotorEngineModel<MujocoRotor, MujocoOptions> &&
+              RotorEngineModel<OdeRotor, OdeOptions> &&
+              RotorEngineModel<BulletRotor, BulletOptions> &&
+              RotorEngineModel<DartRotor, DartOptions>);
+static_assert(!ChainEngineModel<ChainWithoutEnergies, OdeOptions>);
+static_assert(!ChainEngineModel<OdeChain, MujocoOptions>);  // built from its own options only
 
 // Every chain problem at its defaults and at non-unit parameters (so a swapped mass or length
 // shows), up to the longest rod chain the problem allows.
