@@ -35,14 +35,29 @@ Coefficients coefficients(bool diagonal_mass) {
 const Vec kQ0 = (Vec(2) << 0.02, -0.035).finished();
 const Vec kV0 = (Vec(2) << 0.4, 0.9).finished();
 
+// F = −Cv, the force both kinds below take.
+class LinearDamping : public NonConservativeForce {
+ public:
+  explicit LinearDamping(const Eigen::Matrix2d& damping) : damping_(damping) {}
+  bool has_force_jacobian() const override { return true; }
+  void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -damping_ * v; }
+  void force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix& C) const override {
+    C = damping_.sparseView();
+  }
+
+ private:
+  Eigen::Matrix2d damping_;
+};
+
 // The general kind: L = ½vᵀMv − ½qᵀKq with M constant but given as M(q) (mass_matrix), F = −Cv.
 // `recursive` declares the mass an O(n) operator, so that del and hp take their matrix-free
 // solve (operator_del_solve.hpp) as on the articulated chains.
 class GeneralDampedOscillator final : public Problem,
                                       public LagrangianSystem,
-                                      public NonConservativeForce {
+                                      public LinearDamping {
  public:
-  GeneralDampedOscillator(const Coefficients& c, bool recursive) : c_(c), recursive_(recursive) {
+  GeneralDampedOscillator(const Coefficients& c, bool recursive)
+      : LinearDamping(c.damping), c_(c), recursive_(recursive) {
     set_dof(2);
     set_capabilities(0);
     set_defaults(0.01, 1.0);
@@ -64,12 +79,6 @@ class GeneralDampedOscillator final : public Problem,
   void potential_hessian(const Vec&, DenseMatrix& K) const override { K = c_.stiffness; }
   bool mass_is_recursive() const override { return recursive_; }
 
-  bool has_force_jacobian() const override { return true; }
-  void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -c_.damping * v; }
-  void force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix& C) const override {
-    C = c_.damping.sparseView();
-  }
-
  private:
   Coefficients c_;
   bool recursive_;
@@ -77,9 +86,9 @@ class GeneralDampedOscillator final : public Problem,
 
 // The same system on the separable kind (constant diagonal M), the path the catalogue's damped
 // problems take.
-class SeparableDampedOscillator final : public Problem, public NonConservativeForce {
+class SeparableDampedOscillator final : public Problem, public LinearDamping {
  public:
-  explicit SeparableDampedOscillator(const Coefficients& c) : c_(c) {
+  explicit SeparableDampedOscillator(const Coefficients& c) : LinearDamping(c.damping), c_(c) {
     set_mass(c.mass.diagonal());
     set_capabilities(kHessian);
     set_defaults(0.01, 1.0);
@@ -89,12 +98,6 @@ class SeparableDampedOscillator final : public Problem, public NonConservativeFo
   double potential(const Vec& q) const override { return 0.5 * q.dot(c_.stiffness * q); }
   void gradient(const Vec& q, Vec& g) const override { g = c_.stiffness * q; }
   void hessian(const Vec&, SparseMatrix& H) const override { H = c_.stiffness.sparseView(); }
-
-  bool has_force_jacobian() const override { return true; }
-  void force(const Vec&, const Vec& v, double, Vec& f) const override { f = -c_.damping * v; }
-  void force_jacobian_v(const Vec&, const Vec&, double, SparseMatrix& C) const override {
-    C = c_.damping.sparseView();
-  }
 
  private:
   Coefficients c_;
