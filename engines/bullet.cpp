@@ -317,7 +317,7 @@ class BulletMethod final : public EngineMethod<BulletChain, BulletRotor, BulletO
              "(rigid_body) is a btRigidBody, whose step is Bullet's semi-implicit Euler only "
              "(use bullet or bullet:gyro=...)";
     }
-    if (!free_body && options_.gyro != "implicit_body") {
+    if (!free_body && options_.gyro_given) {
       return fmt::format(
           "method 'bullet:gyro={}' sets the gyroscopic term of a btRigidBody, which "
           "only the free body (rigid_body) is; problem '{}' is a btMultiBody",
@@ -340,6 +340,7 @@ std::unique_ptr<Integrator> make_bullet(Params& params) {
       params.choice("defaults", "clean", {"clean", "shipped"},
                     "clean: no damping, sleeping or velocity clamp; shipped: Bullet's own "
                     "defaults (damping 0.04, joint rates clamped at 100)") == "shipped";
+  options.gyro_given = params.given("gyro");
   options.gyro = params.choice(
       "gyro", "implicit_body", engines::bullet_gyroscopic_modes(),
       "the free body's (btRigidBody's) gyroscopic term: none, explicit "

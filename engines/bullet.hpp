@@ -18,6 +18,9 @@ struct BulletOptions {
   // The btRigidBody's gyroscopic term (the free body only): none, explicit, implicit_body
   // (Bullet's default), implicit_world.
   std::string gyro = "implicit_body";
+  // Whether the spec wrote gyro= (a btMultiBody refuses it even at the default value: it has no
+  // such term).
+  bool gyro_given = false;
 };
 
 const std::vector<std::string>& bullet_integrators();

@@ -701,7 +701,8 @@ TEST(RotorApplicability, EveryEngineRunsTheRotorProblemsAndRefusesTheRest) {
   EXPECT_FALSE(rk4.ok);
   EXPECT_NE(rk4.reason.find("btRigidBody"), std::string::npos) << rk4.reason;
   EXPECT_TRUE(applicable(*make_integrator("bullet:integrator=rk4"), *make_problem("heavy_top")).ok);
-  for (const std::string gyro : {"none", "explicit", "implicit_world"}) {
+  // Every gyro= value, Bullet's default included, is the btRigidBody's and refused on the top.
+  for (const std::string gyro : {"none", "explicit", "implicit_world", "implicit_body"}) {
     const auto method = make_integrator("bullet:gyro=" + gyro);
     EXPECT_TRUE(applicable(*method, *make_problem("rigid_body")).ok) << gyro;
     const Applicability top = applicable(*method, *make_problem("heavy_top"));
