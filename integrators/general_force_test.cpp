@@ -7,7 +7,6 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <string>
-#include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
 #include "integrators/integrator.hpp"
@@ -121,16 +120,26 @@ RunEnd run(const std::string& method, const Problem& problem, double h, int step
   return {state, "", integrator->counters()};
 }
 
-// The exact (q, p) at t: y = exp(At) y₀ for y = (q, v), ẏ = (v, −M⁻¹(Kq + Cv)), p = Mv.
+// The exact (q, p) at t to round-off: y' = Ay for y = (q, v), A = [0 I; −M⁻¹K −M⁻¹C], by classical
+// RK4 with 2¹⁶ steps (its error, ~(t/2¹⁶)⁴·|A|⁵·t ≈ 1e-13 here, is far below the errors tested),
+// written out here so that the reference shares no code with the methods; p = Mv.
 State exact(const Coefficients& c, double t) {
   Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
   A.topRightCorner<2, 2>() = Eigen::Matrix2d::Identity();
   const Eigen::Matrix2d inverse_mass = c.mass.inverse();
   A.bottomLeftCorner<2, 2>() = -inverse_mass * c.stiffness;
   A.bottomRightCorner<2, 2>() = -inverse_mass * c.damping;
-  Eigen::Vector4d start;
-  start << kQ0, kV0;
-  const Eigen::Vector4d y = (A * t).exp() * start;
+  Eigen::Vector4d y;
+  y << kQ0, kV0;
+  constexpr int kSteps = 1 << 16;
+  const double h = t / kSteps;
+  for (int k = 0; k < kSteps; ++k) {
+    const Eigen::Vector4d k1 = A * y;
+    const Eigen::Vector4d k2 = A * (y + (h / 2) * k1);
+    const Eigen::Vector4d k3 = A * (y + (h / 2) * k2);
+    const Eigen::Vector4d k4 = A * (y + h * k3);
+    y += (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
   return {t, y.head<2>(), c.mass * y.tail<2>()};
 }
 
